@@ -99,6 +99,7 @@ class RunConfig:
             "eta": float(self.eta),
             "D": float(self.D),
             "truncation": float(self.truncation) if self.truncation is not None else math.inf,
+            "dt_growth": float(self.dt_growth),
             "seed": int(self.seed),
         }
 

@@ -1,0 +1,20 @@
+# Reproduces every figure of Benson et al. (2020), "Entropy: (1) The former trouble with
+# particle-tracking simulation, and (2) A measure of computational information penalty".
+from snakemake.utils import min_version
+
+min_version("8.0")
+
+
+configfile: "config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/simulate.smk"
+include: "workflow/rules/aggregate.smk"
+include: "workflow/rules/figures.smk"
+
+
+rule all:
+    input:
+        all_targets(),
+    default_target: True

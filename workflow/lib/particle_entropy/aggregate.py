@@ -1,0 +1,95 @@
+"""Ensemble statistics over realisations, COMIC tables and their minima (Figs. 3-6, 8, 9)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
+CASE_KEYS = ["method", "kernel", "n", "eta", "truncation", "dt_growth"]
+SUMMARY_COLUMNS = {
+    "step": "time-step index",
+    "time": "time [T]",
+    "n_realisations": "number of realisations averaged",
+    **{f"{m}_mean": f"ensemble mean of {m}" for m in METRICS},
+    **{f"{m}_std": f"ensemble standard deviation of {m} (ddof = 1; 0 for one realisation)" for m in METRICS},
+}
+
+
+def summarise_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
+    """Per-step ensemble mean and standard deviation of every metric over realisations of one case."""
+    if not runs:
+        raise ValueError("no realisations to summarise")
+    steps = [r["step"].to_numpy() for r in runs]
+    if any(len(s) != len(steps[0]) or np.any(s != steps[0]) for s in steps):
+        raise ValueError("realisations of one case must share their time steps")
+    first = runs[0]
+    out = {"step": first["step"].to_numpy(), "time": first["time"].to_numpy(), "n_realisations": len(runs)}
+    for m in METRICS:
+        v = np.stack([r[m].to_numpy(dtype=np.float64) for r in runs])
+        with np.errstate(invalid="ignore"):  # -inf at t = 0 stays -inf, its std is nan -> 0
+            out[f"{m}_mean"] = v.mean(axis=0)
+            std = v.std(axis=0, ddof=1) if len(runs) > 1 else np.zeros(v.shape[1])
+        out[f"{m}_std"] = np.where(np.isfinite(std), std, 0.0)
+    df = pd.DataFrame(out)
+    for c in ["H_C_analytic", "E_analytic", "dV", "settled"]:
+        df[c] = first[c].to_numpy()
+    for c in ["method", "kernel", "n", "eta", "truncation", "D"]:
+        df[c] = first[c].iloc[0]
+    return df
+
+
+def model_name(method: str, kernel: str, eta: float) -> str:
+    """Human name of a model, e.g. 'mtpt collision eta=1' or 'fd'."""
+    if method == "fd":
+        return "fd"
+    if method == "pt":
+        return f"pt {kernel}"
+    return f"{method} {kernel} eta={eta:g}"
+
+
+def at_times(summary: pd.DataFrame, times: list[float]) -> pd.DataFrame:
+    """Rows of ``summary`` nearest to each requested time (one row per time)."""
+    t = summary["time"].to_numpy()
+    idx = [int(np.argmin(np.abs(t - x))) for x in times]
+    rows = summary.iloc[idx].copy()
+    rows["time_requested"] = list(times)
+    return rows
+
+
+def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
+    """COMIC and SSE statistics per model, N and requested time (results/tables/comic.parquet)."""
+    rows = []
+    for s in summaries:
+        for _, r in at_times(s, times).iterrows():
+            rows.append({
+                "model": model_name(r["method"], r["kernel"], r["eta"]),
+                "method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]),
+                "n": int(r["n"]), "time": float(r["time_requested"]), "time_step": float(r["time"]),
+                "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
+                "SSE_mean": r["SSE_mean"], "SSE_std": r["SSE_std"],
+                "n_realisations": int(r["n_realisations"]),
+            })
+    cols = ["model", "method", "kernel", "eta", "n", "time", "time_step", "COMIC_mean", "COMIC_std",
+            "SSE_mean", "SSE_std", "n_realisations"]
+    return pd.DataFrame(rows, columns=cols).sort_values(["model", "time", "n"], ignore_index=True)
+
+
+def comic_minima(comic: pd.DataFrame) -> pd.DataFrame:
+    """For each model and time: the N minimising mean COMIC, its COMIC, and its neighbours' values."""
+    rows = []
+    for (model, time), g in comic.groupby(["model", "time"], sort=True):
+        g = g.sort_values("n", ignore_index=True)
+        k = int(np.argmin(g["COMIC_mean"].to_numpy()))
+        below = g.iloc[k - 1] if k > 0 else None
+        above = g.iloc[k + 1] if k + 1 < len(g) else None
+        rows.append({
+            "model": model, "time": time, "n_opt": int(g["n"][k]),
+            "COMIC_opt": g["COMIC_mean"][k], "COMIC_opt_std": g["COMIC_std"][k],
+            "n_below": int(below["n"]) if below is not None else -1,
+            "COMIC_below": below["COMIC_mean"] if below is not None else np.nan,
+            "n_above": int(above["n"]) if above is not None else -1,
+            "COMIC_above": above["COMIC_mean"] if above is not None else np.nan,
+            "interior": below is not None and above is not None,
+        })
+    return pd.DataFrame(rows)

@@ -1,0 +1,45 @@
+# Ensembles -> per-step means and standard deviations; COMIC tables, minima, paper claims.
+
+
+rule summarise_case:
+    input:
+        summary_runs,
+    output:
+        "results/tables/cases/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{count}.parquet",
+    log:
+        "logs/summarise_case/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{count}.log",
+    resources:
+        mem_mb=500,
+    script:
+        "../scripts/summarise_case.py"
+
+
+rule comic_tables:
+    input:
+        comic_summaries(),
+    output:
+        comic="results/tables/comic.parquet",
+        minima="results/tables/comic_minima.parquet",
+    log:
+        "logs/comic_tables.log",
+    params:
+        times=config["comic_times"],
+    script:
+        "../scripts/comic_tables.py"
+
+
+rule paper_claims:
+    input:
+        minima="results/tables/comic_minima.parquet",
+        comic="results/tables/comic.parquet",
+        summaries=[summary_path(c) for f in ("fig3", "fig5") if f in FIGURES for c in figure_cases(config, f)],
+        runs=[run_path(c, 0, config) for c in figure_cases(config, "fig1")] if "fig1" in FIGURES else [],
+    output:
+        table="results/tables/paper_claims.parquet",
+        md="results/paper_claims.md",
+    log:
+        "logs/paper_claims.log",
+    params:
+        claims=config["claims"],
+    script:
+        "../scripts/paper_claims.py"
