@@ -5,11 +5,13 @@ rule summarise_case:
     input:
         summary_runs,
     output:
-        "results/tables/cases/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{count}.parquet",
+        "results/tables/cases/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{nreal}.parquet",
     log:
-        "logs/summarise_case/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{count}.log",
+        "logs/summarise_case/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{nreal}.log",
     resources:
         mem_mb=500,
+    conda:
+        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/summarise_case.py"
 
@@ -24,6 +26,8 @@ rule comic_tables:
         "logs/comic_tables.log",
     params:
         times=config["comic_times"],
+    conda:
+        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/comic_tables.py"
 
@@ -41,5 +45,7 @@ rule paper_claims:
         "logs/paper_claims.log",
     params:
         claims=config["claims"],
+    conda:
+        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/paper_claims.py"

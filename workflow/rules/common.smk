@@ -30,7 +30,7 @@ wildcard_constraints:
     trunc=r"none|[0-9.eE+-]+",
     growth=r"[0-9.eE+-]+",
     seed=r"\d+",
-    count=r"\d+",
+    nreal=r"\d+",
     fig=r"fig\d+",
 
 

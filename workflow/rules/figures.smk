@@ -18,5 +18,7 @@ for _fig in ALL_FIGURES:
             t_final=config["physics"]["t_final"],
         resources:
             mem_mb=1000,
+        conda:
+            "../../envs/particle-entropy.yaml"
         script:
             "../scripts/plot_figure.py"

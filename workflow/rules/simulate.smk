@@ -23,6 +23,8 @@ rule simulate:
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,
+    conda:
+        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/simulate.py"
 
@@ -40,5 +42,7 @@ rule snapshot:
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,
+    conda:
+        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/simulate.py"

@@ -15,7 +15,7 @@ def entropy_discrete(p: np.ndarray) -> float:
     """H_D = -sum p ln p over the non-zero probabilities (Eq. 2)."""
     p = np.asarray(p, dtype=np.float64)
     p = p[p > 0]
-    return float(-np.sum(p * np.log(p)))
+    return float(-np.sum(p * np.log(p))) + 0.0  # + 0.0: no "-0" for a delta
 
 
 def entropy_inconsistent(f: np.ndarray, dx: float) -> float:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 RUN_DIR = "{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}"
 RUN_PATTERN = "results/{kind}/" + RUN_DIR + "/seed~{seed}.parquet"
-SUMMARY_PATTERN = "results/tables/cases/" + RUN_DIR + "/r~{count}.parquet"
+SUMMARY_PATTERN = "results/tables/cases/" + RUN_DIR + "/r~{nreal}.parquet"
 
 
 def _text(value) -> str:
@@ -23,7 +23,7 @@ def realisations_for(spec: dict, n: int, config: dict) -> int:
     """Realisations of one N in a figure: an integer, or the `realisations` table (capped)."""
     r = spec.get("realisations", 1)
     if r == "ensemble":
-        table = {int(k): int(v) for k, v in config["realisations"].items()}
+        table = {int(e["n"]): int(e["count"]) for e in config["realisations"]}
         if n not in table:
             raise ValueError(f"figure uses realisations: ensemble but realisations has no entry for n={n}")
         r = table[n]
@@ -47,7 +47,7 @@ def figure_cases(config: dict, fig: str) -> list[dict]:
                 "eta": _text(c.get("eta", 1 if fd else defaults.get("eta", 1))),
                 "trunc": _text(c.get("truncation", "none" if fd else defaults.get("truncation", "none"))),
                 "growth": _text(c.get("dt_growth", 1 if fd else defaults.get("dt_growth", config["time"]["dt_growth"]))),
-                "count": str(realisations_for(spec, int(n), config)),
+                "nreal": str(realisations_for(spec, int(n), config)),
             })
     return cases
 
@@ -63,8 +63,8 @@ def summary_path(case: dict) -> str:
 
 def case_runs(wildcards, config: dict) -> list[str]:
     """Run tables behind one case summary (wildcards: a case plus its count)."""
-    case = {k: wildcards[k] for k in ("method", "kernel", "n", "eta", "trunc", "growth", "count")}
-    return [run_path(case, r, config) for r in range(int(case["count"]))]
+    case = {k: wildcards[k] for k in ("method", "kernel", "n", "eta", "trunc", "growth", "nreal")}
+    return [run_path(case, r, config) for r in range(int(case["nreal"]))]
 
 
 def check_sweeps(config: dict) -> None:
