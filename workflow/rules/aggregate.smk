@@ -37,7 +37,7 @@ rule paper_claims:
         minima="results/tables/comic_minima.parquet",
         comic="results/tables/comic.parquet",
         summaries=[summary_path(c) for f in ("fig3", "fig5") if f in FIGURES for c in figure_cases(config, f)],
-        runs=[run_path(c, 0, config) for c in figure_cases(config, "fig1")] if "fig1" in FIGURES else [],
+        runs=[run_path(c, config["base_seed"]) for c in figure_cases(config, "fig1")] if "fig1" in FIGURES else [],
     output:
         table="results/tables/paper_claims.parquet",
         md="results/paper_claims.md",

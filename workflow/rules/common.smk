@@ -29,7 +29,8 @@ wildcard_constraints:
     eta=r"[0-9.eE+-]+",
     trunc=r"none|[0-9.eE+-]+",
     growth=r"[0-9.eE+-]+",
-    seed=r"\d+",
+    first=r"\d+",
+    last=r"\d+",
     nreal=r"\d+",
     fig=r"fig\d+",
 
@@ -51,9 +52,9 @@ def figure_inputs(fig):
         return ["results/tables/comic.parquet"]
     cases = figure_cases(config, fig)
     if config["figures"][fig].get("snapshot"):
-        return [run_path(c, 0, config, kind="snapshots") for c in cases]
+        return [run_path(c, config["base_seed"], kind="snapshots") for c in cases]
     if fig in ("fig1", "fig2"):
-        return [run_path(c, 0, config) for c in cases]
+        return [run_path(c, config["base_seed"]) for c in cases]
     return [summary_path(c) for c in cases]
 
 

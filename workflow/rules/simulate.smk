@@ -1,4 +1,4 @@
-# One job per simulation: (method, kernel, N, eta, truncation, dt growth, seed) -> Parquet.
+# One job per simulation case and block of seeds -> one tidy Parquet table (a `seed` column).
 
 
 def sim_mem_mb(wildcards):
@@ -6,17 +6,17 @@ def sim_mem_mb(wildcards):
 
 
 def sim_runtime_min(wildcards):
-    n = int(wildcards.n)
-    return 5 if n <= 3000 else 30
+    seeds = int(wildcards.last) - int(wildcards.first) + 1
+    return seeds * (2 if int(wildcards.n) <= 3000 else 20)
 
 
 rule simulate:
     output:
-        "results/runs/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.parquet",
+        "results/runs/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.parquet",
     log:
-        "logs/simulate/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.log",
+        "logs/simulate/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.log",
     benchmark:
-        "benchmarks/simulate/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.tsv"
+        "benchmarks/simulate/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.tsv"
     params:
         physics=config["physics"],
         time=config["time"],
@@ -31,11 +31,11 @@ rule simulate:
 
 rule snapshot:
     output:
-        "results/snapshots/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.parquet",
+        "results/snapshots/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.parquet",
     log:
-        "logs/snapshot/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.log",
+        "logs/snapshot/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.log",
     benchmark:
-        "benchmarks/snapshot/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seed~{seed}.tsv"
+        "benchmarks/snapshot/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.tsv"
     params:
         physics=config["physics"],
         time=config["time"],

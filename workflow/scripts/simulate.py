@@ -1,4 +1,7 @@
-"""Run one simulation from Snakemake wildcards; `snapshot` rules write the final state instead."""
+"""Run one block of seeds of one case from Snakemake wildcards -> one tidy Parquet table.
+
+The `snapshot` rule writes the final particle or grid states instead of the per-step tables.
+"""
 
 import sys
 
@@ -6,7 +9,7 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from particle_entropy.io import write_parquet  # noqa: E402
 from particle_entropy.runconfig import RunConfig  # noqa: E402
-from particle_entropy.simulate import run  # noqa: E402
+from particle_entropy.simulate import run_seeds  # noqa: E402
 
 w, phys, tm = snakemake.wildcards, snakemake.params.physics, snakemake.params.time  # noqa: F821
 fd = w.method == "fd"
@@ -20,10 +23,10 @@ cfg = RunConfig(
     dt0=float(tm["fd_dt"] if fd else tm["dt0"]),
     dt_growth=float(w.growth),
     truncation=None if w.trunc == "none" else float(w.trunc),
-    seed=int(w.seed),
     omega=float(phys["omega"]),
     fd_length=float(phys["fd_length"]),
 )
 snapshot = snakemake.rule == "snapshot"  # noqa: F821
-table, state = run(cfg, progress=lambda msg: print(msg, file=sys.stderr), want_state=snapshot)
-write_parquet(state if snapshot else table, snakemake.output[0])  # noqa: F821
+seeds = range(int(w.first), int(w.last) + 1)
+table = run_seeds(cfg, seeds, progress=lambda msg: print(msg, file=sys.stderr), state=snapshot)
+write_parquet(table, snakemake.output[0])  # noqa: F821

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -81,3 +82,14 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, rec: Recorder) -> dict:
         _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
     return {"x": x, "c": c}
 
+
+
+def run_seeds(cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False) -> pd.DataFrame:
+    """Run ``cfg`` for each seed and concatenate the per-step tables (or final states)."""
+    parts = []
+    for seed in seeds:
+        if progress:
+            progress(f"seed {seed}")
+        table, final = run(replace(cfg, seed=int(seed)), progress=progress, want_state=state)
+        parts.append(final if state else table)
+    return pd.concat(parts, ignore_index=True)

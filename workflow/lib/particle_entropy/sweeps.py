@@ -2,13 +2,16 @@
 
 A case is one model setting (method, kernel, N, eta, truncation, dt growth) with the number
 of realisations a figure averages; its runs are realisations r = 0 .. count-1, seeded
-base_seed + r. Paths hold parameters as written in config, so file names stay stable.
+base_seed + r. Small-N realisations are run in blocks of seeds (one job, one table with a
+`seed` column) to amortise job start-up; each seed's random stream depends only on the seed,
+so the blocking never changes a result. Paths hold parameters as written in config, so file
+names stay stable.
 """
 
 from __future__ import annotations
 
 RUN_DIR = "{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}"
-RUN_PATTERN = "results/{kind}/" + RUN_DIR + "/seed~{seed}.parquet"
+RUN_PATTERN = "results/{kind}/" + RUN_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + RUN_DIR + "/r~{nreal}.parquet"
 
 
@@ -52,9 +55,23 @@ def figure_cases(config: dict, fig: str) -> list[dict]:
     return cases
 
 
-def run_path(case: dict, r: int, config: dict, kind: str = "runs") -> str:
-    """Path of realisation ``r`` of ``case`` (kind: runs = per-step table, snapshots = final state)."""
-    return RUN_PATTERN.format(kind=kind, seed=int(config["base_seed"]) + r, **case)
+def seed_blocks(case: dict, config: dict) -> list[tuple[int, int]]:
+    """Inclusive seed ranges of the jobs behind a case: blocks aligned to multiples of the
+    block size (config seed_blocks.size, for N <= seed_blocks.max_n; else one seed a job)."""
+    blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
+    size = int(blocks["size"]) if int(case["n"]) <= int(blocks["max_n"]) else 1
+    base, count = int(config["base_seed"]), int(case["nreal"])
+    return [(base + r, base + min(r + size, count) - 1) for r in range(0, count, size)]
+
+
+def run_path(case: dict, first: int, last: int | None = None, kind: str = "runs") -> str:
+    """Table of seeds first..last of ``case`` (kind: runs = per-step tables, snapshots = final states)."""
+    return RUN_PATTERN.format(kind=kind, first=first, last=first if last is None else last, **case)
+
+
+def case_run_paths(case: dict, config: dict) -> list[str]:
+    """Every run table behind a case."""
+    return [run_path(case, a, b) for a, b in seed_blocks(case, config)]
 
 
 def summary_path(case: dict) -> str:
@@ -62,9 +79,8 @@ def summary_path(case: dict) -> str:
 
 
 def case_runs(wildcards, config: dict) -> list[str]:
-    """Run tables behind one case summary (wildcards: a case plus its count)."""
-    case = {k: wildcards[k] for k in ("method", "kernel", "n", "eta", "trunc", "growth", "nreal")}
-    return [run_path(case, r, config) for r in range(int(case["nreal"]))]
+    """Run tables behind one case summary (wildcards: a case plus its realisation count)."""
+    return case_run_paths({k: wildcards[k] for k in ("method", "kernel", "n", "eta", "trunc", "growth", "nreal")}, config)
 
 
 def check_sweeps(config: dict) -> None:

@@ -1,0 +1,165 @@
+"""MTPT mass transfer (Eqs. 16-21) against a dense transfer matrix built in the tests."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from particle_entropy.mass_transfer import mass_transfer, transfer_matrix_dense
+
+from conftest import dense_kernel, dense_mass_update, dense_transfer_matrix
+
+
+def _positions(rng, n):
+    return np.sort(rng.uniform(-5.0, 5.0, n))
+
+
+def _masses(rng, n, kind):
+    if kind == "delta":  # the paper's initial condition: one unit mass, all others zero
+        m = np.zeros(n)
+        m[n // 2] = 1.0
+        return m
+    m = rng.exponential(1.0, n)
+    m[rng.random(n) < 0.3] = 0.0  # many empty particles
+    return m / m.sum()
+
+
+# --------------------------------------------------------------------------- the dense matrix
+@pytest.mark.parametrize("truncation", [None, 3.0])
+def test_transfer_matrix_dense_is_symmetric_and_matches_definition(rng, truncation):
+    x = _positions(rng, 300)
+    sigma = 0.07
+    P = transfer_matrix_dense(x, sigma, truncation)
+    assert np.array_equal(P, P.T)  # average of row- and column-normalised symmetric W
+    # exp of a large negative argument carries a relative error ~ |arg| eps, hence rtol 1e-12
+    np.testing.assert_allclose(P, dense_transfer_matrix(x, sigma, truncation), rtol=1e-12, atol=1e-16)
+    if truncation is not None:
+        far = np.abs(x[:, None] - x[None, :]) > truncation * sigma
+        assert far.any() and np.all(P[far] == 0.0)
+
+
+@pytest.mark.parametrize("truncation", [None, 3.0])
+@pytest.mark.parametrize("sigma", [0.005, 0.05, 0.5])
+def test_row_sums_identity(rng, sigma, truncation):
+    """Row sums of the symmetrised matrix are 0.5 (1 + sum_j W_ij / r_j), not 1 in general."""
+    x = _positions(rng, 250)
+    P = transfer_matrix_dense(x, sigma, truncation)
+    W = dense_kernel(x, x, sigma, truncation)
+    r = W.sum(axis=1)
+    expected = 0.5 * (1.0 + W @ (1.0 / r))
+    np.testing.assert_allclose(P.sum(axis=1), expected, rtol=1e-13, atol=0)
+    # random spacings: rows do not sum to one (the identity above is not trivially 1)
+    assert np.max(np.abs(P.sum(axis=1) - 1.0)) > 1e-3
+
+
+@pytest.mark.parametrize("truncation", [None, 3.0])
+def test_interior_rows_sum_to_one_on_a_lattice(truncation):
+    """Equally spaced particles: r_j is the same for every particle away from the ends, so
+    interior rows sum to 1. W is below 1e-17 beyond 8.9 sigma, so with spacing 1 and
+    sigma = 2, r_j is at its interior value 18 particles in and rows 36 in sum to 1."""
+    x = np.arange(400, dtype=np.float64)
+    P = transfer_matrix_dense(x, 2.0, truncation)
+    rows = P.sum(axis=1)
+    np.testing.assert_allclose(rows[50:-50], 1.0, rtol=0, atol=1e-12)
+    assert abs(rows[0] - 1.0) > 1e-3  # the ends do not
+
+
+# --------------------------------------------------------------------------- one transfer step
+CASES = [
+    # (n, sigma): sigma from well below to well above the mean spacing 10 / n
+    (50, 0.05),
+    (50, 1.0),
+    (200, 0.02),
+    (200, 0.3),
+    (400, 0.01),
+    (400, 0.4),  # > 150 neighbours within 9 sigma: auto takes the taylor path
+]
+
+
+@pytest.mark.parametrize("n,sigma", CASES)
+@pytest.mark.parametrize("method", ["auto", "direct", "taylor"])
+@pytest.mark.parametrize("truncation", [None, 3.0])
+@pytest.mark.parametrize("kind", ["delta", "random"])
+def test_mass_transfer_equals_dense_update(rng, n, sigma, method, truncation, kind):
+    if method == "taylor" and truncation is not None:
+        pytest.raises(ValueError, mass_transfer, np.linspace(0, 1, 10), np.ones(10), 0.1, 0.5, truncation, "taylor")
+        return
+    x = _positions(rng, n)
+    m = _masses(rng, n, kind)
+    beta = 0.5  # collision kernel (Eq. 16)
+    P = dense_transfer_matrix(x, sigma, truncation)
+    offdiag = P.sum(axis=1) - np.diag(P)
+    assert beta * offdiag.max() < 1.0  # single step expected
+    ref = dense_mass_update(P, m, beta)
+    res = mass_transfer(x, m.copy(), sigma, beta, truncation, method)
+    total = m.sum()
+    assert res.substeps == 1
+    assert np.max(np.abs(res.mass - ref)) <= 1e-12 * total
+    assert abs(res.mass.sum() - total) <= 1e-13 * total
+    assert res.mass.min() >= 0.0
+    assert res.max_offdiag_beta == pytest.approx(beta * offdiag.max(), rel=1e-12)
+
+
+@pytest.mark.parametrize("method", ["auto", "direct", "taylor"])
+def test_untruncated_transfer_equals_full_dense_gaussian(rng, method):
+    """truncation=None means the whole Gaussian (no cut-off visible at 1e-12)."""
+    n, sigma = 300, 0.6  # kernel wider than 1/16 of the domain: many long-range pairs
+    x = _positions(rng, n)
+    m = _masses(rng, n, "random")
+    d = x[:, None] - x[None, :]
+    W = np.exp(-d * d / (2 * sigma * sigma))  # no truncation, no cut-off at all
+    r = W.sum(axis=1)
+    P = 0.5 * (W / r[:, None] + W / r[None, :])
+    ref = m + 0.5 * (P @ m - m * P.sum(axis=1))
+    res = mass_transfer(x, m, sigma, 0.5, None, method)
+    assert np.max(np.abs(res.mass - ref)) <= 1e-12 * m.sum()
+
+
+@pytest.mark.parametrize("truncation", [None, 3.0])
+def test_uniform_masses_are_a_fixed_point(rng, truncation):
+    """A symmetric P leaves equal masses unchanged (well-mixed state is stationary)."""
+    x = _positions(rng, 300)
+    m = np.full(300, 1.0 / 300)
+    res = mass_transfer(x, m, 0.1, 0.5, truncation)
+    np.testing.assert_allclose(res.mass, m, rtol=1e-13, atol=0)
+
+
+@pytest.mark.parametrize("beta", [5.0, 50.0])
+@pytest.mark.parametrize("truncation", [None, 3.0])
+@pytest.mark.parametrize("kind", ["delta", "random"])
+def test_large_beta_substeps_keep_masses_non_negative(rng, beta, truncation, kind):
+    n, sigma = 200, 0.08
+    x = _positions(rng, n)
+    m = _masses(rng, n, kind)
+    P = dense_transfer_matrix(x, sigma, truncation)
+    c_max = beta * np.max(P.sum(axis=1) - np.diag(P))
+    expected_substeps = math.ceil(c_max)
+    assert expected_substeps > 1
+    res = mass_transfer(x, m.copy(), sigma, beta, truncation)
+    assert res.substeps == expected_substeps
+    assert res.max_offdiag_beta == pytest.approx(c_max, rel=1e-12)
+    assert res.mass.min() >= 0.0
+    assert abs(res.mass.sum() - m.sum()) <= 1e-13 * m.sum()
+    ref = dense_mass_update(P, m, beta, expected_substeps)
+    assert np.max(np.abs(res.mass - ref)) <= 1e-12 * m.sum()
+
+
+def test_single_explicit_step_with_large_beta_would_go_negative(rng):
+    """Why substeps are needed: the plain explicit update with beta = 5 makes masses negative."""
+    x = _positions(rng, 200)
+    m = _masses(rng, 200, "delta")
+    P = dense_transfer_matrix(x, 0.08)
+    assert dense_mass_update(P, m, 5.0).min() < 0.0
+    assert mass_transfer(x, m, 0.08, 5.0).mass.min() >= 0.0
+
+
+def test_trivial_cases_return_a_copy():
+    m = np.array([1.0])
+    res = mass_transfer(np.array([0.0]), m, 0.1, 0.5)
+    assert res.substeps == 1 and np.array_equal(res.mass, m) and res.mass is not m
+    x = np.linspace(-1, 1, 5)
+    m = np.array([0, 0, 1.0, 0, 0])
+    res = mass_transfer(x, m, 0.1, 0.0)
+    assert np.array_equal(res.mass, m)
