@@ -1,0 +1,191 @@
+"""The Snakemake workflow: config schema, dry runs, a tiny end-to-end run and its properties."""
+
+from __future__ import annotations
+
+import copy
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+from snakemake.exceptions import WorkflowError
+from snakemake.utils import validate
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
+
+
+def load(path):
+    return yaml.safe_load(Path(path).read_text())
+
+
+def snakemake(workdir, *args, configfile=None, check=True):
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2"]
+    if configfile:
+        cmd += ["--configfile", str(configfile)]
+    proc = subprocess.run(cmd + list(args), capture_output=True, text=True)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"snakemake failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    return proc
+
+
+def planned_outputs(proc, prefix="results/runs/"):
+    """Outputs of the jobs a dry run plans, for one output folder."""
+    return sorted(set(re.findall(r"(" + re.escape(prefix) + r"\S+\.parquet)", proc.stdout + proc.stderr)))
+
+
+# --- schema --------------------------------------------------------------------------------
+
+def test_shipped_config_is_valid():
+    validate(load(ROOT / "config.yaml"), str(SCHEMA))
+
+
+BAD = [
+    (("physics", "D"), -1.0, "D"),
+    (("physics", "t_final"), 0, "t_final"),
+    (("time", "dt_growth"), 0.9, "dt_growth"),
+    (("base_seed",), -3, "base_seed"),
+    (("figures", "fig9", "n"), [0, 100], "n"),
+    (("figures", "fig5", "cases"), [{"method": "mtpt", "kernel": "collision", "eta": 1.5}], "eta"),
+    (("figures", "fig1", "cases"), [{"method": "lbm", "kernel": "bins"}], "method"),
+    (("figures", "fig9", "realisations"), 0, "realisations"),
+    (("seed_blocks", "size"), 0, "size"),
+    (("physics", "dx"), 0.1, "dx"),  # unknown key
+]
+
+
+@pytest.mark.parametrize("keys,value,name", BAD, ids=[b[2] + "=" + str(b[1])[:12] for b in BAD])
+def test_bad_config_names_the_key(keys, value, name):
+    cfg = load(ROOT / "config.yaml")
+    node = cfg
+    for k in keys[:-1]:
+        node = node[k]
+    node[keys[-1]] = value
+    with pytest.raises(WorkflowError) as err:
+        validate(cfg, str(SCHEMA))
+    assert name in str(err.value)
+
+
+def test_bad_config_stops_before_any_job(tmp_path):
+    cfg = load(ROOT / "config.yaml")
+    cfg["figures"]["fig9"]["cases"][0]["eta"] = 2
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(cfg))
+    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    assert proc.returncode != 0
+    out = proc.stdout + proc.stderr
+    assert "eta" in out and "maximum" in out and "2" in out
+    assert not (tmp_path / "results").exists()
+
+
+def test_kernel_method_mismatch_is_refused(tmp_path):
+    cfg = load(ROOT / "config.yaml")
+    cfg["figures"]["fig1"]["cases"][0] = {"method": "pt", "kernel": "sph"}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(cfg))
+    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    assert proc.returncode != 0
+    assert "figures.fig1.cases[0].kernel='sph'" in proc.stdout + proc.stderr
+
+
+# --- dry runs on the full config -------------------------------------------------------------
+
+def test_full_dry_run_plans_every_figure(tmp_path):
+    proc = snakemake(tmp_path, "-n", configfile=ROOT / "config.yaml")
+    out = proc.stdout + proc.stderr
+    for k in range(1, 10):
+        assert f"figures/fig{k}.png" in out
+    runs = planned_outputs(proc)
+    # Fig. 9 alone: 3 models x (80 + 80 + 60 + 50 seeds in blocks of 10, 20 seeds one a job at
+    # N = 3000, 6 at 10,000, 4 at 30,000)
+    fig9 = [r for r in runs if re.search(r"mtpt/(collision/.*eta~(1|0.5)|sph/.*eta~1)/", r)]
+    assert len(fig9) >= 3 * (8 + 8 + 6 + 5 + 20 + 6 + 4)
+
+
+def test_one_figure_runs_only_its_jobs(tmp_path):
+    proc = snakemake(tmp_path, "-n", "figures/fig8.png", configfile=ROOT / "config.yaml")
+    runs = planned_outputs(proc)
+    assert len(runs) == 7
+    assert all(r.startswith("results/runs/fd/implicit/") for r in runs)
+    assert "results/runs/mtpt" not in proc.stdout and "results/runs/pt" not in proc.stdout
+
+
+def test_slurm_profile_parses(tmp_path):
+    proc = snakemake(tmp_path, "-n", "--profile", str(ROOT / "workflow/profiles/slurm"), "figures/fig8.png",
+                     configfile=ROOT / "config.yaml")
+    assert len(planned_outputs(proc)) == 7
+
+
+# --- a tiny end-to-end run --------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    work = tmp_path_factory.mktemp("tiny")
+    snakemake(work, configfile=TINY)
+    return work
+
+
+def test_tiny_run_builds_every_figure(tiny_run):
+    for k in range(1, 10):
+        for ext in ("png", "pdf"):
+            f = tiny_run / "figures" / f"fig{k}.{ext}"
+            assert f.exists() and f.stat().st_size > 5000, f
+
+
+def test_tiny_run_tables_have_documented_columns(tiny_run):
+    comic = pd.read_parquet(tiny_run / "results/tables/comic.parquet")
+    assert {"model", "n", "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std", "n_realisations"} <= set(comic.columns)
+    assert set(comic["model"]) == {"fd", "mtpt collision eta=1", "mtpt sph eta=1", "mtpt collision eta=0.5"}
+    minima = pd.read_parquet(tiny_run / "results/tables/comic_minima.parquet")
+    assert {"model", "time", "n_opt", "COMIC_opt", "n_below", "n_above"} <= set(minima.columns)
+    for _, m in minima.iterrows():  # the reported optimum really is the smallest mean COMIC
+        g = comic[(comic["model"] == m["model"]) & (comic["time"] == m["time"])]
+        assert m["COMIC_opt"] == g["COMIC_mean"].min()
+    claims = pd.read_parquet(tiny_run / "results/tables/paper_claims.parquet")
+    assert {"claim", "paper", "reproduced", "tolerance", "passed"} <= set(claims.columns)
+    assert (tiny_run / "results/paper_claims.md").read_text().count("| ") > len(claims)
+    run = next((tiny_run / "results/runs/mtpt").rglob("*.parquet"))
+    cols = set(pd.read_parquet(run).columns)
+    assert {"step", "time", "dt", "H_D", "H_C", "E", "SSE", "COMIC", "mass_total", "mass_min", "beta", "h",
+            "substeps", "wall_s", "seed"} <= cols
+
+
+def test_summary_averages_its_realisations(tiny_run):
+    summary_file = next((tiny_run / "results/tables/cases/mtpt/collision").rglob("r~3.parquet"))
+    summary = pd.read_parquet(summary_file)
+    runs_dir = Path(str(summary_file.parent).replace("tables/cases", "runs"))
+    runs = pd.concat([pd.read_parquet(p) for p in runs_dir.glob("seeds~*.parquet")])
+    assert sorted(runs["seed"].unique()) == [0, 1, 2]
+    expected = runs.groupby("step")["COMIC"].mean().to_numpy()
+    last = len(summary) - 1
+    assert summary["n_realisations"].iloc[0] == 3
+    assert summary["COMIC_mean"].iloc[last] == pytest.approx(expected[last], rel=1e-12)
+
+
+def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
+    cfg = load(TINY)
+    cfg["figures"]["fig9"]["n"] = cfg["figures"]["fig9"]["n"] + [400]
+    cfg["realisations"].append({"n": 400, "count": 2})
+    new = tmp_path / "more.yaml"
+    new.write_text(yaml.safe_dump(cfg))
+    proc = snakemake(tiny_run, "-n", configfile=new)
+    runs = planned_outputs(proc)
+    assert runs and all("/n~400/" in r for r in runs)
+    assert len(runs) == 3  # one block of 2 seeds for each of the three Fig. 9 models
+    figs = set(re.findall(r"figures/fig\d+\.png", proc.stdout))
+    assert figs == {"figures/fig9.png"}
+
+
+def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
+    cfg = load(TINY)
+    cfg["realisations"] = [dict(e, count=e["count"] + 2) if e["n"] == 200 else e for e in cfg["realisations"]]
+    new = tmp_path / "seeds.yaml"
+    new.write_text(yaml.safe_dump(cfg))
+    runs = planned_outputs(snakemake(tiny_run, "-n", configfile=new))
+    assert runs and all("/n~200/" in r for r in runs)
+    assert all(not r.endswith("seeds~0-0.parquet") and not r.endswith("seeds~1-1.parquet") for r in runs)
