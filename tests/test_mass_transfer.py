@@ -163,3 +163,25 @@ def test_trivial_cases_return_a_copy():
     m = np.array([0, 0, 1.0, 0, 0])
     res = mass_transfer(x, m, 0.1, 0.0)
     assert np.array_equal(res.mass, m)
+
+
+@pytest.mark.parametrize("truncation", [None, 5.0])
+@pytest.mark.parametrize("method", ["auto", "direct"])
+def test_transfer_on_a_lattice_adds_variance_beta_sigma2(truncation, method):
+    """Eq. 19 is diffusive: on an equally spaced lattice (far from its ends) P_ij = W_ij / r with
+    sum_j P_ij (x_j - x_i)^2 = sigma^2 (Poisson summation, error ~ exp(-2 pi^2 sigma^2) for the
+    whole Gaussian), so one step keeps the mean and adds beta sigma^2 to the second moment:
+    for the collision kernel 0.5 * 4 eta D dt = 2 eta D dt."""
+    x = np.arange(-300.0, 301.0)
+    sigma, beta = 3.0, 0.5
+    m = np.exp(-0.5 * (x / 20.0) ** 2)
+    m /= m.sum()
+    res = mass_transfer(x, m, sigma, beta, truncation, method)
+    assert abs(np.sum(res.mass * x) - np.sum(m * x)) <= 1e-12
+    dvar = np.sum(res.mass * x * x) - np.sum(m * x * x)
+    if truncation is None:
+        assert dvar == pytest.approx(beta * sigma**2, rel=1e-10)
+    else:  # truncated at 5 sigma: the lattice second moment of the cut kernel, summed in the test
+        k = np.arange(-15, 16)
+        w = np.exp(-0.5 * (k / sigma) ** 2)
+        assert dvar == pytest.approx(beta * np.sum(w * k * k) / np.sum(w), rel=1e-10)

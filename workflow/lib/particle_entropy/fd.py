@@ -50,7 +50,7 @@ def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -
         "H_D": h_c,
         "H_C": h_c,
         "H_I": h_c + math.log(dx),
-        "H_PMF": M.entropy_pmf(h_c, cfg.fd_length, n),
+        "H_PMF": M.entropy_pmf(h_c, cfg.fd_length, cfg.n),  # dV = L / N intervals
         "E": M.dilution_index(h_c, dx),
         "SSE": err,
         "n_sse": n,

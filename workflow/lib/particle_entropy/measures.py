@@ -88,7 +88,7 @@ def sse(model: np.ndarray, reference: np.ndarray) -> float:
 
 
 def _log_mse(sse_value: float, n: int) -> float:
-    return math.log(sse_value / n) if sse_value > 0 else -math.inf
+    return math.log(sse_value) - math.log(n) if sse_value > 0 else -math.inf  # no underflow of SSE / n
 
 
 def aic(sse_value: float, n: int, k: int = 0) -> float:

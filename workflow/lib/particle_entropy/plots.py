@@ -74,13 +74,14 @@ def _case(df: pd.DataFrame) -> dict:
     return {k: df[k].iloc[0] for k in ("method", "kernel", "n", "eta") if k in df.columns}
 
 
-def _label(df: pd.DataFrame, with_n: bool = True) -> str:
-    """Legend text naming method, kernel, eta (MTPT) and N, e.g. 'MTPT collision, η=1, N=300'."""
+def _label(df: pd.DataFrame) -> str:
+    """Legend text: method, kernel, eta (MTPT), N and realisations, e.g. 'MTPT SPH, η=1, N=300 (5 runs)'."""
     c = _case(df)
     text = f"{c['method'].upper()} {NAMES.get(c['kernel'], c['kernel'])}"
     if c["method"] == "mtpt":
         text += f", η={c['eta']:g}"
-    return text + (f", N={int(c['n']):,}" if with_n else "")
+    text += f", N={int(c['n']):,}"
+    return text + (f" ({int(df['n_realisations'].iloc[0])} runs)" if "n_realisations" in df.columns else "")
 
 
 def _select(tables, method=None, kernel=None, eta=None, n=None) -> list[pd.DataFrame]:
@@ -140,6 +141,8 @@ def _nearest(df: pd.DataFrame, time: float) -> pd.DataFrame:
 
 def _no_data(ax, what: str) -> None:
     ax.text(0.5, 0.5, f"no data:\n{what}", transform=ax.transAxes, ha="center", va="center", color="0.4")
+    ax.set_xticks([])
+    ax.set_yticks([])
 
 
 # ---------------------------------------------------------------- figures
@@ -159,9 +162,9 @@ def fig1(runs: list[pd.DataFrame]) -> Figure:
                    linewidth=2.0, marker=None)
         ref = _select(runs, n=n)[0]
         _analytic(ax, ref, "H_C_analytic", f"$H_C$ analytic (Eq. 14), N={n:,}")
-        settle = ref.loc[ref["settled"].astype(bool), "time"]
-        if len(settle):
-            ax.axvline(settle.iloc[0], color="0.5", linewidth=0.8, linestyle="-.",
+        t_settle = ref["dV"].iloc[0] ** 2 / (4 * np.pi * np.e * ref["D"].iloc[0]) if "D" in ref else 0.0
+        if t_settle > ref.loc[ref["time"] > 0, "time"].min():  # draw only inside the plotted range
+            ax.axvline(t_settle, color="0.5", linewidth=0.8, linestyle="-.",
                        label=r"settling time $\Delta V^2/(4\pi e D)$")
         ax.set_ylim(bottom=max(ax.get_ylim()[0], -3.0))
         _style(ax, letter, f"N = {n:,}", "entropy $H$, $H_C$ [nats]", legend="lower right")
@@ -186,12 +189,12 @@ def fig3(summaries: list[pd.DataFrame]) -> Figure:
     fig, (ax,) = _figure(1, width=7.0, height=4.8)
     ns = _ns(summaries, descending=True)
     for i, n in enumerate(ns):
-        for df in _select(summaries, "pt", "adaptive", n=n)[:1] + _select(summaries, "mtpt", "sph", 1.0, n)[:1]:
-            _curve(ax, df, "H_C", _label(df), **_model_style(df, open=i > 0))
+        for sel in (("pt", "adaptive"), ("mtpt", "sph", 1.0)):
+            for df in _select(summaries, *sel, n=n)[:1]:
+                _curve(ax, df, "H_C", _label(df), **_model_style(df, open=i > 0))
         _analytic(ax, _select(summaries, n=n)[0], "H_C_analytic", f"analytic $H_C$, N={n:,}")
     ax.set_ylim(bottom=max(ax.get_ylim()[0], -3.0))
-    nreal = sorted({int(df["n_realisations"].iloc[0]) for df in summaries if "n_realisations" in df})
-    _style(ax, None, f"ensemble means ± 1 std ({'/'.join(map(str, nreal))} realisations)",
+    _style(ax, None, "ensemble means ± 1 std",
            "consistent entropy $H_C$ [nats]", legend="lower right")
     return fig
 
@@ -202,7 +205,7 @@ def fig4(summaries: list[pd.DataFrame]) -> Figure:
     fig, axes = _figure(len(ns))
     for letter, ax, n in zip("abcdefgh", axes, ns):
         sel = [(("pt", "adaptive"), {}), (("mtpt", "sph", 1.0), {}),
-               (("mtpt", "collision", 1.0), {"color": GREY, "open": True})]
+               (("mtpt", "collision", 1.0), {"color": GREY, "open": True, "zorder": 1})]
         for case, over in sel:
             for df in _select(summaries, *case, n=n)[:1]:
                 _curve(ax, df, "E", _label(df), logy=True, **_model_style(df, **over))
@@ -233,9 +236,8 @@ def fig6(summaries: list[pd.DataFrame], D: float = 1e-3) -> Figure:
     ordered = sorted(summaries, key=lambda df: int(df["n"].iloc[0]))
     cmap = matplotlib.colormaps["viridis"]
     for i, df in enumerate(ordered):
-        colour = cmap(0.9 * i / max(len(ordered) - 1, 1))
-        nreal = f" ({int(df['n_realisations'].iloc[0])} real.)" if "n_realisations" in df else ""
-        _curve(ax, df, "H_PMF", _label(df) + nreal, band=False, color=colour, marker=None)
+        colour = cmap(0.85 * i / max(len(ordered) - 1, 1))
+        _curve(ax, df, "H_PMF", _label(df), band=False, color=colour, marker=None)
     if ordered:
         if "D" in ordered[0].columns:
             D = float(ordered[0]["D"].iloc[0])
@@ -251,26 +253,31 @@ def fig6(summaries: list[pd.DataFrame], D: float = 1e-3) -> Figure:
 def fig7(states: list[pd.DataFrame], D: float = 1e-3, t: float = 1000.0) -> Figure:
     """Fig. 7: concentrations at t = 1000 (MTPT collision eta=0.1, fixed-kernel PT) and their spread."""
     ns = _ns(states, descending=True)
-    fig, axes = _figure(len(ns), width=5.6, height=4.3)
+    fig, axes = _figure(len(ns), width=5.6, height=5.2)
     var = 2 * D * t
     gauss = lambda x: np.exp(-x**2 / (2 * var)) / np.sqrt(2 * np.pi * var)  # noqa: E731
     for letter, ax, n in zip("abcdefgh", axes, ns):
-        lines = [f"analytic variance $2Dt$ = {var:.3g} L²"]
-        sel = [(("mtpt", "collision", 0.1), dict(s=3, color=GREEN, alpha=0.6, linewidths=0, zorder=2)),
-               (("pt", "fixed"), dict(s=14, facecolors="none", edgecolors=BLUE, linewidths=0.7, zorder=3))]
+        dot = 2 if n >= 10000 else 8  # dense clouds need small dots
+        sel = [(("mtpt", "collision", 0.1), dict(s=dot, color=GREEN, alpha=0.6, linewidths=0, zorder=2)),
+               (("pt", "fixed"), dict(s=3 * dot, facecolors="none", edgecolors=BLUE, linewidths=0.7, zorder=3))]
+        xs = [np.array([-5.0, 5.0])]
         for case, kw in sel:
             for df in _select(states, *case, n=n)[:1]:
                 x, c, m = (df[k].to_numpy(float) for k in ("x", "c", "mass"))
                 msd = np.mean((c - gauss(x)) ** 2)
-                ax.scatter(x, c, label=f"{_label(df)}\n  mean sq. dev. from analytic = {msd:.3g} L⁻²", **kw)
                 mean = np.sum(m * x) / np.sum(m)
-                lines.append(f"{case[0].upper()} plume variance = {np.sum(m * (x - mean) ** 2) / np.sum(m):.3g} L²")
-        xs = np.linspace(-5, 5, 801)
-        ax.plot(xs, gauss(xs), label=f"analytic Gaussian, variance $2Dt$, t={t:g}", **ANALYTIC)
-        ax.text(0.02, 0.97, "\n".join(lines), transform=ax.transAxes, va="top", fontsize=8,
-                bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "0.8"})
+                spread = np.sum(m * (x - mean) ** 2) / np.sum(m)
+                label = f"{_label(df)}\n  mean sq. dev. from analytic {msd:.2g} L⁻², plume variance {spread:.2f} L²"
+                ax.scatter(x, c, rasterized=True, label=label, **kw)
+                xs.append(x)
+        grid = np.linspace(min(map(np.min, xs)), max(map(np.max, xs)), 801)
+        ax.plot(grid, gauss(grid), label=f"analytic Gaussian, variance $2Dt$ = {var:.2f} L²", **ANALYTIC)
         _style(ax, letter, f"N = {n:,}, t = {t:g}", "concentration $c$ [L⁻¹]", xlabel="position $x$ [L]",
-               logx=False, legend="upper right")
+               logx=False, legend=None)
+        leg = ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=8, frameon=False)
+        for handle in leg.legend_handles:  # same legend marker size whatever the dot size
+            if hasattr(handle, "set_sizes"):
+                handle.set_sizes([20])
     return fig
 
 
@@ -281,7 +288,7 @@ def fig8(summaries: list[pd.DataFrame], time_c: float = 250.0) -> Figure:
     cmap = matplotlib.colormaps["viridis"]
     rows = []
     for i, df in enumerate(ordered):
-        colour = cmap(0.9 * i / max(len(ordered) - 1, 1))
+        colour = cmap(0.85 * i / max(len(ordered) - 1, 1))
         n, dx = int(df["n"].iloc[0]), float(df["dV"].iloc[0])
         half = df.assign(lnSSE=_col(df, "AIC")[0] / 2)
         label = f"Δx = {dx:.2g} (N = {n:,})"
@@ -300,8 +307,8 @@ def fig8(summaries: list[pd.DataFrame], time_c: float = 250.0) -> Figure:
         k = int(np.argmin(comic))
         ax.plot(dx[k], comic[k], "*", color="black", markersize=14, zorder=6,
                 label=f"min COMIC: Δx = {dx[k]:.2g} (N = {12 / dx[k]:,.0f})")
-        _style(ax, "c", f"at t = {tc[0]:g}", "fitness [nats]", xlabel=r"grid spacing $\Delta x$ [L]",
-               legend="lower right")
+        _style(ax, "c", f"both measures at t = {tc[0]:g}", "fitness [nats]",
+               xlabel=r"grid spacing $\Delta x$ [L]", legend="upper left")
     else:
         _no_data(axes[2], "FD summaries")
     return fig
@@ -316,13 +323,13 @@ def fig9(comic: pd.DataFrame, time: float = 1000.0) -> Figure:
         g = comic[comic["model"] == model]
         title = model.replace("mtpt", "MTPT").replace("eta", "η").replace("sph", "SPH")
         if g.empty:
-            _no_data(ax, model)
             _style(ax, letter, title, "COMIC", xlabel="number of particles $N$")
+            _no_data(ax, model)
             continue
         g = _nearest(g, time).sort_values("n")
         n, mu, sd = (g[k].to_numpy(float) for k in ("n", "COMIC_mean", "COMIC_std"))
         ax.errorbar(n, mu, yerr=sd, color=colour, marker=marker, markersize=5, capsize=3,
-                    label="ensemble mean ± 1 std")
+                    label="ensemble mean ± 1 std", zorder=3)
         k = int(np.argmin(mu))
         ax.plot(n[k], mu[k], "*", color="black", markersize=14, zorder=6, label=f"minimum: N = {int(n[k]):,}")
         for ni, top, r in zip(n, mu + sd, g["n_realisations"]):
@@ -331,5 +338,7 @@ def fig9(comic: pd.DataFrame, time: float = 1000.0) -> Figure:
         ax.plot([], [], " ", label="numbers: realisations")
         ax.margins(x=0.08, y=0.12)
         _style(ax, letter, f"{title}, t = {g['time'].iloc[0]:g}", r"COMIC $= 2\ln(SSE/N) - \ln\Delta V$",
-               xlabel="number of particles $N$", legend="upper right")
+               xlabel="number of particles $N$", legend=None)
+        handles, labels = ax.get_legend_handles_labels()  # errorbar entry first
+        ax.legend(handles[-1:] + handles[:-1], labels[-1:] + labels[:-1], loc="best", fontsize=8)
     return fig

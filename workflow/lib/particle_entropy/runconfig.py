@@ -84,6 +84,8 @@ class RunConfig:
         _finite_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
+        if self.transfer_method == "taylor" and self.truncation is not None:
+            raise SettingError("transfer_method", self.transfer_method, "auto or direct when truncation is set (taylor sums the whole Gaussian)")
 
     def rng(self) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels and eta share positions and walks."""

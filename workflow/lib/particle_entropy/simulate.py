@@ -11,7 +11,7 @@ import pandas as pd
 from . import fd, measures as M, mtpt, pt
 from .records import Recorder
 from .runconfig import RunConfig
-from .timegrid import time_steps
+from .timegrid import time_steps, times
 
 
 def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
@@ -28,7 +28,7 @@ def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_stat
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
     runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
     rec = Recorder(cfg.case_columns(), len(dts), progress)
-    state = runner(cfg, dts, rec)
+    state = runner(cfg, dts, times(dts, cfg.t_final), rec)
     table = rec.table()
     if not want_state:
         return table, None
@@ -42,40 +42,37 @@ def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: di
     rec.add(step=step, time=t, dt=dt, **meas, **_analytic_columns(cfg, t, meas["dV"]))
 
 
-def _run_pt(cfg: RunConfig, dts: np.ndarray, rec: Recorder) -> dict:
+def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
     rng = cfg.rng()
     x = pt.initial_positions(cfg)
-    t = 0.0
-    _row(rec, cfg, 0, t, 0.0, pt.measure(cfg, x, t))
+    _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
     for k, dt in enumerate(dts, start=1):
-        t += dt
+        t = ts[k]
         x = np.sort(pt.walk(x, cfg.D, dt, rng))
         _row(rec, cfg, k, t, dt, pt.measure(cfg, x, t))
     return pt.final_state(cfg, x, t)
 
 
-def _run_mtpt(cfg: RunConfig, dts: np.ndarray, rec: Recorder) -> dict:
+def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
     rng = cfg.rng()
     x, m = mtpt.initial_state(cfg, rng)
-    t = 0.0
-    _row(rec, cfg, 0, t, 0.0, {**mtpt.measure(cfg, x, m, t), "beta": 0.0, "h": 0.0, "substeps": 1})
+    _row(rec, cfg, 0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
     for k, dt in enumerate(dts, start=1):
-        t += dt
+        t = ts[k]
         x, m, h, beta, sub = mtpt.step(cfg, x, m, dt, t, rng)
         _row(rec, cfg, k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
     dV = cfg.omega / cfg.n
     return {"x": x, "mass": m, "c": m / dV}
 
 
-def _run_fd(cfg: RunConfig, dts: np.ndarray, rec: Recorder) -> dict:
+def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
     extra = {"beta": 0.0, "h": dx, "substeps": 1}
-    t = 0.0
-    _row(rec, cfg, 0, t, 0.0, {**fd.measure(cfg, x, c, dx, t), **extra})
+    _row(rec, cfg, 0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
     solvers: dict[float, fd.ImplicitSolver] = {}
     for k, dt in enumerate(dts, start=1):
-        t += dt
+        t = ts[k]
         if dt not in solvers:  # one factorisation per distinct step size (one for a fixed dt)
             solvers[dt] = fd.ImplicitSolver(cfg.n - 1, cfg.D * dt / dx**2)
         c[1:-1] = solvers[dt].solve(c[1:-1])

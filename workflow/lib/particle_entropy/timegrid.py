@@ -32,14 +32,17 @@ def time_steps(t_final: float, dt0: float, growth: float = 1.05) -> np.ndarray:
             f" at most {MAX_STEPS} allowed"
         )
     dt = dt0 * growth ** np.arange(n, dtype=np.float64)
-    t = np.cumsum(dt)
-    dt[-1] -= t[-1] - t_final
-    if dt[-1] <= 0:  # round-off: drop the vanishing last step
+    t_before_last = float(np.cumsum(dt[:-1])[-1]) if n > 1 else 0.0  # same sums as times()
+    if t_before_last >= t_final:  # round-off in n: the last step would vanish
         dt = dt[:-1]
-        dt[-1] += t_final - dt.sum()
+        t_before_last = float(np.cumsum(dt[:-1])[-1]) if dt.size > 1 else 0.0
+    dt[-1] = t_final - t_before_last  # exact end, no cancellation
     return dt
 
 
-def times(dt: np.ndarray) -> np.ndarray:
-    """Output times t_0 = 0, t_1, ..., t_n for step sizes ``dt``."""
-    return np.concatenate([[0.0], np.cumsum(dt)])
+def times(dt: np.ndarray, t_final: float | None = None) -> np.ndarray:
+    """Output times t_0 = 0, t_1, ..., t_n for step sizes ``dt``; t_n is set to ``t_final`` if given."""
+    t = np.concatenate([[0.0], np.cumsum(dt)])
+    if t_final is not None:
+        t[-1] = t_final
+    return t
