@@ -36,7 +36,8 @@ def snakemake(workdir, *args, configfile=None, check=True):
 
 def planned_outputs(proc, prefix="results/runs/"):
     """Outputs of the jobs a dry run plans, for one output folder."""
-    return sorted(set(re.findall(r"(" + re.escape(prefix) + r"\S+\.parquet)", proc.stdout + proc.stderr)))
+    lines = re.findall(r"^\s*output: (.*)$", proc.stdout + proc.stderr, flags=re.M)
+    return sorted({p for line in lines for p in line.split(", ") if p.startswith(prefix)})
 
 
 # --- schema --------------------------------------------------------------------------------
@@ -75,7 +76,7 @@ def test_bad_config_stops_before_any_job(tmp_path):
     cfg = load(ROOT / "config.yaml")
     cfg["figures"]["fig9"]["cases"][0]["eta"] = 2
     bad = tmp_path / "bad.yaml"
-    bad.write_text(yaml.safe_dump(cfg))
+    bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
     proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
     assert proc.returncode != 0
     out = proc.stdout + proc.stderr
@@ -87,7 +88,7 @@ def test_kernel_method_mismatch_is_refused(tmp_path):
     cfg = load(ROOT / "config.yaml")
     cfg["figures"]["fig1"]["cases"][0] = {"method": "pt", "kernel": "sph"}
     bad = tmp_path / "bad.yaml"
-    bad.write_text(yaml.safe_dump(cfg))
+    bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
     proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
     assert proc.returncode != 0
     assert "figures.fig1.cases[0].kernel='sph'" in proc.stdout + proc.stderr
@@ -172,20 +173,20 @@ def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
     cfg["figures"]["fig9"]["n"] = cfg["figures"]["fig9"]["n"] + [400]
     cfg["realisations"].append({"n": 400, "count": 2})
     new = tmp_path / "more.yaml"
-    new.write_text(yaml.safe_dump(cfg))
+    new.write_text(yaml.safe_dump(cfg, sort_keys=True))
     proc = snakemake(tiny_run, "-n", configfile=new)
     runs = planned_outputs(proc)
     assert runs and all("/n~400/" in r for r in runs)
-    assert len(runs) == 3  # one block of 2 seeds for each of the three Fig. 9 models
-    figs = set(re.findall(r"figures/fig\d+\.png", proc.stdout))
-    assert figs == {"figures/fig9.png"}
+    assert len(runs) == 6  # 3 Fig. 9 models x 2 seeds, one seed a job (N = 400 > seed_blocks.max_n)
+    figs = set(planned_outputs(proc, prefix="figures/"))
+    assert figs == {"figures/fig9.png", "figures/fig9.pdf"}
 
 
 def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
     cfg = load(TINY)
     cfg["realisations"] = [dict(e, count=e["count"] + 2) if e["n"] == 200 else e for e in cfg["realisations"]]
     new = tmp_path / "seeds.yaml"
-    new.write_text(yaml.safe_dump(cfg))
+    new.write_text(yaml.safe_dump(cfg, sort_keys=True))
     runs = planned_outputs(snakemake(tiny_run, "-n", configfile=new))
     assert runs and all("/n~200/" in r for r in runs)
     assert all(not r.endswith("seeds~0-0.parquet") and not r.endswith("seeds~1-1.parquet") for r in runs)

@@ -10,6 +10,11 @@ def sim_runtime_min(wildcards):
     return seeds * (2 if int(wildcards.n) <= 3000 else 20)
 
 
+def first_step(wildcards):
+    """FD runs use their own fixed step (Fig. 8); particle runs start at dt0."""
+    return config["time"]["fd_dt"] if wildcards.method == "fd" else config["time"]["dt0"]
+
+
 rule simulate:
     output:
         "results/runs/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.parquet",
@@ -18,8 +23,11 @@ rule simulate:
     benchmark:
         "benchmarks/simulate/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.tsv"
     params:
-        physics=config["physics"],
-        time=config["time"],
+        D=config["physics"]["D"],
+        t_final=config["physics"]["t_final"],
+        omega=config["physics"]["omega"],
+        fd_length=config["physics"]["fd_length"],
+        dt0=first_step,
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,
@@ -37,8 +45,11 @@ rule snapshot:
     benchmark:
         "benchmarks/snapshot/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/seeds~{first}-{last}.tsv"
     params:
-        physics=config["physics"],
-        time=config["time"],
+        D=config["physics"]["D"],
+        t_final=config["physics"]["t_final"],
+        omega=config["physics"]["omega"],
+        fd_length=config["physics"]["fd_length"],
+        dt0=first_step,
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,

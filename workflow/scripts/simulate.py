@@ -11,20 +11,19 @@ from particle_entropy.io import write_parquet  # noqa: E402
 from particle_entropy.runconfig import RunConfig  # noqa: E402
 from particle_entropy.simulate import run_seeds  # noqa: E402
 
-w, phys, tm = snakemake.wildcards, snakemake.params.physics, snakemake.params.time  # noqa: F821
-fd = w.method == "fd"
+w, par = snakemake.wildcards, snakemake.params  # noqa: F821
 cfg = RunConfig(
     method=w.method,
     kernel=w.kernel,
     n=int(w.n),
     eta=float(w.eta),
-    D=float(phys["D"]),
-    t_final=float(phys["t_final"]),
-    dt0=float(tm["fd_dt"] if fd else tm["dt0"]),
+    D=float(par.D),
+    t_final=float(par.t_final),
+    dt0=float(par.dt0),
     dt_growth=float(w.growth),
     truncation=None if w.trunc == "none" else float(w.trunc),
-    omega=float(phys["omega"]),
-    fd_length=float(phys["fd_length"]),
+    omega=float(par.omega),
+    fd_length=float(par.fd_length),
 )
 snapshot = snakemake.rule == "snapshot"  # noqa: F821
 seeds = range(int(w.first), int(w.last) + 1)
