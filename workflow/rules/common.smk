@@ -19,6 +19,7 @@ from particle_entropy.sweeps import (  # noqa: E402
 
 check_sweeps(config)
 FIGURES = sorted(config["figures"])
+SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 ALL_FIGURES = [f for f in ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9"] if f in FIGURES]
 
 
@@ -36,7 +37,7 @@ wildcard_constraints:
 
 
 def all_targets():
-    figs = [f"figures/{f}.{ext}" for f in ALL_FIGURES for ext in ("png", "pdf")]
+    figs = [f"figures/{f}.{ext}" for f in ALL_FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
     return figs + [
         "results/tables/comic.parquet",
         "results/tables/comic_minima.parquet",

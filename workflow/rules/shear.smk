@@ -1,0 +1,40 @@
+# Fig. 10 (Appendix B): 2-D shear flow, one job per case, then the figure.
+
+SHEAR_PARAMS = ["n", "length", "strip_lo", "strip_hi", "alpha_L", "alpha_T", "dt", "t_final"]
+
+
+rule simulate_shear:
+    output:
+        steps="results/shear/{case}/seed~{seed}/steps.parquet",
+        state="results/shear/{case}/seed~{seed}/state.parquet",
+    log:
+        "logs/simulate_shear/{case}/seed~{seed}.log",
+    benchmark:
+        "benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
+    wildcard_constraints:
+        case="rw_nodrift|rw_drift|mt",
+    params:
+        **{k: config["shear"][k] for k in SHEAR_PARAMS},
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    conda:
+        "../../envs/particle-entropy.yaml"
+    script:
+        "../scripts/shear2d.py"
+
+
+rule plot_fig10:
+    input:
+        [f"results/shear/{case}/seed~{config['shear']['seed']}/state.parquet" for case in config["shear"]["cases"]],
+    output:
+        png=report("figures/fig10.png", caption="../report/fig10.rst", category="Figures"),
+        pdf="figures/fig10.pdf",
+    log:
+        "logs/plot/fig10.log",
+    resources:
+        mem_mb=2000,
+    conda:
+        "../../envs/particle-entropy.yaml"
+    script:
+        "../scripts/plot_fig10.py"
