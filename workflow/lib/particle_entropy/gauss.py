@@ -27,9 +27,13 @@ from numba import njit
 
 CUTOFF_SIGMAS = 9.0
 P_TERMS = 24
-# The Taylor method wins once a target sees more sources than this (measured crossover,
-# see benchmarks/bench_transfer.py).
-DIRECT_MAX_NEIGHBOURS = 150.0
+# Hermite / Taylor terms of the fast Gauss transform with boxes of width sigma: the
+# truncation error of both expansions is below r^p / sqrt(p!) / (1 - r), r = 1 / (2 sqrt 2),
+# i.e. < 1e-18 of the kernel's peak for p = 20.
+FGT_TERMS = 20
+# The fast Gauss transform wins once a target sees more sources than this within the
+# cut-off (measured crossover, see benchmarks/bench_transfer.py).
+DIRECT_MAX_NEIGHBOURS = 300.0
 
 
 @njit(cache=True)
@@ -55,6 +59,27 @@ def _direct(y, x, q, sigma, radius, skip_self):
             w = math.exp(-d * d * inv2s2)
             for k in range(nk):
                 out[k, i] += w * q[k, j]
+    return out
+
+
+@njit(cache=True)
+def _direct_symmetric(x, q, sigma, radius):
+    """Windowed sum with targets = sources: each pair's exp is evaluated once."""
+    nk, n = q.shape
+    out = q.copy()  # self terms, W_ii = 1
+    inv2s2 = 0.5 / (sigma * sigma)
+    hi = 0
+    for i in range(n):
+        if hi < i + 1:
+            hi = i + 1
+        while hi < n and x[hi] <= x[i] + radius:
+            hi += 1
+        for j in range(i + 1, hi):
+            d = x[i] - x[j]
+            w = math.exp(-d * d * inv2s2)
+            for k in range(nk):
+                out[k, i] += w * q[k, j]
+                out[k, j] += w * q[k, i]
     return out
 
 
@@ -122,6 +147,101 @@ def _taylor_eval(y, centres, A, sigma, radius):
     return out
 
 
+@njit(cache=True)
+def _boxes(z, origin, width):
+    """Consecutive-box partition of sorted z: (box start indices incl. end, box centres)."""
+    n = z.shape[0]
+    starts = np.empty(n + 1, np.int64)
+    centres = np.empty(n)
+    nb = 0
+    prev = -(2**62)
+    for j in range(n):
+        b = int(math.floor((z[j] - origin) / width))
+        if b != prev:
+            starts[nb] = j
+            centres[nb] = origin + (b + 0.5) * width
+            nb += 1
+            prev = b
+    starts[nb] = n
+    return starts[: nb + 1], centres[:nb]
+
+
+@njit(cache=True)
+def _fgt(y, x, q, sigma, radius, p):
+    """Fast Gauss transform: Hermite expansions of source boxes translated to Taylor
+    expansions about target-box centres (Greengard-Strain), boxes of width sigma."""
+    nk, ns = q.shape
+    nt = y.shape[0]
+    scale = 1.0 / (math.sqrt(2.0) * sigma)  # kernel = exp(-(Y - X)^2) in scaled units
+    # Boxes and offsets live in the original units: x - c, y - c and c_t - c_s are exact
+    # differences of nearby numbers, so no precision is lost when sigma << |x|.
+    reach = radius + sigma
+    origin = min(x[0], y[0])
+    s_starts, s_centres = _boxes(x, origin, sigma)
+    t_starts, t_centres = _boxes(y, origin, sigma)
+    nbs = s_centres.shape[0]
+    # Hermite moments A[b, n, k] = sum_j q_kj (X_j - C_b)^n / n!
+    A = np.zeros((nbs, p, nk))
+    for b in range(nbs):
+        for j in range(s_starts[b], s_starts[b + 1]):
+            u = (x[j] - s_centres[b]) * scale
+            c = 1.0
+            for n in range(p):
+                for k in range(nk):
+                    A[b, n, k] += c * q[k, j]
+                c *= u / (n + 1)
+    out = np.zeros((nk, nt))
+    h = np.empty(2 * p)
+    B = np.empty((p, nk))
+    inv_fact = np.empty(p)
+    inv_fact[0] = 1.0
+    for m in range(1, p):
+        inv_fact[m] = inv_fact[m - 1] / m
+    lo = 0
+    for tb in range(t_centres.shape[0]):
+        ct = t_centres[tb]
+        while lo < nbs and s_centres[lo] < ct - reach:
+            lo += 1
+        B[:, :] = 0.0
+        sb = lo
+        t_lo, t_hi = t_starts[tb], t_starts[tb + 1]
+        while sb < nbs and s_centres[sb] <= ct + reach:
+            s_lo, s_hi = s_starts[sb], s_starts[sb + 1]
+            if (s_hi - s_lo) * (t_hi - t_lo) * (8 + nk) <= p * p * nk:
+                # sparse box pair: exact pairwise sum is cheaper than a translation
+                for i in range(t_lo, t_hi):
+                    for j in range(s_lo, s_hi):
+                        d = (y[i] - x[j]) * scale
+                        g = math.exp(-d * d)
+                        for k in range(nk):
+                            out[k, i] += g * q[k, j]
+                sb += 1
+                continue
+            t0 = (ct - s_centres[sb]) * scale
+            h[0] = math.exp(-t0 * t0)
+            h[1] = 2.0 * t0 * h[0]
+            for kk in range(1, 2 * p - 1):
+                h[kk + 1] = 2.0 * t0 * h[kk] - 2.0 * kk * h[kk - 1]
+            for m in range(p):
+                for n in range(p):
+                    hn = h[n + m]
+                    for k in range(nk):
+                        B[m, k] += A[sb, n, k] * hn
+            sb += 1
+        for m in range(p):
+            f = inv_fact[m] if m % 2 == 0 else -inv_fact[m]
+            for k in range(nk):
+                B[m, k] *= f
+        for i in range(t_lo, t_hi):
+            w = (y[i] - ct) * scale
+            for k in range(nk):
+                acc = B[p - 1, k]
+                for m in range(p - 2, -1, -1):
+                    acc = acc * w + B[m, k]
+                out[k, i] += acc
+    return out
+
+
 def neighbour_count(y: np.ndarray, x: np.ndarray, radius: float) -> float:
     """Mean number of sources within ``radius`` of a target (sorted inputs)."""
     if y.size == 0 or x.size == 0:
@@ -132,12 +252,12 @@ def neighbour_count(y: np.ndarray, x: np.ndarray, radius: float) -> float:
 
 
 def choose_method(y, x, sigma, truncation) -> str:
-    """Pick ``direct`` or ``taylor`` for this transform (see module docstring)."""
+    """Pick ``direct`` or ``fgt`` for this transform (see module docstring)."""
     if truncation is not None:
         return "direct"
     if neighbour_count(y, x, CUTOFF_SIGMAS * sigma) <= DIRECT_MAX_NEIGHBOURS:
         return "direct"
-    return "taylor"
+    return "fgt"
 
 
 def gauss_transform(
@@ -155,8 +275,9 @@ def gauss_transform(
     ``truncation``: None for the whole Gaussian, else drop pairs with |y - x| > truncation * sigma.
     ``skip_self`` (only when ``y is x``): leave out the j == i term (direct method only).
     """
+    same = y is x
     y = np.ascontiguousarray(y, dtype=np.float64)
-    x = np.ascontiguousarray(x, dtype=np.float64)
+    x = y if same else np.ascontiguousarray(x, dtype=np.float64)
     q = np.asarray(q, dtype=np.float64)
     squeeze = q.ndim == 1
     q2 = np.ascontiguousarray(np.atleast_2d(q))
@@ -167,8 +288,19 @@ def gauss_transform(
     if method == "auto":
         method = choose_method(y, x, sigma, truncation)
     radius = (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
-    if method == "direct":
+    if method == "direct" and same and not skip_self:
+        out = _direct_symmetric(x, q2, float(sigma), float(radius))
+    elif method == "direct":
         out = _direct(y, x, q2, float(sigma), float(radius), bool(skip_self))
+    elif method == "fgt":
+        if truncation is not None:
+            raise ValueError("the fgt method evaluates the untruncated kernel only")
+        if skip_self:
+            raise ValueError("skip_self is only supported by the direct method")
+        if x.size == 0 or y.size == 0:
+            out = np.zeros((q2.shape[0], y.size))
+        else:
+            out = _fgt(y, x, q2, float(sigma), float(radius), FGT_TERMS)
     elif method == "taylor":
         if truncation is not None:
             raise ValueError("the taylor method evaluates the untruncated kernel only")
@@ -180,5 +312,5 @@ def gauss_transform(
             centres, A = _taylor_moments(x, q2, float(sigma), float(x[0]), 0, P_TERMS)
             out = _taylor_eval(y, centres, A, float(sigma), float(radius))
     else:
-        raise ValueError(f"method must be 'auto', 'direct' or 'taylor', got {method!r}")
+        raise ValueError(f"method must be 'auto', 'direct', 'fgt' or 'taylor', got {method!r}")
     return out[0] if squeeze else out

@@ -6,7 +6,8 @@ column-normalised kernel matrix, self term included. The update (Eq. 19) is
 
     m_i <- m_i + beta * sum_j P_ij (m_j - m_i),
 
-which needs four Gauss transforms, W 1, W (1/r), W m and W (m/r); P is never stored.
+built from the products W 1, W (1/r), W m and W (m/r), computed in two Gauss-transform
+passes a step (W 1, then W [1/r, m, m/r] together); P is never stored.
 The explicit update keeps masses non-negative while beta * sum_{j != i} P_ij <= 1 for every
 i. Where it is not (the SPH beta exceeds 1 at late times), the step is split into
 ``substeps`` equal pieces of beta with the same P, each of them positivity-preserving;
@@ -59,17 +60,23 @@ def mass_transfer(
     """One mass-transfer step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 19); x sorted."""
     if x.size < 2 or beta == 0.0:
         return TransferResult(m.copy(), 1, 0.0)
-    r, inv_r, rowsum = transfer_weights(x, sigma, truncation, method)
+    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method)
+    inv_r = 1.0 / r
+    # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
+    W3 = gauss_transform(x, x, np.vstack([inv_r, m, m * inv_r]), sigma, truncation, method)
+    rowsum = 0.5 * (1.0 + W3[0])
     offdiag = rowsum - inv_r  # sum_{j != i} P_ij, since P_ii = W_ii / r_i = 1 / r_i
     c_max = float(beta * offdiag.max())
     # split so that b * offdiag stays a hair below 1 (round-off margin)
     substeps = max(1, math.ceil(c_max / (1.0 - 1e-9)))
     b = beta / substeps
     keep = 1.0 - b * offdiag  # >= 0 by the choice of substeps
-    for _ in range(substeps):
+    Wm, Wmr = W3[1], W3[2]
+    for k in range(substeps):
+        if k > 0:
+            Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method)
         # sum_{j != i} W_ij q_j for q = m and q = m / r, as non-negative sums
-        Wq = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method)
-        s1 = Wq[0] - m
-        s2 = Wq[1] - m * inv_r
+        s1 = Wm - m
+        s2 = Wmr - m * inv_r
         m = m * keep + b * 0.5 * (s1 * inv_r + s2)
     return TransferResult(m, substeps, c_max)
