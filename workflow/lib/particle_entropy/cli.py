@@ -43,8 +43,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=0, help="random seed (>= 0)")
     s.add_argument("--omega", type=float, default=PAPER["omega"], help="particle domain length Omega [L]")
     s.add_argument("--fd-length", type=float, default=PAPER["fd_length"], help="FD domain length [L], centred on 0")
-    s.add_argument("--transfer-method", choices=("auto", "direct", "taylor"), default="auto",
+    s.add_argument("--transfer-method", choices=("auto", "direct", "fgt", "taylor"), default="auto",
                    help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)")
+    s.add_argument("--scheme", choices=("symmetric", "sequential"), default="symmetric",
+                   help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop")
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
     s.add_argument("--state-out", default=None, help="optional Parquet path for the final state (x, mass, c)")
     s.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
@@ -55,7 +57,7 @@ def config_from_args(a: argparse.Namespace) -> RunConfig:
     return RunConfig(
         method=a.method, kernel=a.kernel, n=a.n, eta=a.eta, D=a.D, t_final=a.t_final,
         dt0=a.dt0, dt_growth=a.dt_growth, truncation=a.truncation, seed=a.seed,
-        omega=a.omega, fd_length=a.fd_length, transfer_method=a.transfer_method,
+        omega=a.omega, fd_length=a.fd_length, transfer_method=a.transfer_method, scheme=a.scheme,
     ).resolved()
 
 

@@ -10,6 +10,7 @@ import numpy as np
 from . import measures as M
 from .kernels import beta_sph, collision_sigma, h_sph
 from .mass_transfer import mass_transfer
+from .sequential import sequential_transfer
 from .runconfig import RunConfig
 
 
@@ -38,6 +39,8 @@ def step(cfg: RunConfig, x, m, dt: float, t_end: float, rng: np.random.Generator
         order = np.argsort(x, kind="stable")
         x, m = x[order], m[order]
     sigma, beta = kernel_for_step(cfg, dt, t_end)
+    if sigma > 0 and beta > 0 and cfg.eta > 0 and cfg.scheme == "sequential":
+        return x, sequential_transfer(x, m, sigma, beta, cfg.truncation, rng), sigma, beta, 1
     if sigma > 0 and beta > 0 and cfg.eta > 0:
         res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method)
         return x, res.mass, sigma, beta, res.substeps

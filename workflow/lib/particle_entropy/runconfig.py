@@ -11,7 +11,8 @@ import numpy as np
 METHODS = ("pt", "mtpt", "fd")
 KERNELS = {"pt": ("bins", "fixed", "adaptive"), "mtpt": ("collision", "sph"), "fd": ("implicit",)}
 DEFAULT_KERNEL = {"pt": "bins", "mtpt": "collision", "fd": "implicit"}
-TRANSFER_METHODS = ("auto", "direct", "taylor")
+TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
+SCHEMES = ("symmetric", "sequential")
 
 PAPER = {
     "D": 1e-3,  # diffusion coefficient [L^2/T]
@@ -49,6 +50,7 @@ class RunConfig:
     fd_length: float = PAPER["fd_length"]
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = "auto"
+    scheme: str = "symmetric"  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
     extra: dict = field(default_factory=dict)
 
     def resolved(self) -> "RunConfig":
@@ -84,8 +86,11 @@ class RunConfig:
         _finite_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
-        if self.transfer_method == "taylor" and self.truncation is not None:
-            raise SettingError("transfer_method", self.transfer_method, "auto or direct when truncation is set (taylor sums the whole Gaussian)")
+        if self.scheme not in SCHEMES:
+            raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
+        if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:
+            raise SettingError("transfer_method", self.transfer_method,
+                               "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)")
 
     def rng(self) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels and eta share positions and walks."""
@@ -102,6 +107,7 @@ class RunConfig:
             "D": float(self.D),
             "truncation": float(self.truncation) if self.truncation is not None else math.inf,
             "dt_growth": float(self.dt_growth),
+            "scheme": self.scheme,
             "seed": int(self.seed),
         }
 
