@@ -25,7 +25,7 @@ ALL_FIGURES = [f for f in ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7
 
 wildcard_constraints:
     method="pt|mtpt|fd",
-    kernel="bins|fixed|adaptive|collision|sph|implicit",
+    kernel="bins|fixed|adaptive|collision|sph|implicit|explicit",
     n=r"\d+",
     eta=r"[0-9.eE+-]+",
     trunc=r"none|[0-9.eE+-]+",

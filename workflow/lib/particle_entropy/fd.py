@@ -1,4 +1,5 @@
-"""Implicit (backward-Euler) finite differences for 1-D diffusion (Section 6.1, Fig. 8)."""
+"""Finite differences for 1-D diffusion (Section 6.1, Fig. 8): implicit (backward Euler, the
+paper's) and explicit (forward Euler, refused past its stability limit r = 1/2)."""
 
 from __future__ import annotations
 
@@ -37,6 +38,17 @@ class ImplicitSolver:
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         return self._lu.solve(c_interior)
+
+
+class ExplicitSolver:
+    """Forward Euler c^{n+1} = c^n + r (c_{i-1} - 2 c_i + c_{i+1}); callers ensure r <= 1/2."""
+
+    def __init__(self, n_interior: int, r: float):
+        self.r = r
+
+    def solve(self, c_interior: np.ndarray) -> np.ndarray:
+        padded = np.concatenate([[0.0], c_interior, [0.0]])
+        return c_interior + self.r * (padded[:-2] - 2.0 * c_interior + padded[2:])
 
 
 def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -> dict:

@@ -44,7 +44,7 @@ def entropy_pmf(h_d: float, omega: float, n: int) -> float:
 
 def analytic_h_i(D: float, t: float) -> float:
     """H_I of the Gaussian with variance 2 D t: ln sqrt(4 pi D t) + 1/2 (Eq. 14, dV = 1)."""
-    if t <= 0:
+    if D * t <= 0:  # a delta: t = 0 or no diffusion
         return -math.inf
     return 0.5 * math.log(4.0 * math.pi * D * t) + 0.5
 

@@ -24,7 +24,9 @@ def initial_state(cfg: RunConfig, rng: np.random.Generator):
 
 
 def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
-    """(sigma, beta) of the transfer kernel for a step of size dt ending at t_end."""
+    """(sigma, beta) of the transfer kernel for a step of size dt ending at t_end (0, 0: no transfer)."""
+    if cfg.eta * cfg.D == 0.0:
+        return 0.0, 0.0
     if cfg.kernel == "collision":
         return collision_sigma(cfg.eta, cfg.D, dt), 0.5
     h = h_sph(cfg.n, cfg.omega, cfg.D, t_end)

@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 METHODS = ("pt", "mtpt", "fd")
-KERNELS = {"pt": ("bins", "fixed", "adaptive"), "mtpt": ("collision", "sph"), "fd": ("implicit",)}
+KERNELS = {"pt": ("bins", "fixed", "adaptive"), "mtpt": ("collision", "sph"), "fd": ("implicit", "explicit")}
 DEFAULT_KERNEL = {"pt": "bins", "mtpt": "collision", "fd": "implicit"}
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 SCHEMES = ("symmetric", "sequential")
@@ -86,6 +86,16 @@ class RunConfig:
         _finite_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
+        if self.method == "fd" and self.kernel == "explicit":
+            dx = self.fd_length / self.n
+            r = self.D * self.dt0 / dx**2
+            if r > 0.5 or self.dt_growth != 1.0:
+                raise SettingError(
+                    "dt0", self.dt0,
+                    f"explicit fd is stable only for r = D dt / dx^2 <= 1/2 with a fixed step: dt0 <= "
+                    f"{0.5 * dx**2 / self.D if self.D > 0 else math.inf:.6g} and dt_growth = 1 for n={self.n} "
+                    f"(got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
+                )
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:

@@ -70,11 +70,12 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
     c = fd.initial_concentration(cfg)
     extra = {"beta": 0.0, "h": dx, "substeps": 1}
     _row(rec, cfg, 0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
-    solvers: dict[float, fd.ImplicitSolver] = {}
+    solver_type = fd.ExplicitSolver if cfg.kernel == "explicit" else fd.ImplicitSolver
+    solvers: dict = {}
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
         if dt not in solvers:  # one factorisation per distinct step size (one for a fixed dt)
-            solvers[dt] = fd.ImplicitSolver(cfg.n - 1, cfg.D * dt / dx**2)
+            solvers[dt] = solver_type(cfg.n - 1, cfg.D * dt / dx**2)
         c[1:-1] = solvers[dt].solve(c[1:-1])
         _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
     return {"x": x, "c": c}

@@ -85,7 +85,7 @@ def case_runs(wildcards, config: dict) -> list[str]:
 
 def check_sweeps(config: dict) -> None:
     """Semantic checks the JSON schema cannot express; the message names the key and value."""
-    allowed = {"pt": {"bins", "fixed", "adaptive"}, "mtpt": {"collision", "sph"}, "fd": {"implicit"}}
+    allowed = {"pt": {"bins", "fixed", "adaptive"}, "mtpt": {"collision", "sph"}, "fd": {"implicit", "explicit"}}
     for fig, spec in config["figures"].items():
         for i, c in enumerate(spec["cases"]):
             if c["kernel"] not in allowed[c["method"]]:

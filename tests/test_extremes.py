@@ -1,0 +1,158 @@
+"""Extreme settings: each gives the right answer (against an analytic value) or a clear error."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+from particle_entropy import measures as M
+from particle_entropy.mass_transfer import mass_transfer
+from particle_entropy.runconfig import RunConfig, SettingError
+from particle_entropy.simulate import run
+
+
+def finite_after_start(table):
+    """No NaN anywhere; after t = 0 everything finite, except ln(SSE) = -inf where SSE is exactly 0."""
+    num = table.select_dtypes(include=[np.number]).drop(columns=["truncation"])
+    assert not num.isna().any().any(), num.columns[num.isna().any()].tolist()
+    later = num.iloc[1:]
+    exact = later["SSE"] == 0.0 if "SSE" in later else False
+    assert (later.loc[exact, ["AIC", "COMIC"]] == -np.inf).all().all()
+    rest = later.drop(columns=["AIC", "COMIC"]) if exact is not False else later
+    bad = ~np.isfinite(rest.to_numpy()).all(axis=0)
+    assert not bad.any(), rest.columns[bad].tolist()
+    assert np.isfinite(later.loc[~exact, ["AIC", "COMIC"]].to_numpy()).all()
+
+
+@pytest.mark.parametrize("n", [1, 2, 10])
+@pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("pt", "fixed"), ("pt", "adaptive"),
+                                           ("mtpt", "collision"), ("mtpt", "sph")])
+def test_tiny_particle_numbers(n, method, kernel):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tab, state = run(RunConfig(method=method, kernel=kernel, n=n, t_final=50.0, seed=3), want_state=True)
+    finite_after_start(tab)
+    assert np.allclose(tab["mass_total"], 1.0, rtol=0, atol=1e-14)
+    assert (tab["mass_min"] >= 0).all()
+    if method == "mtpt":
+        assert tab["H_D"].iloc[0] == 0.0
+        if n == 1:  # one particle keeps the whole mass: no entropy, E = dV
+            assert (tab["H_D"] == 0.0).all()
+            assert np.allclose(tab["E"], 10.0)
+    else:
+        assert np.allclose(tab["H_D"], math.log(n))
+
+
+def test_one_step_with_300k_particles():
+    rng = np.random.default_rng(5)
+    x = np.sort(rng.uniform(-5, 5, 300_000))
+    m = np.exp(-x * x) * rng.random(x.size)
+    m /= m.sum()
+    for sigma in (0.0063, 0.44):
+        res = mass_transfer(x, m, sigma, 0.5)
+        assert abs(res.mass.sum() - 1.0) < 1e-12
+        assert res.mass.min() >= 0.0
+    # the fast path against the exact windowed sum, early width (cheap for the direct sum)
+    fast = mass_transfer(x, m, 0.002, 0.5, method="fgt").mass
+    exact = mass_transfer(x, m, 0.002, 0.5, method="direct").mass
+    assert np.max(np.abs(fast - exact)) < 1e-12 * m.max()
+
+
+def test_all_particles_at_one_point_mix_to_the_mean():
+    """W is all ones, so P = 1/N and m_i <- m_i + beta (mean(m) - m_i) exactly."""
+    m = np.random.default_rng(2).random(500)
+    for method in ("direct", "fgt"):
+        out = mass_transfer(np.zeros(500), m, 0.1, 0.5, method=method).mass
+        np.testing.assert_allclose(out, m + 0.5 * (m.mean() - m), rtol=1e-12)
+
+
+@pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("mtpt", "collision"), ("mtpt", "sph"), ("fd", "implicit")])
+def test_zero_diffusion_changes_nothing(method, kernel):
+    tab, state = run(RunConfig(method=method, kernel=kernel, n=200, D=0.0, t_final=10.0), want_state=True)
+    finite_after_start(tab.drop(columns=["H_C_analytic", "H_I", "E_analytic"]))
+    first, last = tab.iloc[1], tab.iloc[-1]
+    assert last["H_D"] == first["H_D"] == tab["H_D"].iloc[0]  # a delta stays a delta
+    assert last["mass_total"] == pytest.approx(1.0, abs=1e-14)
+
+
+def test_eta_zero_is_a_pure_random_walk_and_eta_one_never_moves():
+    walk, s0 = run(RunConfig(method="mtpt", n=300, eta=0.0, t_final=100.0, seed=4), want_state=True)
+    assert (walk["H_D"] == 0.0).all() and (walk["beta"] == 0.0).all()
+    still, s1 = run(RunConfig(method="mtpt", n=300, eta=1.0, t_final=100.0, seed=4), want_state=True)
+    init = run(RunConfig(method="mtpt", n=300, eta=1.0, t_final=1e-9, seed=4), want_state=True)[1]
+    np.testing.assert_array_equal(s1["x"].to_numpy(), init["x"].to_numpy())
+    assert not np.array_equal(s0["x"].to_numpy(), init["x"].to_numpy())
+
+
+@pytest.mark.parametrize("dt0,growth,t_final", [(1e-6, 1.5, 1.0), (1e3, 1.05, 10.0), (1e3, 1.0, 3000.0), (0.5, 1.0, 0.2)])
+def test_time_steps_from_tiny_to_huge(dt0, growth, t_final):
+    tab = run(RunConfig(method="mtpt", kernel="collision", n=500, dt0=dt0, dt_growth=growth, t_final=t_final))[0]
+    assert tab["time"].iloc[-1] == t_final
+    assert abs(tab["mass_total"].iloc[-1] - 1.0) < 1e-12 and (tab["mass_min"] >= 0).all()
+    finite_after_start(tab)
+    if dt0 >= t_final:  # t_final shorter than one step: exactly one (shortened) step
+        assert len(tab) == 2 and tab["dt"].iloc[1] == t_final
+
+
+def test_forced_huge_sph_beta_stays_positive_and_conservative():
+    """Omega = 0.005 packs N = 2000 particles so densely that beta = 2 D dt / h^2 >> 1."""
+    tab = run(RunConfig(method="mtpt", kernel="sph", n=2000, omega=0.005, t_final=100.0, seed=1))[0]
+    assert tab["beta"].max() > 20
+    assert tab["substeps"].max() > 10
+    assert (tab["mass_min"] >= 0).all()
+    assert np.max(np.abs(tab["mass_total"] - 1.0)) < 1e-12
+
+
+def test_explicit_fd_past_its_limit_is_refused_with_the_safe_range():
+    cfg = RunConfig(method="fd", kernel="explicit", n=3000, dt0=0.05)  # r = 1e-3 * 0.05 / 0.004^2 = 3.1
+    with pytest.raises(SettingError) as err:
+        cfg.resolved()
+    msg = str(err.value)
+    assert "dt0" in msg and "r = D dt / dx^2 <= 1/2" in msg and "0.008" in msg  # dt0 <= 0.5 dx^2 / D
+
+
+def test_explicit_fd_within_its_limit_matches_implicit():
+    kw = dict(method="fd", n=300, dt0=0.05, t_final=200.0)  # r = 0.03
+    ex = run(RunConfig(kernel="explicit", **kw))[0].iloc[-1]
+    im = run(RunConfig(kernel="implicit", **kw))[0].iloc[-1]
+    assert ex["H_C"] == pytest.approx(im["H_C"], abs=1e-3)
+    assert ex["H_C"] == pytest.approx(ex["H_C_analytic"], abs=2e-3)
+
+
+def test_cli_refuses_explicit_fd_past_limit(tmp_path):
+    out = tmp_path / "x.parquet"
+    proc = subprocess.run([sys.executable, "-m", "particle_entropy", "simulate", "--method", "fd", "--kernel",
+                           "explicit", "--n", "3000", "--out", str(out)], capture_output=True, text=True)
+    assert proc.returncode == 2 and "--dt0" in proc.stderr and not out.exists()
+
+
+def test_implicit_fd_with_a_million_nodes_in_bounded_memory():
+    code = (
+        "import resource\n"
+        "from particle_entropy.simulate import run\n"
+        "from particle_entropy.runconfig import RunConfig\n"
+        "t = run(RunConfig(method='fd', n=1_200_000, t_final=0.15))[0]\n"  # dx = 1e-5
+        "print(t['mass_total'].iloc[-1], t['mass_min'].min(), t['H_C'].iloc[-1], t['H_C_analytic'].iloc[-1],"
+        " resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    mass, mass_min, h_c, h_c_an, rss_mb = map(float, out)
+    # r = D dt / dx^2 = 5e5: the LU solve's round-off grows with the condition number ~ r
+    assert abs(mass - 1.0) < 1e-9 and mass_min >= 0.0
+    assert abs(h_c - h_c_an) < 0.2  # 3 backward-Euler steps from a delta: dt error ~ dt / t
+    assert rss_mb < 1500
+
+
+def test_entropy_before_the_settling_time_is_flagged_not_nan():
+    tab = run(RunConfig(method="mtpt", n=30, t_final=1.0))[0]
+    t_settle = M.settling_time(10.0 / 30, 1e-3)
+    early = tab[(tab["time"] > 0) & (tab["time"] <= t_settle)]
+    assert len(early) > 0 and not early["settled"].any()
+    assert tab[tab["time"] > t_settle]["settled"].all()
+    assert (early["H_C_analytic"] < 0).all() and np.isfinite(early["H_C_analytic"]).all()
+    finite_after_start(tab)
