@@ -102,10 +102,11 @@ def test_full_dry_run_plans_every_figure(tmp_path):
     for k in range(1, 11):
         assert f"figures/fig{k}.png" in out
     runs = planned_outputs(proc)
-    # Fig. 9 alone: 3 models x (80 + 80 + 60 + 50 seeds in blocks of 10, 20 seeds one a job at
-    # N = 3000, 6 at 10,000, 4 at 30,000)
+    # Fig. 9 alone: 3 models x (80 + 80 + 60 + 50 + 20 seeds in blocks of 10 for N <= 3000,
+    # then one seed a job: 6 at N = 10,000 and 4 at 30,000)
     fig9 = [r for r in runs if re.search(r"mtpt/(collision/.*eta~(1|0.5)|sph/.*eta~1)/", r)]
-    assert len(fig9) >= 3 * (8 + 8 + 6 + 5 + 20 + 6 + 4)
+    # + 1: Figs. 1-2 run collision eta = 1 at N = 300 alone (seeds~0-0), apart from the blocks
+    assert len(fig9) == 3 * (8 + 8 + 6 + 5 + 2 + 6 + 4) + 1
 
 
 def test_one_figure_runs_only_its_jobs(tmp_path):
