@@ -25,10 +25,10 @@ def load(path):
 
 
 def snakemake(workdir, *args, configfile=None, check=True):
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2"]
-    if configfile:
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2", *args]
+    if configfile:  # last: --configfile takes every following word as a file
         cmd += ["--configfile", str(configfile)]
-    proc = subprocess.run(cmd + list(args), capture_output=True, text=True)
+    proc = subprocess.run(cmd, capture_output=True, text=True)
     if check and proc.returncode != 0:
         raise AssertionError(f"snakemake failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
     return proc
@@ -101,12 +101,11 @@ def test_full_dry_run_plans_every_figure(tmp_path):
     out = proc.stdout + proc.stderr
     for k in range(1, 11):
         assert f"figures/fig{k}.png" in out
-    runs = planned_outputs(proc)
-    # Fig. 9 alone: 3 models x (80 + 80 + 60 + 50 + 20 seeds in blocks of 10 for N <= 3000,
-    # then one seed a job: 6 at N = 10,000 and 4 at 30,000)
-    fig9 = [r for r in runs if re.search(r"mtpt/(collision/.*eta~(1|0.5)|sph/.*eta~1)/", r)]
-    # + 1: Figs. 1-2 run collision eta = 1 at N = 300 alone (seeds~0-0), apart from the blocks
-    assert len(fig9) == 3 * (8 + 8 + 6 + 5 + 2 + 6 + 4) + 1
+    assert "figures/tradeoff.png" in out and "results/paper_claims.md" in out
+    fig9 = planned_outputs(snakemake(tmp_path, "-n", "figures/fig9.png", configfile=ROOT / "config.yaml"))
+    # 3 models x (80 + 80 + 60 + 50 + 20 seeds in blocks of 10 for N <= 3000, then one seed a
+    # job: 6 at N = 10,000 and 4 at 30,000)
+    assert len(fig9) == 3 * (8 + 8 + 6 + 5 + 2 + 6 + 4)
 
 
 def test_one_figure_runs_only_its_jobs(tmp_path):
@@ -191,3 +190,59 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
     runs = planned_outputs(snakemake(tiny_run, "-n", configfile=new))
     assert runs and all("/n~200/" in r for r in runs)
     assert all(not r.endswith("seeds~0-0.parquet") and not r.endswith("seeds~1-1.parquet") for r in runs)
+
+
+# --- a figure target pulls only its own simulations ------------------------------------------
+
+def _expected_runs(cfg, fig):
+    from particle_entropy.sweeps import case_run_paths, figure_cases, spec_cases
+
+    cases = spec_cases(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_cases(cfg, fig)
+    if fig in ("fig1", "fig2", "fig7"):
+        return {f"results/runs/{c['method']}/{c['kernel']}/n~{c['n']}/eta~{c['eta']}/trunc~{c['trunc']}/"
+                f"growth~{c['growth']}/seeds~0-0.parquet" for c in cases} if fig != "fig7" else set()
+    return {p for c in cases for p in case_run_paths(c, cfg)}
+
+
+@pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
+def test_each_figure_target_plans_only_its_runs(fig, tmp_path):
+    cfg = load(TINY)
+    proc = snakemake(tmp_path, "-n", f"figures/{fig}.png", configfile=TINY)
+    assert set(planned_outputs(proc)) == _expected_runs(cfg, fig)
+    snaps = planned_outputs(proc, prefix="results/snapshots/")
+    assert (len(snaps) > 0) == (fig == "fig7")  # particle snapshots only where a figure plots them
+    assert planned_outputs(proc, prefix="results/shear/") == []
+
+
+def test_fig10_target_runs_only_the_shear_cases(tmp_path):
+    proc = snakemake(tmp_path, "-n", "figures/fig10.png", configfile=TINY)
+    assert planned_outputs(proc) == []
+    shear = planned_outputs(proc, prefix="results/shear/")
+    assert sorted(shear) == sorted(f"results/shear/{c}/seed~0/{f}.parquet" for c in ("rw_nodrift", "rw_drift", "mt")
+                                   for f in ("steps", "state"))
+
+
+# --- a killed run resumes to the same tables ----------------------------------------------------
+
+def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
+    import os
+    import signal
+    import time
+
+    target = "results/tables/comic.parquet"
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2", target,
+           "--configfile", str(TINY)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list((tmp_path / "results").rglob("*.parquet"))) < 6:
+        time.sleep(0.2)
+    os.killpg(proc.pid, signal.SIGKILL)  # no clean-up: jobs die mid-write or mid-run
+    proc.wait()
+    assert not (tmp_path / target).exists(), "the run finished before it could be killed"
+    snakemake(tmp_path, target, configfile=TINY)  # the same command again
+    assert (tmp_path / target).read_bytes() == (tiny_run / target).read_bytes()
+    for new in (tmp_path / "results/runs").rglob("*.parquet"):
+        old = tiny_run / new.relative_to(tmp_path)
+        a, b = (pd.read_parquet(p).drop(columns="wall_s") for p in (new, old))
+        pd.testing.assert_frame_equal(a, b)
+    assert not list((tmp_path / "results").rglob("*.tmp"))  # no half-written file left behind

@@ -32,6 +32,23 @@ rule comic_tables:
         "../scripts/comic_tables.py"
 
 
+rule comic_tables_fig9:
+    """Fig. 9's own COMIC table, so that its target pulls no FD run."""
+    input:
+        [summary_path(c) for c in figure_cases(config, "fig9")] if "fig9" in FIGURES else [],
+    output:
+        comic="results/tables/fig9/comic.parquet",
+        minima="results/tables/fig9/comic_minima.parquet",
+    log:
+        "logs/comic_tables_fig9.log",
+    params:
+        times=config["comic_times"],
+    conda:
+        "../../envs/particle-entropy.yaml"
+    script:
+        "../scripts/comic_tables.py"
+
+
 rule paper_claims:
     input:
         minima="results/tables/comic_minima.parquet",
@@ -49,3 +66,18 @@ rule paper_claims:
         "../../envs/particle-entropy.yaml"
     script:
         "../scripts/paper_claims.py"
+
+
+rule tradeoff_table:
+    input:
+        [summary_path(c) for c in spec_cases(config["tradeoff"], config)] if "tradeoff" in config else [],
+    output:
+        "results/tables/tradeoff.parquet",
+    log:
+        "logs/tradeoff_table.log",
+    params:
+        times=config.get("tradeoff", {}).get("times", []),
+    conda:
+        "../../envs/particle-entropy.yaml"
+    script:
+        "../scripts/tradeoff_table.py"

@@ -10,6 +10,7 @@ sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
 validate(config, str(Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
 
 from particle_entropy.sweeps import (  # noqa: E402
+    spec_cases,
     case_runs,
     check_sweeps,
     figure_cases,
@@ -38,6 +39,8 @@ wildcard_constraints:
 
 def all_targets():
     figs = [f"figures/{f}.{ext}" for f in ALL_FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
+    if "tradeoff" in config:
+        figs += ["figures/tradeoff.png", "figures/tradeoff.pdf", "results/tables/tradeoff.parquet"]
     return figs + [
         "results/tables/comic.parquet",
         "results/tables/comic_minima.parquet",
@@ -50,7 +53,7 @@ def figure_inputs(fig):
     """What a figure reads: single runs (Figs. 1, 2), final states (Fig. 7), the COMIC table
     (Fig. 9) or case summaries (ensemble figures and FD)."""
     if fig == "fig9":
-        return ["results/tables/comic.parquet"]
+        return ["results/tables/fig9/comic.parquet"]
     cases = figure_cases(config, fig)
     if config["figures"][fig].get("snapshot"):
         return [run_path(c, config["base_seed"], kind="snapshots") for c in cases]

@@ -22,3 +22,17 @@ for _fig in ALL_FIGURES:
             "../../envs/particle-entropy.yaml"
         script:
             "../scripts/plot_figure.py"
+
+
+rule plot_tradeoff:
+    input:
+        "results/tables/tradeoff.parquet",
+    output:
+        png=report("figures/tradeoff.png", caption="../report/tradeoff.rst", category="Speed and accuracy"),
+        pdf="figures/tradeoff.pdf",
+    log:
+        "logs/plot/tradeoff.log",
+    conda:
+        "../../envs/particle-entropy.yaml"
+    script:
+        "../scripts/plot_tradeoff.py"

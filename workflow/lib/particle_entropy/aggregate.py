@@ -11,6 +11,8 @@ SUMMARY_COLUMNS = {
     "step": "time-step index",
     "time": "time [T]",
     "n_realisations": "number of realisations averaged",
+    "wall_cum_mean": "wall seconds of one realisation from t = 0 to this step, ensemble mean (varies run to run)",
+    "wall_cum_std": "its standard deviation",
     **{f"{m}_mean": f"ensemble mean of {m}" for m in METRICS},
     **{f"{m}_std": f"ensemble standard deviation of {m} (ddof = 1; 0 for one realisation)" for m in METRICS},
 }
@@ -31,21 +33,51 @@ def summarise_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
             out[f"{m}_mean"] = v.mean(axis=0)
             std = v.std(axis=0, ddof=1) if len(runs) > 1 else np.zeros(v.shape[1])
         out[f"{m}_std"] = np.where(np.isfinite(std), std, 0.0)
+    wall = np.stack([np.cumsum(r["wall_s"].to_numpy(dtype=np.float64)) for r in runs])
+    out["wall_cum_mean"] = wall.mean(axis=0)
+    out["wall_cum_std"] = wall.std(axis=0, ddof=1) if len(runs) > 1 else np.zeros(wall.shape[1])
     df = pd.DataFrame(out)
     for c in ["H_C_analytic", "E_analytic", "dV", "n_sse", "settled"]:
         df[c] = first[c].to_numpy()
-    for c in ["method", "kernel", "n", "eta", "truncation", "D"]:
+    for c in ["method", "kernel", "n", "eta", "truncation", "dt_growth", "D"]:
         df[c] = first[c].iloc[0]
     return df
 
 
-def model_name(method: str, kernel: str, eta: float) -> str:
-    """Human name of a model, e.g. 'mtpt collision eta=1' or 'fd'."""
+def model_name(method: str, kernel: str, eta: float, truncation: float = np.inf,
+               dt_growth: float | None = None, default_growth: float = 1.05) -> str:
+    """Human name of a model, e.g. 'mtpt collision eta=1', 'mtpt sph eta=1 trunc=3' or 'fd'."""
     if method == "fd":
-        return "fd"
-    if method == "pt":
-        return f"pt {kernel}"
-    return f"{method} {kernel} eta={eta:g}"
+        return "fd" if kernel == "implicit" else f"fd {kernel}"
+    name = f"pt {kernel}" if method == "pt" else f"{method} {kernel} eta={eta:g}"
+    if method == "mtpt" and np.isfinite(truncation):
+        name += f" trunc={truncation:g}"
+    if dt_growth is not None and dt_growth != default_growth:
+        name += f" growth={dt_growth:g}"
+    return name
+
+
+def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
+    """Cost (wall time) beside error (RMSE, H_C and E errors) and COMIC per model, N and time."""
+    rows = []
+    for s in summaries:
+        for _, r in at_times(s, times).iterrows():
+            rows.append({
+                "model": model_name(r["method"], r["kernel"], r["eta"], r["truncation"], r["dt_growth"]),
+                "method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]),
+                "truncation": float(r["truncation"]), "dt_growth": float(r["dt_growth"]), "n": int(r["n"]),
+                "time": float(r["time_requested"]), "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
+                "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
+                "rmse_std": float(np.sqrt(r["SSE_std"] / r["n_sse"])),
+                "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
+                "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
+                "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
+                "n_realisations": int(r["n_realisations"]),
+            })
+    df = pd.DataFrame(rows).sort_values(["model", "time", "n"], ignore_index=True)
+    best = df.groupby(["model", "time"])["COMIC_mean"].transform("min")
+    df["is_comic_optimum"] = df["COMIC_mean"] == best
+    return df
 
 
 def at_times(summary: pd.DataFrame, times: list[float]) -> pd.DataFrame:

@@ -348,3 +348,94 @@ def fig9(comic: pd.DataFrame, time: float = 1000.0) -> Figure:
                xlabel="number of particles $N$", legend=None)
         ax.legend(loc="best", fontsize=7)
     return fig
+
+
+
+# colour and marker of each trade-off model family (model name without its trunc= / growth= variant)
+TRADEOFF_FAMILY = {
+    "fd": {"color": "black", "marker": "o"},
+    "pt bins": STYLE[("pt", "bins")],
+    "pt fixed": STYLE[("pt", "fixed")],
+    "pt adaptive": STYLE[("pt", "adaptive")],
+    "mtpt collision eta=1": STYLE[("mtpt", "collision")],
+    "mtpt sph eta=1": {**STYLE[("mtpt", "sph")], "marker": "v"},
+    "mtpt collision eta=0.5": {"color": PURPLE, "marker": "D", "markerfacecolor": "white"},
+    "mtpt sph eta=0.5": {"color": GREY, "marker": "v", "markerfacecolor": "white"},
+}
+# line style of each variant: (truncated, time-step growth) -> linestyle
+TRADEOFF_VARIANT = {(False, False): ("-", "baseline"), (True, False): ("--", "truncated kernel (trunc=)"),
+                    (False, True): (":", "Δt growth variant (growth=)"), (True, True): ("-.", "truncated and Δt growth")}
+
+
+def _tradeoff_family(model: str) -> str:
+    import re
+
+    return re.sub(r"\s+(trunc|growth)=\S+", "", model).strip()
+
+
+def _tradeoff_label(model: str) -> str:
+    """Legend text of a model, e.g. 'mtpt sph eta=1 trunc=3' -> 'MTPT SPH, η=1, truncation 3'."""
+    words = model.split()
+    text = " ".join(w.upper() if w in ("fd", "pt", "mtpt") else NAMES.get(w, w) for w in words if "=" not in w)
+    extras = [w.replace("eta=", "η=").replace("trunc=", "truncation ").replace("growth=", "Δt growth ×")
+              for w in words if "=" in w]
+    return ", ".join([text, *extras])
+
+
+def tradeoff(table: pd.DataFrame) -> Figure:
+    """Speed-accuracy trade-off: error against cost and N, COMIC optimum starred."""
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FuncFormatter, LogLocator
+
+    times = sorted(table["time"].unique()) if len(table) else []
+    fig = Figure(figsize=(11.5, 4.3 * max(len(times), 1)), layout="constrained")
+    axes = fig.subplots(max(len(times), 1), 2, squeeze=False)
+    ylabel = "concentration RMSE sqrt(SSE/n) [1/L]"
+    xlabels = ("wall time per realisation [s]", "number of particles or FD intervals N")
+    if not times:
+        for ax, xlabel in zip(axes[0], xlabels):
+            _style(ax, None, "speed-accuracy trade-off", ylabel, xlabel=xlabel, logx=False, legend=None)
+            _no_data(ax, "tradeoff table")
+        return fig
+    families = dict(TRADEOFF_FAMILY)
+    spare = [BLUE, VERMILLION, GREEN, ORANGE, SKY, PURPLE]
+    for family in dict.fromkeys(map(_tradeoff_family, sorted(table["model"].unique()))):
+        if family not in families:  # unforeseen family: a hollow cross in the next palette colour
+            families[family] = {"color": spare.pop(0) if spare else GREY, "marker": "X", "markerfacecolor": "white"}
+    rank = {f: i for i, f in enumerate(families)}  # legend order: FD, PT, MTPT, then unforeseen families
+    models = sorted(table["model"].unique(), key=lambda m: (rank[_tradeoff_family(m)], m))
+    handles, variants = {}, set()
+    letters = iter("abcdefghijklmnopqrstuvwxyz")
+    for row, time in zip(axes, times):
+        at = table[table["time"] == time]
+        for model in models:
+            g = at[at["model"] == model].sort_values("n")
+            g = g[np.isfinite(g["rmse"]) & np.isfinite(g["wall_s"]) & (g["rmse"] > 0) & (g["wall_s"] > 0)]
+            if g.empty:
+                continue
+            variant = (" trunc=" in model, " growth=" in model)
+            variants.add(variant)
+            style = {**families[_tradeoff_family(model)], "linestyle": TRADEOFF_VARIANT[variant][0]}
+            best = g[g["is_comic_optimum"].astype(bool)]
+            for ax, x in zip(row, ("wall_s", "n")):
+                line, = ax.plot(g[x], g["rmse"], label=_tradeoff_label(model), linewidth=1.4, markersize=4.5,
+                                **style)
+                ax.plot(best[x], best["rmse"], "*", color=style["color"], markeredgecolor="black",
+                        markeredgewidth=0.8, markersize=13, zorder=6)
+            handles.setdefault(line.get_label(), line)
+        row[1].sharey(row[0])  # same error scale in both panels of a row: read across at a target error
+        for ax, xlabel in zip(row, xlabels):
+            _style(ax, next(letters), f"t = {time:g}", ylabel, xlabel=xlabel, logy=True, legend=None)
+            # labelled 1-2-5 error levels with light horizontal lines: read off the cheapest model per error
+            ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+            ax.grid(True, which="minor", axis="y", color="0.95", linewidth=0.6)
+        row[1].set_ylabel("")  # shared with the left panel
+    star = Line2D([], [], linestyle="none", marker="*", markersize=13, color="white", markeredgecolor="black",
+                  markeredgewidth=0.8, label="COMIC optimum (lowest mean COMIC)")
+    key = [Line2D([], [], color="0.3", linestyle=ls, label=text)
+           for v, (ls, text) in TRADEOFF_VARIANT.items() if v in variants]
+    fig.legend(handles=[*handles.values(), star, *key], loc="outside right center", fontsize=8, frameon=False,
+               handlelength=3.0)
+    return fig

@@ -37,7 +37,11 @@ def realisations_for(spec: dict, n: int, config: dict) -> int:
 
 def figure_cases(config: dict, fig: str) -> list[dict]:
     """Every case of a figure, with wildcard values as strings and its realisation count."""
-    spec = config["figures"][fig]
+    return spec_cases(config["figures"][fig], config)
+
+
+def spec_cases(spec: dict, config: dict) -> list[dict]:
+    """Every case of a sweep spec (cases x n), with wildcard values as strings."""
     defaults = config.get("case_defaults", {})
     cases = []
     for c in spec["cases"]:
