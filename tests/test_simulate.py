@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from particle_entropy.io import write_parquet
+from particle_entropy.records import TIMING_COLUMNS
 from particle_entropy.kernels import h_de
 from particle_entropy.runconfig import RunConfig
 from particle_entropy.simulate import run
@@ -176,7 +177,7 @@ def test_fd_conserves_mass_and_starts_from_discrete_delta():
 
 # --------------------------------------------------------------------------- determinism
 def _bytes(tab, path):
-    write_parquet(tab.drop(columns=["wall_s"]), path)
+    write_parquet(tab.drop(columns=TIMING_COLUMNS), path)
     return path.read_bytes()
 
 
@@ -197,8 +198,8 @@ def test_same_seed_same_bytes_different_seed_different_results(tmp_path, kwargs)
     assert sa.equals(sb)
     assert not np.array_equal(a["H_C"].to_numpy()[1:], c["H_C"].to_numpy()[1:])
     assert _bytes(a, tmp_path / "a.parquet") != _bytes(c, tmp_path / "c.parquet")
-    # wall_s is the only column allowed to differ
-    pd.testing.assert_frame_equal(a.drop(columns=["wall_s"]), b.drop(columns=["wall_s"]))
+    # the timing columns (wall_s, peak_rss_mb) are the only ones allowed to differ
+    pd.testing.assert_frame_equal(a.drop(columns=TIMING_COLUMNS), b.drop(columns=TIMING_COLUMNS))
 
 
 def test_fd_is_deterministic(tmp_path):

@@ -13,6 +13,8 @@ SUMMARY_COLUMNS = {
     "n_realisations": "number of realisations averaged",
     "wall_cum_mean": "wall seconds of one realisation from t = 0 to this step, ensemble mean (varies run to run)",
     "wall_cum_std": "its standard deviation",
+    "work_mean": "particle-steps (FD: node-steps) from t = 0 to this step, incl. substeps, ensemble mean",
+    "peak_rss_mb_max": "largest peak resident memory of a realisation's process so far [MB] (varies run to run)",
     **{f"{m}_mean": f"ensemble mean of {m}" for m in METRICS},
     **{f"{m}_std": f"ensemble standard deviation of {m} (ddof = 1; 0 for one realisation)" for m in METRICS},
 }
@@ -33,6 +35,8 @@ def summarise_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
             out[f"{m}_mean"] = v.mean(axis=0)
             std = v.std(axis=0, ddof=1) if len(runs) > 1 else np.zeros(v.shape[1])
         out[f"{m}_std"] = np.where(np.isfinite(std), std, 0.0)
+    out["work_mean"] = np.stack([r["work"].to_numpy(dtype=np.float64) for r in runs]).mean(axis=0)
+    out["peak_rss_mb_max"] = np.stack([r["peak_rss_mb"].to_numpy(dtype=np.float64) for r in runs]).max(axis=0)
     wall = np.stack([np.cumsum(r["wall_s"].to_numpy(dtype=np.float64)) for r in runs])
     out["wall_cum_mean"] = wall.mean(axis=0)
     out["wall_cum_std"] = wall.std(axis=0, ddof=1) if len(runs) > 1 else np.zeros(wall.shape[1])
@@ -67,6 +71,7 @@ def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.Data
                 "method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]),
                 "truncation": float(r["truncation"]), "dt_growth": float(r["dt_growth"]), "n": int(r["n"]),
                 "time": float(r["time_requested"]), "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
+                "work": r["work_mean"], "peak_rss_mb": r["peak_rss_mb_max"],
                 "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
                 "rmse_std": float(np.sqrt(r["SSE_std"] / r["n_sse"])),
                 "H_C_error": r["H_C_mean"] - r["H_C_analytic"],

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import resource
+import sys
 import time
 from typing import Callable
 
@@ -30,15 +32,20 @@ COLUMNS = {
     "h": "kernel width of the step: MTPT transfer kernel, PT reconstruction kernel or bin width, FD dx [L]",
     "substeps": "mass-transfer substeps taken to keep masses non-negative (1: none needed)",
     "settled": "t > dV^2 / (4 pi e D): the analytic H_C is meaningful (Section 3)",
-    "wall_s": "wall-clock seconds spent in the step (the only column that varies between identical runs)",
+    "work": "cumulative particle-steps (or FD node-steps) including mass-transfer substeps",
+    "wall_s": "wall-clock seconds spent in the step (varies between identical runs)",
+    "peak_rss_mb": "peak resident memory of the process so far [MB] (varies between machines and runs)",
 }
+TIMING_COLUMNS = ["wall_s", "peak_rss_mb"]
 
 
 class Recorder:
     """Collects one row per step and times each step; reports progress through a callback."""
 
-    def __init__(self, case: dict, n_steps: int, progress: Callable[[str], None] | None = None):
+    def __init__(self, case: dict, n_steps: int, progress: Callable[[str], None] | None = None, size: int = 1):
         self.case = case
+        self.size = size  # particles or nodes advanced per (sub)step
+        self._work = 0
         self.rows: list[dict] = []
         self.n_steps = n_steps
         self.progress = progress
@@ -49,6 +56,9 @@ class Recorder:
     def add(self, **row) -> None:
         now = time.perf_counter()
         row["wall_s"] = now - self._last
+        row["peak_rss_mb"] = _peak_rss_mb()
+        self._work += row.get("substeps", 1) * self.size if row["step"] > 0 else 0
+        row["work"] = self._work
         self._last = now
         self.rows.append(row)
         if self.progress and (now - self._last_report > 5.0 or row["step"] == self.n_steps):
@@ -69,5 +79,7 @@ class Recorder:
         return df[ordered + [c for c in df.columns if c not in COLUMNS]]
 
 
-def safe_log(v: float) -> float:
-    return math.log(v) if v > 0 else -math.inf
+def _peak_rss_mb() -> float:
+    """Peak resident set size of this process [MB] (ru_maxrss is in kB on Linux, bytes on macOS)."""
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return rss / 2**20 if sys.platform == "darwin" else rss / 1024

@@ -27,7 +27,8 @@ def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_stat
     cfg = cfg.resolved()
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
     runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
-    rec = Recorder(cfg.case_columns(), len(dts), progress)
+    size = cfg.n + 1 if cfg.method == "fd" else cfg.n
+    rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
     state = runner(cfg, dts, times(dts, cfg.t_final), rec)
     table = rec.table()
     if not want_state:

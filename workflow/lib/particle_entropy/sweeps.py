@@ -54,7 +54,8 @@ def spec_cases(spec: dict, config: dict) -> list[dict]:
                 "eta": _text(c.get("eta", 1 if fd else defaults.get("eta", 1))),
                 "trunc": _text(c.get("truncation", "none" if fd else defaults.get("truncation", "none"))),
                 "growth": _text(c.get("dt_growth", 1 if fd else defaults.get("dt_growth", config["time"]["dt_growth"]))),
-                "nreal": str(realisations_for(spec, int(n), config)),
+                # FD is deterministic: one realisation whatever the ensemble size
+                "nreal": "1" if fd else str(realisations_for(spec, int(n), config)),
             })
     return cases
 
