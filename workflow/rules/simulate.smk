@@ -11,8 +11,11 @@ def sim_runtime_min(wildcards):
 
 
 def first_step(wildcards):
-    """FD runs use their own fixed step (Fig. 8); particle runs start at dt0."""
-    return config["time"]["fd_dt"] if wildcards.method == "fd" else config["time"]["dt0"]
+    """FD runs use their own fixed step (Fig. 8); particle runs start at dt0, or take the
+    fixed step time.fixed_dt when their growth factor is 1."""
+    if wildcards.method == "fd":
+        return config["time"]["fd_dt"]
+    return config["time"]["fixed_dt"] if float(wildcards.growth) == 1.0 else config["time"]["dt0"]
 
 
 rule simulate:
