@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import copy
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path

@@ -31,14 +31,6 @@ class TransferResult:
     max_offdiag_beta: float  # beta * max_i sum_{j != i} P_ij, before splitting
 
 
-def transfer_weights(x: np.ndarray, sigma: float, truncation: float | None, method: str = "auto"):
-    """Row sums r = W 1 and the row sums of P, 0.5 (1 + W (1/r)), for sorted positions."""
-    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method)
-    inv_r = 1.0 / r
-    rowsum = 0.5 * (1.0 + gauss_transform(x, x, inv_r, sigma, truncation, method))
-    return r, inv_r, rowsum
-
-
 def transfer_matrix_dense(x: np.ndarray, sigma: float, truncation: float | None = None) -> np.ndarray:
     """Dense P (Eq. 18, symmetrised) for small N: references and tests only."""
     d = x[:, None] - x[None, :]

@@ -12,7 +12,7 @@ import matplotlib
 from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
-from .plots import save_figure  # noqa: F401  (re-exported for the figure script)
+from .plots import save_figure  # noqa: F401  (re-exported for the Fig. 10 script)
 from .shear2d import CASES, WALL_BAND
 
 TITLES = {

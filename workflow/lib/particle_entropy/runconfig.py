@@ -72,18 +72,18 @@ class RunConfig:
             raise SettingError("n", self.n, "an integer >= 1")
         if self.method == "fd" and (self.n < 2 or self.n % 2):
             raise SettingError("n", self.n, "for fd an even number of intervals >= 2, so that a node sits at x = 0")
-        _finite_range("eta", self.eta, 0.0, 1.0)
-        _finite_range("D", self.D, 0.0, math.inf)
-        _finite_range("t_final", self.t_final, 0.0, math.inf, open_low=True)
-        _finite_range("dt0", self.dt0, 0.0, math.inf, open_low=True)
-        _finite_range("dt_growth", self.dt_growth, 1.0, math.inf)
+        check_range("eta", self.eta, 0.0, 1.0)
+        check_range("D", self.D, 0.0, math.inf)
+        check_range("t_final", self.t_final, 0.0, math.inf, open_low=True)
+        check_range("dt0", self.dt0, 0.0, math.inf, open_low=True)
+        check_range("dt_growth", self.dt_growth, 1.0, math.inf)
         if self.truncation is not None:
-            _finite_range("truncation", self.truncation, 0.0, math.inf, open_low=True)
+            check_range("truncation", self.truncation, 0.0, math.inf, open_low=True)
         if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
             raise SettingError("seed", self.seed, "an integer >= 0")
-        _finite_range("omega", self.omega, 0.0, math.inf, open_low=True)
-        _finite_range("fd_length", self.fd_length, 0.0, math.inf, open_low=True)
-        _finite_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
+        check_range("omega", self.omega, 0.0, math.inf, open_low=True)
+        check_range("fd_length", self.fd_length, 0.0, math.inf, open_low=True)
+        check_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
         if self.method == "fd" and self.kernel == "explicit":
@@ -122,7 +122,7 @@ class RunConfig:
         }
 
 
-def _finite_range(name, value, lo, hi, open_low=False):
+def check_range(name, value, lo, hi, open_low=False):
     """Raise SettingError unless lo <(=) value <= hi and value is a finite number."""
     is_number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
     v = float(value) if is_number else math.nan

@@ -32,7 +32,7 @@ from numba import njit
 from scipy.spatial import cKDTree
 
 from .records import Recorder
-from .runconfig import SettingError
+from .runconfig import SettingError, check_range
 
 CASES = ("rw_nodrift", "rw_drift", "mt")
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
@@ -84,17 +84,17 @@ class ShearConfig:
             raise SettingError("case", self.case, f"one of {', '.join(CASES)}")
         if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or self.n < 1:
             raise SettingError("n", self.n, "an integer >= 1")
-        _in_range("length", self.length, 0.0, math.inf, open_low=True)
-        _in_range("strip_lo", self.strip_lo, 0.0, self.length)
-        _in_range("strip_hi", self.strip_hi, self.strip_lo, self.length, open_low=True)
-        _in_range("alpha_L", self.alpha_L, 0.0, math.inf, open_low=True)
-        _in_range("alpha_T", self.alpha_T, 0.0, math.inf)
-        _in_range("dt", self.dt, 0.0, math.inf, open_low=True)
-        _in_range("t_final", self.t_final, 0.0, math.inf)
+        check_range("length", self.length, 0.0, math.inf, open_low=True)
+        check_range("strip_lo", self.strip_lo, 0.0, self.length)
+        check_range("strip_hi", self.strip_hi, self.strip_lo, self.length, open_low=True)
+        check_range("alpha_L", self.alpha_L, 0.0, math.inf, open_low=True)
+        check_range("alpha_T", self.alpha_T, 0.0, math.inf)
+        check_range("dt", self.dt, 0.0, math.inf, open_low=True)
+        check_range("t_final", self.t_final, 0.0, math.inf)
         steps = self.t_final / self.dt
         if abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
             raise SettingError("t_final", self.t_final, f"a whole number of steps dt={self.dt!r}")
-        _in_range("beta", self.beta, 0.0, 1.0)
+        check_range("beta", self.beta, 0.0, 1.0)
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
             raise SettingError("seed", self.seed, "an integer >= 0")
         if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
@@ -115,16 +115,6 @@ class ShearConfig:
         """The case parameters written beside every row of the step table."""
         d = asdict(self)
         return {"case": d.pop("case"), "seed": int(d.pop("seed")), **{k: v for k, v in d.items()}}
-
-
-def _in_range(name, value, lo, hi, open_low=False):
-    """Raise SettingError unless value is a finite number with lo <(=) value <= hi."""
-    is_number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    v = float(value) if is_number else math.nan
-    if not math.isfinite(v) or (v <= lo if open_low else v < lo) or v > hi:
-        low = f"> {lo}" if open_low else f">= {lo}"
-        high = "finite" if hi == math.inf else f"<= {hi}"
-        raise SettingError(name, value, f"a number {low} and {high}")
 
 
 # ---------------------------------------------------------------- flow and dispersion
