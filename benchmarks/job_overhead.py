@@ -2,7 +2,7 @@
 
     python benchmarks/job_overhead.py [WORKDIR]
 
-Reads every simulate job's benchmark file (benchmarks/simulate/...tsv, written by Snakemake)
+Reads every simulate job's benchmark file (results/benchmarks/simulate/...tsv, written by Snakemake)
 and its output table (results/runs/...parquet, wall_s per step) and prints the distribution
 of (job wall time - simulation time): interpreter start-up, imports, JIT cache loading,
 Snakemake's script preamble and the Parquet write.
@@ -20,8 +20,8 @@ import pandas as pd
 def main() -> None:
     root = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
     rows = []
-    for tsv in sorted((root / "benchmarks" / "simulate").rglob("*.tsv")):
-        rel = tsv.relative_to(root / "benchmarks" / "simulate").with_suffix(".parquet")
+    for tsv in sorted((root / "results" / "benchmarks" / "simulate").rglob("*.tsv")):
+        rel = tsv.relative_to(root / "results" / "benchmarks" / "simulate").with_suffix(".parquet")
         table = root / "results" / "runs" / rel
         if not table.exists():
             continue

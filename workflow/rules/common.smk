@@ -70,3 +70,20 @@ def summary_runs(wildcards):
 def comic_summaries():
     """Case summaries of the COMIC models: FD (Fig. 8) and the MTPT models of Fig. 9."""
     return [summary_path(c) for f in ("fig8", "fig9") if f in FIGURES for c in figure_cases(config, f)]
+
+
+def sim_mem_mb(wildcards):
+    return 300 + int(wildcards.n) // 20
+
+
+def sim_runtime_min(wildcards):
+    seeds = int(wildcards.last) - int(wildcards.first) + 1
+    return seeds * (2 if int(wildcards.n) <= 3000 else 20)
+
+
+def first_step(wildcards):
+    """FD runs use their own fixed step (Fig. 8); particle runs start at dt0, or take the
+    fixed step time.fixed_dt when their growth factor is 1."""
+    if wildcards.method == "fd":
+        return config["time"]["fd_dt"]
+    return config["time"]["fixed_dt"] if float(wildcards.growth) == 1.0 else config["time"]["dt0"]

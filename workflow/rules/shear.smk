@@ -10,7 +10,7 @@ rule simulate_shear:
     log:
         "logs/simulate_shear/{case}/seed~{seed}.log",
     benchmark:
-        "benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
+        "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
     wildcard_constraints:
         case="rw_nodrift|rw_drift|mt",
     params:
