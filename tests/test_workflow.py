@@ -244,3 +244,12 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
         a, b = (pd.read_parquet(p).drop(columns=["wall_s", "peak_rss_mb"]) for p in (new, old))
         pd.testing.assert_frame_equal(a, b)
     assert not list((tmp_path / "results").rglob("*.tmp"))  # no half-written file left behind
+
+
+def test_report_holds_every_figure_with_its_caption(tiny_run):
+    snakemake(tiny_run, "--report", "report.html", configfile=TINY)
+    html = (tiny_run / "report.html").read_text(errors="replace")
+    assert len(html) > 100_000
+    for k in range(1, 11):
+        assert f"fig{k}.png" in html
+    assert "Reproduces" in html and "tradeoff.png" in html
