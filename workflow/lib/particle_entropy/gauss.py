@@ -1,19 +1,21 @@
 """Discrete Gauss transforms in 1-D: out[k, i] = sum_j exp(-(y_i - x_j)^2 / (2 sigma^2)) q[k, j].
 
 These sums are the only O(N^2)-looking work of the project (MTPT transfer weights,
-Eqs. 17 and 21, and kernel reconstructions, Eq. 10). Two exact-to-round-off methods
-share one entry point, :func:`gauss_transform`; neither builds an N x N matrix:
+Eqs. 17 and 21, and kernel reconstructions, Eq. 10). Three methods, exact to round-off,
+share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
 
 * ``direct``: windowed sum over sorted sources, O(N x neighbours) time, O(N) memory.
   Used for truncated kernels (exactly the pairs with |y - x| <= truncation * sigma) and
-  whenever the neighbour count is small.
-* ``taylor``: sources are grouped in boxes of width sigma; each box carries ``P_TERMS``
-  Taylor moments of exp(u v) (u, v: source and target offsets from the box centre in
-  units of sigma). Truncation error < 1e-17 of the kernel's peak (see ``P_TERMS``), so
-  the transform stays symmetric to round-off and MTPT conserves mass to round-off.
-  O(N x P_TERMS x boxes-in-range) time, independent of the neighbour count.
+  whenever the neighbour count is small (``auto`` below ``DIRECT_MAX_NEIGHBOURS``).
+* ``fgt``: fast Gauss transform, the ``auto`` choice at large neighbour counts. Source
+  boxes of width sigma carry ``FGT_TERMS`` Hermite moments, translated to Taylor
+  expansions about each target box; sparse box pairs are summed exactly. Truncation error
+  < 1e-18 of the kernel's peak, so the transform stays symmetric to round-off and MTPT
+  conserves mass to round-off. O(N x FGT_TERMS) time plus O(boxes x FGT_TERMS^2).
+* ``taylor``: per-target evaluation of each source box's Taylor moments of exp(u v);
+  O(N x P_TERMS x boxes-in-range), kept as an independent cross-check of ``fgt``.
 
-For the untruncated Gaussian both methods drop pairs farther apart than
+For the untruncated Gaussian all methods drop pairs farther apart than
 ``CUTOFF_SIGMAS`` sigma, where the kernel is below exp(-CUTOFF_SIGMAS^2 / 2) = 2.6e-18,
 i.e. below double-precision resolution of the self term (which is 1).
 """
@@ -84,7 +86,7 @@ def _direct_symmetric(x, q, sigma, radius):
 
 
 @njit(cache=True)
-def _taylor_moments(x, q, sigma, x0, nbox_guess, p):
+def _taylor_moments(x, q, sigma, x0, p):
     """Box ids, box centres and Taylor moments A[b, n, k] of sorted sources."""
     nk, ns = q.shape
     ids = np.empty(ns, np.int64)
@@ -309,7 +311,7 @@ def gauss_transform(
         if x.size == 0:
             out = np.zeros((q2.shape[0], y.size))
         else:
-            centres, A = _taylor_moments(x, q2, float(sigma), float(x[0]), 0, P_TERMS)
+            centres, A = _taylor_moments(x, q2, float(sigma), float(x[0]), P_TERMS)
             out = _taylor_eval(y, centres, A, float(sigma), float(radius))
     else:
         raise ValueError(f"method must be 'auto', 'direct', 'fgt' or 'taylor', got {method!r}")

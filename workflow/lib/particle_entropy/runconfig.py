@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -51,7 +51,6 @@ class RunConfig:
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = "auto"
     scheme: str = "symmetric"  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
-    extra: dict = field(default_factory=dict)
 
     def resolved(self) -> "RunConfig":
         """Fill method-dependent defaults and check every setting."""
