@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .measures import comic
+
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
-CASE_KEYS = ["method", "kernel", "n", "eta", "truncation", "dt_growth"]
 SUMMARY_COLUMNS = {
     "step": "time-step index",
     "time": "time [T]",
@@ -61,24 +62,30 @@ def model_name(method: str, kernel: str, eta: float, truncation: float = np.inf,
     return name
 
 
+def _case_rows(summaries: list[pd.DataFrame], times: list[float]):
+    """(summary row, its case columns) for every summary at every requested time."""
+    for s in summaries:
+        for _, r in at_times(s, times).iterrows():
+            yield r, {"method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]), "n": int(r["n"]),
+                      "time": float(r["time_requested"])}
+
+
 def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
     """Cost (wall time) beside error (RMSE, H_C and E errors) and COMIC per model, N and time."""
     rows = []
-    for s in summaries:
-        for _, r in at_times(s, times).iterrows():
-            rows.append({
-                "model": model_name(r["method"], r["kernel"], r["eta"], r["truncation"], r["dt_growth"]),
-                "method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]),
-                "truncation": float(r["truncation"]), "dt_growth": float(r["dt_growth"]), "n": int(r["n"]),
-                "time": float(r["time_requested"]), "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
-                "work": r["work_mean"], "peak_rss_mb": r["peak_rss_mb_max"],
-                "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
-                "rmse_std": float(np.sqrt(r["SSE_std"] / r["n_sse"])),
-                "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
-                "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
-                "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
-                "n_realisations": int(r["n_realisations"]),
-            })
+    for r, case in _case_rows(summaries, times):
+        rows.append({
+            "model": model_name(r["method"], r["kernel"], r["eta"], r["truncation"], r["dt_growth"]),
+            **case, "truncation": float(r["truncation"]), "dt_growth": float(r["dt_growth"]),
+            "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
+            "work": r["work_mean"], "peak_rss_mb": r["peak_rss_mb_max"],
+            "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
+            "rmse_std": float(np.sqrt(r["SSE_std"] / r["n_sse"])),
+            "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
+            "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
+            "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
+            "n_realisations": int(r["n_realisations"]),
+        })
     df = pd.DataFrame(rows).sort_values(["model", "time", "n"], ignore_index=True)
     best = df.groupby(["model", "time"])["COMIC_mean"].transform("min")
     df["is_comic_optimum"] = df["COMIC_mean"] == best
@@ -97,17 +104,15 @@ def at_times(summary: pd.DataFrame, times: list[float]) -> pd.DataFrame:
 def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
     """COMIC and SSE statistics per model, N and requested time (results/tables/comic.parquet)."""
     rows = []
-    for s in summaries:
-        for _, r in at_times(s, times).iterrows():
-            rows.append({
-                "model": model_name(r["method"], r["kernel"], r["eta"]),
-                "method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]),
-                "n": int(r["n"]), "time": float(r["time_requested"]), "time_step": float(r["time"]),
-                "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
-                **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
-                "SSE_mean": r["SSE_mean"], "SSE_std": r["SSE_std"],
-                "n_realisations": int(r["n_realisations"]),
-            })
+    for r, case in _case_rows(summaries, times):
+        rows.append({
+            "model": model_name(r["method"], r["kernel"], r["eta"]),
+            **case, "time_step": float(r["time"]),
+            "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
+            **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
+            "SSE_mean": r["SSE_mean"], "SSE_std": r["SSE_std"],
+            "n_realisations": int(r["n_realisations"]),
+        })
     cols = ["model", "method", "kernel", "eta", "n", "time", "time_step", "COMIC_mean", "COMIC_std",
             "COMIC_of_mean_SSE", "COMIC_of_mean_SSE_lo", "COMIC_of_mean_SSE_hi",
             "SSE_mean", "SSE_std", "n_realisations"]
@@ -117,8 +122,6 @@ def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFra
 def comic_of_mean_sse(sse_mean: float, sse_std: float, n: int, dV: float) -> dict:
     """COMIC of the ensemble-mean SSE (Eq. 43), as the authors' code plots Fig. 9, with the
     band 2 ln((SSE_mean -+ SSE_std) / n) - ln dV (-inf below when the std exceeds the mean)."""
-    from .measures import comic
-
     return {
         "COMIC_of_mean_SSE": comic(sse_mean, n, dV),
         "COMIC_of_mean_SSE_lo": comic(max(sse_mean - sse_std, 0.0), n, dV),

@@ -40,13 +40,13 @@ def step(cfg: RunConfig, x, m, dt: float, t_end: float, rng: np.random.Generator
         x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
         order = np.argsort(x, kind="stable")
         x, m = x[order], m[order]
-    sigma, beta = kernel_for_step(cfg, dt, t_end)
-    if sigma > 0 and beta > 0 and cfg.eta > 0 and cfg.scheme == "sequential":
+    sigma, beta = kernel_for_step(cfg, dt, t_end)  # (0, 0) when eta D = 0
+    if sigma == 0.0 or beta == 0.0:
+        return x, m, sigma, 0.0, 1
+    if cfg.scheme == "sequential":
         return x, sequential_transfer(x, m, sigma, beta, cfg.truncation, rng), sigma, beta, 1
-    if sigma > 0 and beta > 0 and cfg.eta > 0:
-        res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method)
-        return x, res.mass, sigma, beta, res.substeps
-    return x, m, sigma, 0.0, 1
+    res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method)
+    return x, res.mass, sigma, beta, res.substeps
 
 
 def measure(cfg: RunConfig, x, m, t: float) -> dict:
