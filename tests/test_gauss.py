@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from particle_entropy import gauss
 from particle_entropy.gauss import CUTOFF_SIGMAS, gauss_transform
 
 from conftest import dense_kernel
@@ -55,7 +56,7 @@ SIGMA_FACTORS = {  # sigma in units of the mean source spacing 10 / N
 
 @pytest.mark.parametrize("n", [10, 100, 2000])
 @pytest.mark.parametrize("width", list(SIGMA_FACTORS))
-@pytest.mark.parametrize("method", ["direct", "taylor", "auto"])
+@pytest.mark.parametrize("method", ["direct", "fgt", "taylor", "auto"])
 def test_sources_as_targets_match_dense(rng, n, width, method):
     x = _sources(rng, n)
     sigma = SIGMA_FACTORS[width] * 10.0 / n
@@ -66,7 +67,7 @@ def test_sources_as_targets_match_dense(rng, n, width, method):
 
 @pytest.mark.parametrize("n", [10, 300, 2000])
 @pytest.mark.parametrize("width", list(SIGMA_FACTORS))
-@pytest.mark.parametrize("method", ["direct", "taylor", "auto"])
+@pytest.mark.parametrize("method", ["direct", "fgt", "taylor", "auto"])
 def test_other_targets_match_dense(rng, n, width, method):
     """Kernel-reconstruction use: targets on a grid wider than the sources."""
     x = _sources(rng, n)
@@ -77,7 +78,7 @@ def test_other_targets_match_dense(rng, n, width, method):
     _assert_matches(out, y, x, q, sigma)
 
 
-@pytest.mark.parametrize("method", ["direct", "taylor", "auto"])
+@pytest.mark.parametrize("method", ["direct", "fgt", "taylor", "auto"])
 def test_single_rhs_shape_and_clustered_sources(rng, method):
     """1-D weights give a 1-D result; repeated positions and tight clusters are handled."""
     x = np.sort(np.concatenate([np.zeros(50), rng.normal(0, 1e-3, 400), rng.uniform(-3, 3, 300)]))
@@ -149,3 +150,69 @@ def test_other_documented_errors():
         gauss_transform(x, x, np.ones_like(x), 0.1, method="fmm")
     with pytest.raises(ValueError):  # skip_self is direct-only
         gauss_transform(x, x, np.ones_like(x), 0.1, method="taylor", skip_self=True)
+
+
+@pytest.mark.parametrize("ratio", [0.5, 1.0, gauss.FGT_BOX_RATIO, 2.5])
+@pytest.mark.parametrize("density", [0.5, 30.0, 400.0])  # sources per sigma
+def test_fgt_box_widths_match_dense(rng, ratio, density):
+    """Boxes from 0.5 to 2.5 sigma wide, with their default term count, are exact to 1e-12,
+    both where box pairs are summed exactly (sparse) and where they are translated (dense)."""
+    n = 1500
+    x = _sources(rng, n)
+    sigma = density * 10.0 / n
+    q = _weights(rng, n)
+    width = 2.0 ** math.floor(math.log2(ratio * sigma))  # exact box geometry: a power of two
+    p = gauss.fgt_terms(width / sigma, gauss.FGT_TOLERANCE)
+    out = gauss._fgt(x, x, q, sigma, CUTOFF_SIGMAS * sigma, width, p)
+    _assert_matches(out, x, x, q, sigma)
+
+
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 2.0, 3.0])
+@pytest.mark.parametrize("tolerance", [1e-3, 1e-6, 1e-10, 1e-17])
+def test_fgt_term_count_is_the_fewest_meeting_the_bound(ratio, tolerance):
+    p = gauss.fgt_terms(ratio, tolerance)
+    assert gauss.fgt_error_bound(ratio, p) <= tolerance
+    assert p == 1 or gauss.fgt_error_bound(ratio, p - 1) > tolerance
+
+
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 2.25, 3.0])
+def test_fgt_error_bound_dominates_the_dropped_terms(ratio):
+    """The bound against a brute-force sum of the dropped terms of the double series
+    exp(-(t + v - u)^2) = sum h_{n+m}(t) u^n (-v)^m / (n! m!), worst case over u, v, t."""
+    a = ratio / math.sqrt(2)
+    for p in (4, 8, 16):
+        worst = 0.0
+        for t in np.linspace(0.0, 4.0, 9):
+            h = [math.exp(-t * t), 2 * t * math.exp(-t * t)]  # Hermite functions h_k(t)
+            for k in range(1, 160):
+                h.append(2 * t * h[k] - 2 * k * h[k - 1])
+            for u in (-a / 2, a / 2):
+                for v in (-a / 2, a / 2):
+                    kept = sum(h[n + m] * u**n * (-v) ** m / (math.factorial(n) * math.factorial(m))
+                               for n in range(p) for m in range(p))
+                    worst = max(worst, abs(math.exp(-(t + v - u) ** 2) - kept))
+        assert worst <= gauss.fgt_error_bound(ratio, p)
+
+
+@pytest.mark.parametrize("sigma", [0.02, 0.05, 0.5])  # 8 to 200 sources per sigma
+def test_fgt_tolerance_bounds_the_error(rng, sigma):
+    """A looser tolerance keeps the documented bound |error_i| <= tolerance * sum_j |q_j| (over
+    sources within the cut-off) and is really used: the error grows with the tolerance."""
+    n = 4000
+    x = _sources(rng, n)
+    q = _weights(rng, n)
+    ref = q @ dense_kernel(x, x, sigma, None).T
+    near = np.abs(q) @ (np.abs(x[:, None] - x[None, :]) <= CUTOFF_SIGMAS * sigma).T
+    worst = []
+    for tolerance in (1e-4, 1e-8, 1e-12):
+        err = np.abs(gauss_transform(x, x, q, sigma, method="fgt", tolerance=tolerance) - ref)
+        assert np.all(err <= tolerance * near + CUT * np.abs(q).sum(axis=-1, keepdims=True))
+        worst.append(err.max())
+    assert worst[0] > worst[2]
+
+
+@pytest.mark.parametrize("tolerance", [0.0, -1e-10, 0.5, math.nan])
+def test_bad_tolerance_raises(tolerance):
+    x = np.linspace(-1, 1, 20)
+    with pytest.raises(ValueError, match="tolerance"):
+        gauss_transform(x, x, np.ones_like(x), 0.1, method="fgt", tolerance=tolerance)

@@ -14,6 +14,8 @@ rule simulate:
         omega=config["physics"]["omega"],
         fd_length=config["physics"]["fd_length"],
         dt0=first_step,
+        transfer_method=config["numerics"]["transfer_method"],
+        transfer_tolerance=config["numerics"]["transfer_tolerance"],
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,
@@ -36,6 +38,8 @@ rule snapshot:
         omega=config["physics"]["omega"],
         fd_length=config["physics"]["fd_length"],
         dt0=first_step,
+        transfer_method=config["numerics"]["transfer_method"],
+        transfer_tolerance=config["numerics"]["transfer_tolerance"],
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,

@@ -24,6 +24,8 @@ cfg = RunConfig(
     truncation=None if w.trunc == "none" else float(w.trunc),
     omega=float(par.omega),
     fd_length=float(par.fd_length),
+    transfer_method=par.transfer_method,
+    transfer_tolerance=float(par.transfer_tolerance),
 )
 snapshot = snakemake.rule == "snapshot"  # noqa: F821
 seeds = range(int(w.first), int(w.last) + 1)

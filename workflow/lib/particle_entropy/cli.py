@@ -6,6 +6,7 @@ import argparse
 import math
 import sys
 
+from .gauss import FGT_TOLERANCE
 from .runconfig import KERNELS, METHODS, PAPER, RunConfig, SettingError
 
 
@@ -45,6 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--fd-length", type=float, default=PAPER["fd_length"], help="FD domain length [L], centred on 0")
     s.add_argument("--transfer-method", choices=("auto", "direct", "fgt", "taylor"), default="auto",
                    help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)")
+    s.add_argument("--transfer-tolerance", type=float, default=FGT_TOLERANCE,
+                   help="error bound of the fast Gauss transform, relative to the summed |weights| in reach "
+                        f"[-] (default {FGT_TOLERANCE:g}: round-off, mass conserved to 1e-13)")
     s.add_argument("--scheme", choices=("symmetric", "sequential"), default="symmetric",
                    help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop")
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
@@ -57,7 +61,8 @@ def config_from_args(a: argparse.Namespace) -> RunConfig:
     return RunConfig(
         method=a.method, kernel=a.kernel, n=a.n, eta=a.eta, D=a.D, t_final=a.t_final,
         dt0=a.dt0, dt_growth=a.dt_growth, truncation=a.truncation, seed=a.seed,
-        omega=a.omega, fd_length=a.fd_length, transfer_method=a.transfer_method, scheme=a.scheme,
+        omega=a.omega, fd_length=a.fd_length, transfer_method=a.transfer_method,
+        transfer_tolerance=a.transfer_tolerance, scheme=a.scheme,
     ).resolved()
 
 

@@ -8,10 +8,12 @@ share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
   Used for truncated kernels (exactly the pairs with |y - x| <= truncation * sigma) and
   whenever the neighbour count is small (``auto`` below ``DIRECT_MAX_NEIGHBOURS``).
 * ``fgt``: fast Gauss transform, the ``auto`` choice at large neighbour counts. Source
-  boxes of width sigma carry ``FGT_TERMS`` Hermite moments, translated to Taylor
-  expansions about each target box; sparse box pairs are summed exactly. Truncation error
-  < 1e-18 of the kernel's peak, so the transform stays symmetric to round-off and MTPT
-  conserves mass to round-off. O(N x FGT_TERMS) time plus O(boxes x FGT_TERMS^2).
+  boxes ``FGT_BOX_RATIO`` sigma wide carry p Hermite moments, translated to Taylor
+  expansions about each target box (one table of Hermite functions per box offset);
+  sparse box pairs are summed exactly. p is the fewest terms whose Greengard-Strain error
+  bound is below ``tolerance`` (default ``FGT_TOLERANCE`` = 1e-17 of the summed |weights|,
+  i.e. round-off: the transform stays symmetric and MTPT conserves mass to round-off).
+  O(N p) time plus O(boxes x p^2).
 * ``taylor``: per-target evaluation of each source box's Taylor moments of exp(u v);
   O(N x P_TERMS x boxes-in-range), kept as an independent cross-check of ``fgt``.
 
@@ -29,13 +31,15 @@ from numba import njit
 
 CUTOFF_SIGMAS = 9.0
 P_TERMS = 24
-# Hermite / Taylor terms of the fast Gauss transform with boxes of width sigma: the
-# truncation error of both expansions is below r^p / sqrt(p!) / (1 - r), r = 1 / (2 sqrt 2),
-# i.e. < 1e-18 of the kernel's peak for p = 20.
-FGT_TERMS = 20
+FGT_TOLERANCE = 1e-17
+FGT_TOLERANCE_RANGE = (1e-30, 0.1)
+# Box width of the fast Gauss transform in sigma: wide boxes mean fewer translations (each
+# p^2) but more terms p. Measured (benchmarks/bench_transfer.py --boxes): 2.5 is fastest or
+# within 25 % of it from 7 to 1000 sources per sigma, for one and for three weight vectors.
+FGT_BOX_RATIO = 2.5
 # The fast Gauss transform wins once a target sees more sources than this within the
-# cut-off (measured crossover, see benchmarks/bench_transfer.py).
-DIRECT_MAX_NEIGHBOURS = 300.0
+# cut-off, about 7 per sigma (measured crossover, benchmarks/bench_transfer.py --boxes).
+DIRECT_MAX_NEIGHBOURS = 120.0
 
 
 @njit(cache=True)
@@ -151,103 +155,226 @@ def _taylor_eval(y, centres, A, sigma, radius):
 
 @njit(cache=True)
 def _boxes(z, origin, width):
-    """Consecutive-box partition of sorted z: (box start indices incl. end, box centres)."""
+    """Consecutive-box partition of sorted z: (box start indices incl. end, integer box ids)."""
     n = z.shape[0]
     starts = np.empty(n + 1, np.int64)
-    centres = np.empty(n)
+    ids = np.empty(n, np.int64)
     nb = 0
     prev = -(2**62)
     for j in range(n):
         b = int(math.floor((z[j] - origin) / width))
         if b != prev:
             starts[nb] = j
-            centres[nb] = origin + (b + 0.5) * width
+            ids[nb] = b
             nb += 1
             prev = b
     starts[nb] = n
-    return starts[: nb + 1], centres[:nb]
+    return starts[: nb + 1], ids[:nb]
 
 
 @njit(cache=True)
-def _fgt(y, x, q, sigma, radius, p):
-    """Fast Gauss transform: Hermite expansions of source boxes translated to Taylor
-    expansions about target-box centres (Greengard-Strain), boxes of width sigma."""
-    nk, ns = q.shape
-    nt = y.shape[0]
-    scale = 1.0 / (math.sqrt(2.0) * sigma)  # kernel = exp(-(Y - X)^2) in scaled units
-    # Boxes and offsets live in the original units: x - c, y - c and c_t - c_s are exact
-    # differences of nearby numbers, so no precision is lost when sigma << |x|.
-    reach = radius + sigma
-    origin = min(x[0], y[0])
-    s_starts, s_centres = _boxes(x, origin, sigma)
-    t_starts, t_centres = _boxes(y, origin, sigma)
-    nbs = s_centres.shape[0]
-    # Hermite moments A[b, n, k] = sum_j q_kj (X_j - C_b)^n / n!
-    A = np.zeros((nbs, p, nk))
-    for b in range(nbs):
-        for j in range(s_starts[b], s_starts[b + 1]):
-            u = (x[j] - s_centres[b]) * scale
-            c = 1.0
+def _hermite_table(kmax, step, p):
+    """h_n(t) = exp(-t^2) H_n(t), n < 2p, at t = d * step for box offsets d = -kmax .. kmax."""
+    H = np.empty((2 * kmax + 1, 2 * p))
+    for d in range(-kmax, kmax + 1):
+        t = d * step
+        row = H[d + kmax]
+        row[0] = math.exp(-t * t)
+        row[1] = 2.0 * t * row[0]
+        for n in range(1, 2 * p - 1):
+            row[n + 1] = 2.0 * t * row[n] - 2.0 * n * row[n - 1]
+    return H
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def _hermite_moments(x, q, starts, ids, origin, width, scale, p):
+    """A[b, k, n] = sum_{j in box b} q_kj u_j^n / n!, u_j = (x_j - c_b) scale (Hermite moments)."""
+    nk = q.shape[0]
+    nb = ids.shape[0]
+    A = np.zeros((nb, nk, p))
+    inv = np.empty(p)
+    for n in range(p):
+        inv[n] = 1.0 / (n + 1)
+    maxc = 0
+    for b in range(nb):
+        maxc = max(maxc, starts[b + 1] - starts[b])
+    u = np.empty(maxc)
+    c = np.empty(maxc)
+    for b in range(nb):
+        lo = starts[b]
+        cnt = starts[b + 1] - lo
+        centre = origin + (ids[b] + 0.5) * width
+        for jj in range(cnt):
+            u[jj] = (x[lo + jj] - centre) * scale
+        for k in range(nk):
+            for jj in range(cnt):
+                c[jj] = q[k, lo + jj]
             for n in range(p):
-                for k in range(nk):
-                    A[b, n, k] += c * q[k, j]
-                c *= u / (n + 1)
-    out = np.zeros((nk, nt))
-    h = np.empty(2 * p)
-    B = np.empty((p, nk))
-    inv_fact = np.empty(p)
-    inv_fact[0] = 1.0
+                s = 0.0
+                for jj in range(cnt):
+                    s += c[jj]
+                A[b, k, n] = s
+                for jj in range(cnt):
+                    c[jj] *= u[jj] * inv[n]
+    return A
+
+
+@njit(cache=True)
+def _empty_boxes(q, starts):
+    """empty[b, k]: every weight q_kj of box b is zero."""
+    nk = q.shape[0]
+    nb = starts.shape[0] - 1
+    empty = np.ones((nb, nk), np.bool_)
+    for b in range(nb):
+        for k in range(nk):
+            for j in range(starts[b], starts[b + 1]):
+                if q[k, j] != 0.0:
+                    empty[b, k] = False
+                    break
+    return empty
+
+
+@njit(cache=True)
+def _fgt(y, x, q, sigma, radius, width, p):
+    """Fast Gauss transform (Greengard-Strain): Hermite moments of source boxes translated to
+    Taylor coefficients about target-box centres; boxes ``width`` (see fgt_box_width) wide on one
+    grid, so a translation depends only on the box offset and is tabulated once."""
+    nk = q.shape[0]
+    scale = 1.0 / (math.sqrt(2.0) * sigma)  # kernel = exp(-(Y - X)^2) in scaled units
+    # Box geometry is exact: width is k 2^e with a small integer k and origin a multiple of
+    # it, so every centre (b + 1/2) width is a float and centre offsets are exactly d * width. The Hermite
+    # table therefore matches the centres used for moments and evaluation, even when
+    # sigma << |x| (the offsets x - c and y - c are taken in the original units).
+    origin = math.floor(min(x[0], y[0]) / width) * width
+    s_starts, s_ids = _boxes(x, origin, width)
+    t_starts, t_ids = _boxes(y, origin, width)
+    kmax = int(math.ceil(radius / width)) + 1  # |y - x| <= radius needs |box offset| <= kmax
+    H = _hermite_table(kmax, width * scale, p)
+    A = _hermite_moments(x, q, s_starts, s_ids, origin, width, scale, p)
+    empty = _empty_boxes(q, s_starts)
+    sign = np.empty(p)  # Taylor coefficients carry (-1)^m / m!
+    sign[0] = 1.0
     for m in range(1, p):
-        inv_fact[m] = inv_fact[m - 1] / m
+        sign[m] = -sign[m - 1] / m
+    nbs = s_ids.shape[0]
+    out = np.zeros((nk, y.shape[0]))
+    B = np.empty((nk, p))
+    maxc = 0
+    for tb in range(t_ids.shape[0]):
+        maxc = max(maxc, t_starts[tb + 1] - t_starts[tb])
+    v = np.empty(maxc)
+    acc = np.empty(maxc)
     lo = 0
-    for tb in range(t_centres.shape[0]):
-        ct = t_centres[tb]
-        while lo < nbs and s_centres[lo] < ct - reach:
+    for tb in range(t_ids.shape[0]):
+        bt = t_ids[tb]
+        while lo < nbs and s_ids[lo] < bt - kmax:
             lo += 1
+        t_lo, t_hi = t_starts[tb], t_starts[tb + 1]
+        ct = origin + (bt + 0.5) * width
         B[:, :] = 0.0
         sb = lo
-        t_lo, t_hi = t_starts[tb], t_starts[tb + 1]
-        while sb < nbs and s_centres[sb] <= ct + reach:
+        while sb < nbs and s_ids[sb] <= bt + kmax:
             s_lo, s_hi = s_starts[sb], s_starts[sb + 1]
-            if (s_hi - s_lo) * (t_hi - t_lo) * (8 + nk) <= p * p * nk:
-                # sparse box pair: exact pairwise sum is cheaper than a translation
+            if empty[sb].all():
+                sb += 1
+                continue
+            if (s_hi - s_lo) * (t_hi - t_lo) * (30 + nk) <= p * p * nk:
+                # sparse box pair: the exact pairwise sum is cheaper than a translation
                 for i in range(t_lo, t_hi):
                     for j in range(s_lo, s_hi):
                         d = (y[i] - x[j]) * scale
                         g = math.exp(-d * d)
                         for k in range(nk):
                             out[k, i] += g * q[k, j]
-                sb += 1
-                continue
-            t0 = (ct - s_centres[sb]) * scale
-            h[0] = math.exp(-t0 * t0)
-            h[1] = 2.0 * t0 * h[0]
-            for kk in range(1, 2 * p - 1):
-                h[kk + 1] = 2.0 * t0 * h[kk] - 2.0 * kk * h[kk - 1]
-            for m in range(p):
-                for n in range(p):
-                    hn = h[n + m]
-                    for k in range(nk):
-                        B[m, k] += A[sb, n, k] * hn
+            else:
+                h = H[bt - s_ids[sb] + kmax]
+                for k in range(nk):
+                    if empty[sb, k]:
+                        continue  # all weights zero (empty particles at early MTPT times)
+                    for n in range(p):
+                        a = A[sb, k, n]
+                        for m in range(p):
+                            B[k, m] += a * h[n + m]
             sb += 1
-        for m in range(p):
-            f = inv_fact[m] if m % 2 == 0 else -inv_fact[m]
-            for k in range(nk):
-                B[m, k] *= f
-        for i in range(t_lo, t_hi):
-            w = (y[i] - ct) * scale
-            for k in range(nk):
-                acc = B[p - 1, k]
-                for m in range(p - 2, -1, -1):
-                    acc = acc * w + B[m, k]
-                out[k, i] += acc
+        cnt = t_hi - t_lo
+        for ii in range(cnt):
+            v[ii] = (y[t_lo + ii] - ct) * scale
+        for k in range(nk):
+            if not B[k].any():
+                continue
+            for ii in range(cnt):
+                acc[ii] = B[k, p - 1] * sign[p - 1]
+            for m in range(p - 2, -1, -1):
+                b = B[k, m] * sign[m]
+                for ii in range(cnt):
+                    acc[ii] = acc[ii] * v[ii] + b
+            for ii in range(cnt):
+                out[k, t_lo + ii] += acc[ii]
     return out
 
 
-def neighbour_count(y: np.ndarray, x: np.ndarray, radius: float) -> float:
-    """Mean number of sources within ``radius`` of a target (sorted inputs)."""
+def fgt_box_width(sigma: float) -> float:
+    """The largest k 2^e <= FGT_BOX_RATIO sigma with k in 4..7, so within 25 % of it: box
+    centres (b + 1/2) k 2^e and their offsets d k 2^e are exact in floating point."""
+    target = FGT_BOX_RATIO * sigma
+    e = math.floor(math.log2(target)) - 2  # 4 * 2^e <= target < 8 * 2^e
+    return max(k * 2.0**e for k in (4, 5, 6, 7) if k * 2.0**e <= target)
+
+
+def fgt_error_bound(ratio: float, p: int) -> float:
+    """Bound on |FGT - exact| per unit of summed |weights| in reach, for boxes ``ratio`` sigma
+    wide and p Hermite / Taylor terms.
+
+    In units where the kernel is exp(-(Y - X)^2), a source at X = c_s + u and a target at
+    Y = c_t + v (|u|, |v| <= a / 2, a = ratio / sqrt 2) interact through
+    exp(-(t + v - u)^2) = sum_{n,m} h_{n+m}(t) u^n (-v)^m / (n! m!) (h_k = Hermite functions,
+    t = c_t - c_s). With |h_k(t)| <= K 2^(k/2) sqrt(k!) exp(-t^2 / 2), K = 1.09 (Cramer's
+    inequality) and (n + m)! <= 2^(n+m) n! m!, a term is at most K a^n a^m / sqrt(n! m!),
+    so the terms dropped (n >= p or m >= p) sum to at most 2 K S(a) T_p(a), where
+    S(a) = sum_n a^n / sqrt(n!) and T_p(a) = a^p / sqrt(p!) / (1 - a / sqrt(p + 1)) bounds
+    the tail from p on (when a < sqrt(p + 1)).
+    """
+    a = ratio / math.sqrt(2.0)
+    if a >= math.sqrt(p + 1.0):
+        return math.inf
+    return 2.0 * 1.09 * _hermite_sum(a) * _tail(a, p)
+
+
+def _hermite_sum(a: float) -> float:
+    """S(a) = sum_n a^n / sqrt(n!), summed until the terms fall below 1e-20 of it."""
+    total, n = 0.0, 0
+    while True:
+        term = math.exp(n * math.log(a) - 0.5 * math.lgamma(n + 1.0))
+        total += term
+        if n > a * a and term < 1e-20 * total:
+            return total
+        n += 1
+
+
+def _tail(a: float, p: int) -> float:
+    """a^p / sqrt(p!) / (1 - a / sqrt(p + 1)) >= sum_{n >= p} a^n / sqrt(n!), a < sqrt(p + 1)."""
+    return math.exp(p * math.log(a) - 0.5 * math.lgamma(p + 1.0)) / (1.0 - a / math.sqrt(p + 1.0))
+
+
+def fgt_terms(ratio: float, tolerance: float) -> int:
+    """Fewest Hermite / Taylor terms p with fgt_error_bound(ratio, p) <= tolerance."""
+    if not ratio > 0:
+        raise ValueError(f"box width ratio must be > 0, got {ratio!r}")
+    a = ratio / math.sqrt(2.0)
+    scale = 2.0 * 1.09 * _hermite_sum(a)
+    p = max(1, math.floor(a * a))  # the tail bound needs a < sqrt(p + 1)
+    while scale * _tail(a, p) > tolerance:
+        p += 1
+    return p
+
+
+def neighbour_count(y: np.ndarray, x: np.ndarray, radius: float, samples: int | None = None) -> float:
+    """Mean number of sources within ``radius`` of a target (sorted inputs); over ``samples``
+    evenly spaced targets when given (an estimate, cheap for large N)."""
     if y.size == 0 or x.size == 0:
         return 0.0
+    if samples is not None and y.size > samples:
+        y = y[:: y.size // samples]
     hi = np.searchsorted(x, y + radius, side="right")
     lo = np.searchsorted(x, y - radius, side="left")
     return float(np.mean(hi - lo))
@@ -257,7 +384,7 @@ def choose_method(y, x, sigma, truncation) -> str:
     """Pick ``direct`` or ``fgt`` for this transform (see module docstring)."""
     if truncation is not None:
         return "direct"
-    if neighbour_count(y, x, CUTOFF_SIGMAS * sigma) <= DIRECT_MAX_NEIGHBOURS:
+    if neighbour_count(y, x, CUTOFF_SIGMAS * sigma, samples=512) <= DIRECT_MAX_NEIGHBOURS:
         return "direct"
     return "fgt"
 
@@ -270,6 +397,7 @@ def gauss_transform(
     truncation: float | None = None,
     method: str = "auto",
     skip_self: bool = False,
+    tolerance: float = FGT_TOLERANCE,
 ) -> np.ndarray:
     """Return out[k, i] = sum_j exp(-(y_i - x_j)^2 / (2 sigma^2)) q[k, j].
 
@@ -287,6 +415,9 @@ def gauss_transform(
         raise ValueError(f"weights have {q2.shape[1]} columns for {x.shape[0]} sources")
     if not (sigma > 0 and math.isfinite(sigma)):
         raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
+    if not FGT_TOLERANCE_RANGE[0] <= tolerance <= FGT_TOLERANCE_RANGE[1]:
+        raise ValueError(f"tolerance={tolerance!r} is not allowed: a number in "
+                         f"[{FGT_TOLERANCE_RANGE[0]:g}, {FGT_TOLERANCE_RANGE[1]:g}]")
     if method == "auto":
         method = choose_method(y, x, sigma, truncation)
     radius = (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
@@ -302,7 +433,8 @@ def gauss_transform(
         if x.size == 0 or y.size == 0:
             out = np.zeros((q2.shape[0], y.size))
         else:
-            out = _fgt(y, x, q2, float(sigma), float(radius), FGT_TERMS)
+            width = fgt_box_width(sigma)
+            out = _fgt(y, x, q2, float(sigma), float(radius), width, fgt_terms(width / sigma, tolerance))
     elif method == "taylor":
         if truncation is not None:
             raise ValueError("the taylor method evaluates the untruncated kernel only")

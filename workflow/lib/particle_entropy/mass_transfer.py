@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .gauss import gauss_transform
+from .gauss import FGT_TOLERANCE, choose_method, gauss_transform
 
 
 @dataclass(frozen=True)
@@ -48,14 +48,17 @@ def mass_transfer(
     beta: float,
     truncation: float | None = None,
     method: str = "auto",
+    tolerance: float = FGT_TOLERANCE,
 ) -> TransferResult:
     """One mass-transfer step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 19); x sorted."""
     if x.size < 2 or beta == 0.0:
         return TransferResult(m.copy(), 1, 0.0)
-    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method)
+    if method == "auto":  # one choice for all transforms of this step
+        method = choose_method(x, x, sigma, truncation)
+    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
     inv_r = 1.0 / r
     # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
-    W3 = gauss_transform(x, x, np.vstack([inv_r, m, m * inv_r]), sigma, truncation, method)
+    W3 = gauss_transform(x, x, np.vstack([inv_r, m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
     rowsum = 0.5 * (1.0 + W3[0])
     offdiag = rowsum - inv_r  # sum_{j != i} P_ij, since P_ii = W_ii / r_i = 1 / r_i
     c_max = float(beta * offdiag.max())
@@ -66,9 +69,11 @@ def mass_transfer(
     Wm, Wmr = W3[1], W3[2]
     for k in range(substeps):
         if k > 0:
-            Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method)
-        # sum_{j != i} W_ij q_j for q = m and q = m / r, as non-negative sums
-        s1 = Wm - m
-        s2 = Wmr - m * inv_r
+            Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
+        # sum_{j != i} W_ij q_j for q = m and q = m / r: sums of non-negative terms. The
+        # fast transform leaves them within its tolerance (1e-17 of the summed mass in reach
+        # by default), which can dip below 0 where all neighbours are empty; 0 is their bound.
+        s1 = np.maximum(Wm - m, 0.0)
+        s2 = np.maximum(Wmr - m * inv_r, 0.0)
         m = m * keep + b * 0.5 * (s1 * inv_r + s2)
     return TransferResult(m, substeps, c_max)

@@ -45,7 +45,7 @@ def step(cfg: RunConfig, x, m, dt: float, t_end: float, rng: np.random.Generator
         return x, m, sigma, 0.0, 1
     if cfg.scheme == "sequential":
         return x, sequential_transfer(x, m, sigma, beta, cfg.truncation, rng), sigma, beta, 1
-    res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method)
+    res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method, cfg.transfer_tolerance)
     return x, res.mass, sigma, beta, res.substeps
 
 

@@ -8,6 +8,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from .gauss import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
+
 METHODS = ("pt", "mtpt", "fd")
 KERNELS = {"pt": ("bins", "fixed", "adaptive"), "mtpt": ("collision", "sph"), "fd": ("implicit", "explicit")}
 DEFAULT_KERNEL = {"pt": "bins", "mtpt": "collision", "fd": "implicit"}
@@ -50,6 +52,7 @@ class RunConfig:
     fd_length: float = PAPER["fd_length"]
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = "auto"
+    transfer_tolerance: float = FGT_TOLERANCE  # FGT error <= this x sum of |weights| in reach
     scheme: str = "symmetric"  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
 
     def resolved(self) -> "RunConfig":
@@ -85,6 +88,7 @@ class RunConfig:
         check_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
+        check_range("transfer_tolerance", self.transfer_tolerance, *FGT_TOLERANCE_RANGE)
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2
