@@ -78,7 +78,7 @@ def sim_mem_mb(wildcards):
 
 def sim_runtime_min(wildcards):
     seeds = int(wildcards.last) - int(wildcards.first) + 1
-    return seeds * (2 if int(wildcards.n) <= 3000 else 20)
+    return seeds * (2 if int(wildcards.n) <= 3000 else 10)
 
 
 def first_step(wildcards):
