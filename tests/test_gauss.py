@@ -152,7 +152,7 @@ def test_other_documented_errors():
         gauss_transform(x, x, np.ones_like(x), 0.1, method="taylor", skip_self=True)
 
 
-@pytest.mark.parametrize("ratio", [0.5, 1.0, gauss.FGT_BOX_RATIO, 2.5])
+@pytest.mark.parametrize("ratio", [0.5, 1.0, 1.5, 2.5, 3.0])
 @pytest.mark.parametrize("density", [0.5, 30.0, 400.0])  # sources per sigma
 def test_fgt_box_widths_match_dense(rng, ratio, density):
     """Boxes from 0.5 to 2.5 sigma wide, with their default term count, are exact to 1e-12,
@@ -209,6 +209,19 @@ def test_fgt_tolerance_bounds_the_error(rng, sigma):
         assert np.all(err <= tolerance * near + CUT * np.abs(q).sum(axis=-1, keepdims=True))
         worst.append(err.max())
     assert worst[0] > worst[2]
+
+
+def test_fgt_plan_narrow_boxes_for_dense_sources_wide_for_sparse():
+    """Many sources per sigma: per-particle terms dominate, so narrow boxes (fewer terms);
+    few per sigma: translations dominate, so wide boxes. Widths are exact k 2^e."""
+    x = np.linspace(-5.0, 5.0, 30000)  # 1300 sources per sigma = 0.44, 19 per sigma = 0.0063
+    w_dense, p_dense = gauss.fgt_plan(x, x, 0.44, CUTOFF_SIGMAS * 0.44, 1)
+    w_sparse, p_sparse = gauss.fgt_plan(x, x, 0.0063, CUTOFF_SIGMAS * 0.0063, 1)
+    assert w_dense / 0.44 < w_sparse / 0.0063 and p_dense < p_sparse
+    for w in (w_dense, w_sparse):
+        mantissa = w / 2.0 ** math.floor(math.log2(w) - 2)
+        assert mantissa in (4.0, 5.0, 6.0, 7.0)
+    assert gauss.fgt_error_bound(w_dense / 0.44, p_dense) <= gauss.FGT_TOLERANCE
 
 
 @pytest.mark.parametrize("tolerance", [0.0, -1e-10, 0.5, math.nan])

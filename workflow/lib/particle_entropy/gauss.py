@@ -8,7 +8,7 @@ share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
   Used for truncated kernels (exactly the pairs with |y - x| <= truncation * sigma) and
   whenever the neighbour count is small (``auto`` below ``DIRECT_MAX_NEIGHBOURS``).
 * ``fgt``: fast Gauss transform, the ``auto`` choice at large neighbour counts. Source
-  boxes ``FGT_BOX_RATIO`` sigma wide carry p Hermite moments, translated to Taylor
+  boxes 1 to 2.5 sigma wide (``fgt_plan``) carry p Hermite moments, translated to Taylor
   expansions about each target box (one table of Hermite functions per box offset);
   sparse box pairs are summed exactly. p is the fewest terms whose Greengard-Strain error
   bound is below ``tolerance`` (default ``FGT_TOLERANCE`` = 1e-17 of the summed |weights|,
@@ -24,6 +24,7 @@ i.e. below double-precision resolution of the self term (which is 1).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -33,10 +34,11 @@ CUTOFF_SIGMAS = 9.0
 P_TERMS = 24
 FGT_TOLERANCE = 1e-17
 FGT_TOLERANCE_RANGE = (1e-30, 0.1)
-# Box width of the fast Gauss transform in sigma: wide boxes mean fewer translations (each
-# p^2) but more terms p. Measured (benchmarks/bench_transfer.py --boxes): 2.5 is fastest or
-# within 25 % of it from 7 to 1000 sources per sigma, for one and for three weight vectors.
-FGT_BOX_RATIO = 2.5
+# Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
+# mean fewer translations (each p^2) but more terms p. A translation's term pair costs about a
+# quarter of a particle's term (vectorised inner loop; benchmarks/bench_transfer.py --boxes).
+FGT_BOX_RATIOS = (1.0, 1.5, 2.5)
+FGT_TRANSLATION_COST = 0.25
 # The fast Gauss transform wins once a target sees more sources than this within the
 # cut-off, about 7 per sigma (measured crossover, benchmarks/bench_transfer.py --boxes).
 DIRECT_MAX_NEIGHBOURS = 120.0
@@ -313,12 +315,36 @@ def _fgt(y, x, q, sigma, radius, width, p):
     return out
 
 
-def fgt_box_width(sigma: float) -> float:
-    """The largest k 2^e <= FGT_BOX_RATIO sigma with k in 4..7, so within 25 % of it: box
-    centres (b + 1/2) k 2^e and their offsets d k 2^e are exact in floating point."""
-    target = FGT_BOX_RATIO * sigma
+def fgt_box_width(sigma: float, ratio: float) -> float:
+    """The largest k 2^e <= ratio sigma with k in 4..7, so within 25 % of it: box centres
+    (b + 1/2) k 2^e and their offsets d k 2^e are exact in floating point."""
+    target = ratio * sigma
     e = math.floor(math.log2(target)) - 2  # 4 * 2^e <= target < 8 * 2^e
     return max(k * 2.0**e for k in (4, 5, 6, 7) if k * 2.0**e <= target)
+
+
+def fgt_plan(y, x, sigma, radius, nk, tolerance=FGT_TOLERANCE) -> tuple[float, int]:
+    """(box width, terms) of the FGT with the least modelled work: N p per weight vector
+    for moments and evaluation against target boxes x boxes in reach x p^2 translations
+    (FGT_TRANSLATION_COST per term pair, measured). Dense particles favour narrow boxes
+    (fewer terms), sparse ones wide boxes (fewer translations)."""
+    span = max(x[-1], y[-1]) - min(x[0], y[0])
+    best = None
+    for ratio in FGT_BOX_RATIOS:
+        width = fgt_box_width(sigma, ratio)
+        p = fgt_terms(_ratio_ceiling(width / sigma), tolerance)
+        boxes = min(float(y.size), span / width + 1.0)
+        reach = 2 * (math.ceil(radius / width) + 1) + 1
+        work = nk * ((x.size + y.size) * p + FGT_TRANSLATION_COST * boxes * reach * p * p)
+        if best is None or work < best[0]:
+            best = (work, width, p)
+    return best[1], best[2]
+
+
+def _ratio_ceiling(ratio: float) -> float:
+    """ratio rounded up to 1/64: the bound grows with the ratio, so terms for the rounded
+    ratio are safe, and fgt_terms is cached on few distinct values."""
+    return math.ceil(ratio * 64.0) / 64.0
 
 
 def fgt_error_bound(ratio: float, p: int) -> float:
@@ -356,6 +382,7 @@ def _tail(a: float, p: int) -> float:
     return math.exp(p * math.log(a) - 0.5 * math.lgamma(p + 1.0)) / (1.0 - a / math.sqrt(p + 1.0))
 
 
+@functools.lru_cache(maxsize=4096)
 def fgt_terms(ratio: float, tolerance: float) -> int:
     """Fewest Hermite / Taylor terms p with fgt_error_bound(ratio, p) <= tolerance."""
     if not ratio > 0:
@@ -433,8 +460,8 @@ def gauss_transform(
         if x.size == 0 or y.size == 0:
             out = np.zeros((q2.shape[0], y.size))
         else:
-            width = fgt_box_width(sigma)
-            out = _fgt(y, x, q2, float(sigma), float(radius), width, fgt_terms(width / sigma, tolerance))
+            width, p = fgt_plan(y, x, sigma, radius, q2.shape[0], tolerance)
+            out = _fgt(y, x, q2, float(sigma), float(radius), width, p)
     elif method == "taylor":
         if truncation is not None:
             raise ValueError("the taylor method evaluates the untruncated kernel only")
