@@ -2,6 +2,9 @@
 
 
 rule summarise_case:
+    """Averages the realisations of one case, step by step. A `run:` block: with the default
+    profile (force-use-threads) it runs inside the Snakemake process, saving a Python
+    start-up (~1 s of CPU) for each of the ~90 summaries."""
     input:
         summary_runs,
     output:
@@ -10,10 +13,9 @@ rule summarise_case:
         "logs/summarise_case/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{nreal}.log",
     resources:
         mem_mb=500,
-    conda:
-        "../../envs/particle-entropy.yaml"
-    script:
-        "../scripts/summarise_case.py"
+    run:
+        count = summarise_files(list(input), output[0])
+        Path(log[0]).write_text(f"summarised {count} realisations\n")
 
 
 rule comic_tables:

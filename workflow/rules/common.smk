@@ -9,6 +9,7 @@ from snakemake.utils import validate
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
 validate(config, str(Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
 
+from particle_entropy.aggregate import summarise_files  # noqa: E402
 from particle_entropy.sweeps import (  # noqa: E402
     spec_cases,
     case_runs,

@@ -21,6 +21,17 @@ SUMMARY_COLUMNS = {
 }
 
 
+def summarise_files(paths: list[str], out: str) -> int:
+    """Summarise the run tables ``paths`` (blocks of seeds of one case) into ``out``; returns
+    the number of realisations."""
+    from .io import write_parquet
+
+    blocks = pd.concat([pd.read_parquet(p) for p in paths], ignore_index=True)
+    runs = [g for _, g in blocks.groupby("seed", sort=True)]
+    write_parquet(summarise_runs(runs), out)
+    return len(runs)
+
+
 def summarise_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
     """Per-step ensemble mean and standard deviation of every metric over realisations of one case."""
     if not runs:
