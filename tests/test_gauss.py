@@ -229,3 +229,21 @@ def test_bad_tolerance_raises(tolerance):
     x = np.linspace(-1, 1, 20)
     with pytest.raises(ValueError, match="tolerance"):
         gauss_transform(x, x, np.ones_like(x), 0.1, method="fgt", tolerance=tolerance)
+
+
+def test_inline_exp_matches_libm_to_an_ulp():
+    """The windowed sums' exp(-a) (vectorisable polynomial) against numpy's exp."""
+    from numba import njit
+
+    @njit
+    def evaluate(a):
+        out = np.empty_like(a)
+        for i in range(a.size):
+            out[i] = gauss._exp_neg(a[i])
+        return out
+
+    a = np.concatenate([np.linspace(0.0, 50.0, 200001), np.linspace(50.0, 760.0, 20001)])
+    got, ref = evaluate(a), np.exp(-a)
+    normal = ref > np.finfo(float).tiny
+    assert np.all(np.abs(got[normal] - ref[normal]) <= 2.3e-16 * ref[normal])
+    assert np.all(got[a > 746.0] == 0.0) and got[0] == 1.0

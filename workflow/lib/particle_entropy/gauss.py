@@ -35,20 +35,47 @@ P_TERMS = 24
 FGT_TOLERANCE = 1e-17
 FGT_TOLERANCE_RANGE = (1e-30, 0.1)
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
-# mean fewer translations (each p^2) but more terms p. A translation's term pair costs about a
-# quarter of a particle's term (vectorised inner loop; benchmarks/bench_transfer.py --boxes).
+# mean fewer translations (each p^2) but more terms p. A translation's term pair costs about
+# as much as a particle's term (benchmarks/bench_transfer.py --boxes).
 FGT_BOX_RATIOS = (1.0, 1.5, 2.5)
-FGT_TRANSLATION_COST = 0.25
+FGT_TRANSLATION_COST = 1.0
 # The fast Gauss transform wins once a target sees more sources than this within the
-# cut-off, about 7 per sigma (measured crossover, benchmarks/bench_transfer.py --boxes).
-DIRECT_MAX_NEIGHBOURS = 120.0
+# cut-off, about 11 per sigma (measured crossover, benchmarks/bench_transfer.py --boxes).
+DIRECT_MAX_NEIGHBOURS = 200.0
 
 
-@njit(cache=True)
+# exp(-a) for the windowed sums, 0 <= a: inline arithmetic that compilers vectorise (a libm
+# call per pair does not). 2^-k from a table, e^r by a degree-13 Taylor polynomial on
+# |r| <= ln(2) / 2 (truncation < 5e-18 relative), ln 2 split in two for exact reduction.
+_LN2_HI = 0.693147180369123816490  # 32 significant bits: k * _LN2_HI is exact
+_LN2_LO = 1.90821492927058770002e-10
+_INV_LN2 = 1.4426950408889634
+_EXP_MAX_K = 1100  # beyond this exp(-a) is 0 in double precision
+_POW2_NEG = np.array([2.0**-k for k in range(_EXP_MAX_K + 1)])
+
+
+@njit(cache=True, inline="always")
+def _exp_neg(a):
+    """exp(-a) for a >= 0, to about 1 ulp."""
+    k = min(int(a * _INV_LN2 + 0.5), _EXP_MAX_K)  # 2^-_EXP_MAX_K is 0.0: exp underflows
+    r = (k * _LN2_HI - a) + k * _LN2_LO  # -a + k ln 2, |r| <= ln(2) / 2
+    return _taylor_exp13(r) * _POW2_NEG[k]
+
+
+@njit(cache=True, inline="always")
+def _taylor_exp13(r):
+    """sum_(n <= 13) r^n / n! (Horner, literal coefficients so the loop vectorises)."""
+    return (((((((((((((1.6059043836821613e-10) * r + 2.08767569878681e-09) * r + 2.505210838544172e-08) * r + 2.755731922398589e-07) * r + 2.7557319223985893e-06) * r + 2.48015873015873e-05) * r + 0.0001984126984126984) * r + 0.001388888888888889) * r + 0.008333333333333333) * r + 0.041666666666666664) * r + 0.16666666666666666) * r + 0.5) * r + 1.0) * r + 1.0
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
 def _direct(y, x, q, sigma, radius, skip_self):
+    """Windowed sum over sorted sources; the window's weights go to a buffer first, so the
+    exp and the sums vectorise."""
     nk, ns = q.shape
     nt = y.shape[0]
     out = np.zeros((nk, nt))
+    buf = np.empty(ns)
     inv2s2 = 0.5 / (sigma * sigma)
     lo = 0
     hi = 0
@@ -61,33 +88,45 @@ def _direct(y, x, q, sigma, radius, skip_self):
         while hi < ns and x[hi] <= yi + radius:
             hi += 1
         for j in range(lo, hi):
-            if skip_self and j == i:
-                continue
             d = yi - x[j]
-            w = math.exp(-d * d * inv2s2)
-            for k in range(nk):
-                out[k, i] += w * q[k, j]
+            buf[j - lo] = _exp_neg(d * d * inv2s2)
+        if skip_self and lo <= i < hi:
+            buf[i - lo] = 0.0
+        for k in range(nk):
+            acc = 0.0
+            for j in range(lo, hi):
+                acc += buf[j - lo] * q[k, j]
+            out[k, i] = acc
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"reassoc", "contract"})
 def _direct_symmetric(x, q, sigma, radius):
-    """Windowed sum with targets = sources: each pair's exp is evaluated once."""
+    """Windowed sum with targets = sources: each pair's exp is evaluated once (into a
+    buffer, so that the exp and the sums vectorise over a window)."""
     nk, n = q.shape
     out = q.copy()  # self terms, W_ii = 1
     inv2s2 = 0.5 / (sigma * sigma)
+    buf = np.empty(n)
     hi = 0
     for i in range(n):
         if hi < i + 1:
             hi = i + 1
         while hi < n and x[hi] <= x[i] + radius:
             hi += 1
-        for j in range(i + 1, hi):
-            d = x[i] - x[j]
-            w = math.exp(-d * d * inv2s2)
-            for k in range(nk):
-                out[k, i] += w * q[k, j]
-                out[k, j] += w * q[k, i]
+        lo = i + 1
+        xi = x[i]
+        for j in range(lo, hi):
+            d = xi - x[j]
+            buf[j - lo] = _exp_neg(d * d * inv2s2)
+        for k in range(nk):
+            qi = q[k, i]
+            acc = 0.0
+            for j in range(lo, hi):
+                w = buf[j - lo]
+                acc += w * q[k, j]
+                out[k, j] += w * qi
+            out[k, i] += acc
     return out
 
 
@@ -285,7 +324,7 @@ def _fgt(y, x, q, sigma, radius, width, p):
                 for i in range(t_lo, t_hi):
                     for j in range(s_lo, s_hi):
                         d = (y[i] - x[j]) * scale
-                        g = math.exp(-d * d)
+                        g = _exp_neg(d * d)
                         for k in range(nk):
                             out[k, i] += g * q[k, j]
             else:

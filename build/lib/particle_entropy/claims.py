@@ -1,0 +1,127 @@
+"""The paper's quantitative claims next to the reproduced values, each judged pass or fail."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+
+def _near(df: pd.DataFrame, t: float) -> pd.Series:
+    return df.iloc[int(np.argmin(np.abs(df["time"].to_numpy() - t)))]
+
+
+def _pick(tables, **case):
+    for df in tables:
+        first = df.iloc[0]
+        if all(first[k] == v for k, v in case.items()):
+            return df
+    raise KeyError(f"no table for case {case}")
+
+
+def _claim(claim, paper, reproduced, tolerance, passed):
+    return {"claim": claim, "paper": paper, "reproduced": reproduced, "tolerance": tolerance, "passed": bool(passed)}
+
+
+EARLY = (0.1, 10.0)  # "early times": after the settling time of N >= 300, well before t = 1000
+
+
+def _early_gap(run: pd.DataFrame) -> float:
+    """Mean H_C - analytic H_C over the early window."""
+    w = run[(run["time"] >= EARLY[0]) & (run["time"] <= EARLY[1])]
+    return float((w["H_C"] - w["H_C_analytic"]).mean())
+
+
+def single_run_claims(runs: list[pd.DataFrame]) -> list[dict]:
+    """Claims read off the single realisations of Figs. 1-2."""
+    out = []
+    for n in sorted({int(r["n"].iloc[0]) for r in runs}):
+        pt = _pick(runs, method="pt", kernel="bins", n=n)
+        mt = _pick(runs, method="mtpt", kernel="collision", n=n)
+        fx = _pick(runs, method="pt", kernel="fixed", n=n)
+        out.append(_claim(f"classical PT has H_D = ln N at t = 0 (N={n})", f"{math.log(n):.6f}",
+                          f"{pt['H_D'].iloc[0]:.6f}", "1e-12", abs(pt["H_D"].iloc[0] - math.log(n)) < 1e-12))
+        out.append(_claim(f"MTPT represents the delta exactly, H_D(0) = 0 (N={n})", "0",
+                          f"{mt['H_D'].iloc[0]:.3g}", "exact", mt["H_D"].iloc[0] == 0.0))
+        early, late = _near(pt, 1.0), _near(pt, 1000.0)
+        e_err, l_err = abs(early.H_C - early.H_C_analytic), abs(late.H_C - late.H_C_analytic)
+        out.append(_claim(f"binned PT matches H_C early, diverges late (N={n})", "error(t=1000) > error(t=1)",
+                          f"|dH_C| {e_err:.3f} at t=1, {l_err:.3f} at t=1000", "late > early", l_err > e_err))
+        d_fx, d_mt = _early_gap(fx), _early_gap(mt)
+        out.append(_claim(f"fixed-kernel PT over-estimates early mixing (N={n})", f"H_C > analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
+                          f"mean {d_fx:+.3f} nats", "> 0", d_fx > 0))
+        out.append(_claim(f"MTPT collision under-estimates early entropy (N={n})", f"H_C < analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
+                          f"mean {d_mt:+.3f} nats", "< 0", d_mt < 0))
+    ns = sorted({int(r["n"].iloc[0]) for r in runs})
+    if len(ns) >= 2:
+        errs = {n: abs(_near(_pick(runs, method="mtpt", kernel="collision", n=n), 10.0).pipe(lambda r: r.E / r.E_analytic - 1)) for n in ns}
+        out.append(_claim("MTPT collision converges faster for larger N", "relative E error at t = 10 falls with N",
+                          ", ".join(f"N={n}: {errs[n]:.3f}" for n in ns), "monotone", errs[ns[-1]] < errs[ns[0]]))
+    return out
+
+
+def ensemble_claims(summaries: list[pd.DataFrame], tol_hc: float) -> list[dict]:
+    """Claims of Figs. 3 and 5 from ensemble means."""
+    out = []
+    for s in summaries:
+        r = s.iloc[0]
+        if r["method"] == "pt" and r["kernel"] == "adaptive":
+            last = _near(s, 1000.0)
+            d = last.H_C_mean - last.H_C_analytic
+            out.append(_claim(f"adaptive-kernel PT matches analytic H_C (N={int(r['n'])})", "close at t = 1000",
+                              f"{d:+.4f} nats ({int(last.n_realisations)} realisations)", f"{tol_hc} nats",
+                              abs(d) <= tol_hc))
+    ns = sorted({int(s["n"].iloc[0]) for s in summaries if s["method"].iloc[0] == "mtpt"})
+    for n in ns:
+        try:
+            change = {}
+            for k in ("collision", "sph"):
+                e1 = _near(_pick(summaries, method="mtpt", kernel=k, n=n, eta=1.0), 1000.0).E_mean
+                e01 = _near(_pick(summaries, method="mtpt", kernel=k, n=n, eta=0.1), 1000.0).E_mean
+                change[k] = abs(math.log(e01 / e1))
+        except KeyError:
+            continue
+        out.append(_claim(f"eta = 0.1 changes collision little, SPH much (N={n})", "|d ln E| sph > collision",
+                          f"collision {change['collision']:.3f}, sph {change['sph']:.3f}", "sph > 2 x collision",
+                          change["sph"] > 2 * change["collision"]))
+    return out
+
+
+def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[dict]:
+    """COMIC optima of FD (Fig. 8) and the three MTPT models (Fig. 9)."""
+    out = []
+    fd = minima[minima["model"] == "fd"]
+    if len(fd):
+        lo, hi = tol["fd_optimum_nodes"]
+        inside = ((fd["n_opt"] >= lo) & (fd["n_opt"] <= hi))
+        out.append(_claim("FD: COMIC minimal near 3000 nodes at almost every time", "~3000",
+                          ", ".join(f"t={t:g}: {n}" for t, n in zip(fd["time"], fd["n_opt"])),
+                          f"N_opt in [{lo}, {hi}]", inside.mean() >= 0.5))
+    final = minima[minima["time"] == minima["time"].max()]
+    for model, key, paper in [("mtpt collision eta=1", "collision_eta1_optimum", "~3000 (1000-10,000)"),
+                              ("mtpt collision eta=0.5", "collision_eta05_optimum", "~300")]:
+        row = final[final["model"] == model]
+        if len(row):
+            lo, hi = tol[key]
+            for col, how in [("n_opt", "mean of COMIC"), ("n_opt_of_mean_SSE", "COMIC of mean SSE")]:
+                n_opt = int(row[col].iloc[0])
+                out.append(_claim(f"{model}: COMIC minimum at t = {row['time'].iloc[0]:g} ({how})", paper, str(n_opt),
+                                  f"[{lo}, {hi}]", lo <= n_opt <= hi))
+    sph = comic[(comic["model"] == "mtpt sph eta=1") & (comic["time"] == comic["time"].max())]
+    if len(sph):
+        big = sph[sph["n"] >= 100]["COMIC_mean"]
+        spread = float(big.max() - big.min())
+        out.append(_claim("mtpt sph eta=1: COMIC roughly flat for N >= 100", "flat", f"spread {spread:.2f} nats",
+                          f"<= {tol['sph_flat_max_spread']}", spread <= tol["sph_flat_max_spread"]))
+    return out
+
+
+def to_markdown(claims: pd.DataFrame) -> str:
+    """A referee-friendly table of the claims."""
+    lines = ["# Paper claims: reproduced values", "",
+             f"{int(claims['passed'].sum())} of {len(claims)} claims pass.", "",
+             "| claim | paper | reproduced | tolerance | result |", "|---|---|---|---|---|"]
+    for _, c in claims.iterrows():
+        lines.append(f"| {c.claim} | {c.paper} | {c.reproduced} | {c.tolerance} | {'pass' if c.passed else 'FAIL'} |")
+    return "\n".join(lines) + "\n"

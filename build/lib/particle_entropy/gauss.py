@@ -1,0 +1,477 @@
+"""Discrete Gauss transforms in 1-D: out[k, i] = sum_j exp(-(y_i - x_j)^2 / (2 sigma^2)) q[k, j].
+
+These sums are the only O(N^2)-looking work of the project (MTPT transfer weights,
+Eqs. 17 and 21, and kernel reconstructions, Eq. 10). Three methods, exact to round-off,
+share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
+
+* ``direct``: windowed sum over sorted sources, O(N x neighbours) time, O(N) memory.
+  Used for truncated kernels (exactly the pairs with |y - x| <= truncation * sigma) and
+  whenever the neighbour count is small (``auto`` below ``DIRECT_MAX_NEIGHBOURS``).
+* ``fgt``: fast Gauss transform, the ``auto`` choice at large neighbour counts. Source
+  boxes 1 to 2.5 sigma wide (``fgt_plan``) carry p Hermite moments, translated to Taylor
+  expansions about each target box (one table of Hermite functions per box offset);
+  sparse box pairs are summed exactly. p is the fewest terms whose Greengard-Strain error
+  bound is below ``tolerance`` (default ``FGT_TOLERANCE`` = 1e-17 of the summed |weights|,
+  i.e. round-off: the transform stays symmetric and MTPT conserves mass to round-off).
+  O(N p) time plus O(boxes x p^2).
+* ``taylor``: per-target evaluation of each source box's Taylor moments of exp(u v);
+  O(N x P_TERMS x boxes-in-range), kept as an independent cross-check of ``fgt``.
+
+For the untruncated Gaussian all methods drop pairs farther apart than
+``CUTOFF_SIGMAS`` sigma, where the kernel is below exp(-CUTOFF_SIGMAS^2 / 2) = 2.6e-18,
+i.e. below double-precision resolution of the self term (which is 1).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from numba import njit
+
+CUTOFF_SIGMAS = 9.0
+P_TERMS = 24
+FGT_TOLERANCE = 1e-17
+FGT_TOLERANCE_RANGE = (1e-30, 0.1)
+# Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
+# mean fewer translations (each p^2) but more terms p. A translation's term pair costs about a
+# quarter of a particle's term (vectorised inner loop; benchmarks/bench_transfer.py --boxes).
+FGT_BOX_RATIOS = (1.0, 1.5, 2.5)
+FGT_TRANSLATION_COST = 0.25
+# The fast Gauss transform wins once a target sees more sources than this within the
+# cut-off, about 7 per sigma (measured crossover, benchmarks/bench_transfer.py --boxes).
+DIRECT_MAX_NEIGHBOURS = 120.0
+
+
+@njit(cache=True)
+def _direct(y, x, q, sigma, radius, skip_self):
+    nk, ns = q.shape
+    nt = y.shape[0]
+    out = np.zeros((nk, nt))
+    inv2s2 = 0.5 / (sigma * sigma)
+    lo = 0
+    hi = 0
+    for i in range(nt):
+        yi = y[i]
+        while lo < ns and x[lo] < yi - radius:
+            lo += 1
+        if hi < lo:
+            hi = lo
+        while hi < ns and x[hi] <= yi + radius:
+            hi += 1
+        for j in range(lo, hi):
+            if skip_self and j == i:
+                continue
+            d = yi - x[j]
+            w = math.exp(-d * d * inv2s2)
+            for k in range(nk):
+                out[k, i] += w * q[k, j]
+    return out
+
+
+@njit(cache=True)
+def _direct_symmetric(x, q, sigma, radius):
+    """Windowed sum with targets = sources: each pair's exp is evaluated once."""
+    nk, n = q.shape
+    out = q.copy()  # self terms, W_ii = 1
+    inv2s2 = 0.5 / (sigma * sigma)
+    hi = 0
+    for i in range(n):
+        if hi < i + 1:
+            hi = i + 1
+        while hi < n and x[hi] <= x[i] + radius:
+            hi += 1
+        for j in range(i + 1, hi):
+            d = x[i] - x[j]
+            w = math.exp(-d * d * inv2s2)
+            for k in range(nk):
+                out[k, i] += w * q[k, j]
+                out[k, j] += w * q[k, i]
+    return out
+
+
+@njit(cache=True)
+def _taylor_moments(x, q, sigma, x0, p):
+    """Box ids, box centres and Taylor moments A[b, n, k] of sorted sources."""
+    nk, ns = q.shape
+    ids = np.empty(ns, np.int64)
+    for j in range(ns):
+        ids[j] = int(math.floor((x[j] - x0) / sigma))
+    # unique (sorted) box ids
+    nb = 0
+    for j in range(ns):
+        if j == 0 or ids[j] != ids[j - 1]:
+            nb += 1
+    centres = np.empty(nb)
+    A = np.zeros((nb, p, nk))
+    b = -1
+    inv_fact = np.empty(p)
+    inv_fact[0] = 1.0
+    for n in range(1, p):
+        inv_fact[n] = inv_fact[n - 1] / n
+    for j in range(ns):
+        if j == 0 or ids[j] != ids[j - 1]:
+            b += 1
+            centres[b] = x0 + (ids[j] + 0.5) * sigma
+        u = (x[j] - centres[b]) / sigma
+        g = math.exp(-0.5 * u * u)
+        un = 1.0
+        for n in range(p):
+            c = g * un * inv_fact[n]
+            for k in range(nk):
+                A[b, n, k] += c * q[k, j]
+            un *= u
+    return centres, A
+
+
+@njit(cache=True)
+def _taylor_eval(y, centres, A, sigma, radius):
+    nb, p, nk = A.shape
+    nt = y.shape[0]
+    out = np.zeros((nk, nt))
+    reach = radius + 0.5 * sigma
+    lo = 0
+    hi = 0
+    acc = np.empty(nk)
+    for i in range(nt):
+        yi = y[i]
+        while lo < nb and centres[lo] < yi - reach:
+            lo += 1
+        if hi < lo:
+            hi = lo
+        while hi < nb and centres[hi] <= yi + reach:
+            hi += 1
+        for b in range(lo, hi):
+            v = (yi - centres[b]) / sigma
+            for k in range(nk):
+                acc[k] = A[b, p - 1, k]
+            for n in range(p - 2, -1, -1):
+                for k in range(nk):
+                    acc[k] = acc[k] * v + A[b, n, k]
+            g = math.exp(-0.5 * v * v)
+            for k in range(nk):
+                out[k, i] += g * acc[k]
+    return out
+
+
+@njit(cache=True)
+def _boxes(z, origin, width):
+    """Consecutive-box partition of sorted z: (box start indices incl. end, integer box ids)."""
+    n = z.shape[0]
+    starts = np.empty(n + 1, np.int64)
+    ids = np.empty(n, np.int64)
+    nb = 0
+    prev = -(2**62)
+    for j in range(n):
+        b = int(math.floor((z[j] - origin) / width))
+        if b != prev:
+            starts[nb] = j
+            ids[nb] = b
+            nb += 1
+            prev = b
+    starts[nb] = n
+    return starts[: nb + 1], ids[:nb]
+
+
+@njit(cache=True)
+def _hermite_table(kmax, step, p):
+    """h_n(t) = exp(-t^2) H_n(t), n < 2p, at t = d * step for box offsets d = -kmax .. kmax."""
+    H = np.empty((2 * kmax + 1, 2 * p))
+    for d in range(-kmax, kmax + 1):
+        t = d * step
+        row = H[d + kmax]
+        row[0] = math.exp(-t * t)
+        row[1] = 2.0 * t * row[0]
+        for n in range(1, 2 * p - 1):
+            row[n + 1] = 2.0 * t * row[n] - 2.0 * n * row[n - 1]
+    return H
+
+
+@njit(cache=True, fastmath={"reassoc", "contract"})
+def _hermite_moments(x, q, starts, ids, origin, width, scale, p):
+    """A[b, k, n] = sum_{j in box b} q_kj u_j^n / n!, u_j = (x_j - c_b) scale (Hermite moments)."""
+    nk = q.shape[0]
+    nb = ids.shape[0]
+    A = np.zeros((nb, nk, p))
+    inv = np.empty(p)
+    for n in range(p):
+        inv[n] = 1.0 / (n + 1)
+    maxc = 0
+    for b in range(nb):
+        maxc = max(maxc, starts[b + 1] - starts[b])
+    u = np.empty(maxc)
+    c = np.empty(maxc)
+    for b in range(nb):
+        lo = starts[b]
+        cnt = starts[b + 1] - lo
+        centre = origin + (ids[b] + 0.5) * width
+        for jj in range(cnt):
+            u[jj] = (x[lo + jj] - centre) * scale
+        for k in range(nk):
+            for jj in range(cnt):
+                c[jj] = q[k, lo + jj]
+            for n in range(p):
+                s = 0.0
+                for jj in range(cnt):
+                    s += c[jj]
+                A[b, k, n] = s
+                for jj in range(cnt):
+                    c[jj] *= u[jj] * inv[n]
+    return A
+
+
+@njit(cache=True)
+def _empty_boxes(q, starts):
+    """empty[b, k]: every weight q_kj of box b is zero."""
+    nk = q.shape[0]
+    nb = starts.shape[0] - 1
+    empty = np.ones((nb, nk), np.bool_)
+    for b in range(nb):
+        for k in range(nk):
+            for j in range(starts[b], starts[b + 1]):
+                if q[k, j] != 0.0:
+                    empty[b, k] = False
+                    break
+    return empty
+
+
+@njit(cache=True)
+def _fgt(y, x, q, sigma, radius, width, p):
+    """Fast Gauss transform (Greengard-Strain): Hermite moments of source boxes translated to
+    Taylor coefficients about target-box centres; boxes ``width`` (see fgt_box_width) wide on one
+    grid, so a translation depends only on the box offset and is tabulated once."""
+    nk = q.shape[0]
+    scale = 1.0 / (math.sqrt(2.0) * sigma)  # kernel = exp(-(Y - X)^2) in scaled units
+    # Box geometry is exact: width is k 2^e with a small integer k and origin a multiple of
+    # it, so every centre (b + 1/2) width is a float and centre offsets are exactly d * width. The Hermite
+    # table therefore matches the centres used for moments and evaluation, even when
+    # sigma << |x| (the offsets x - c and y - c are taken in the original units).
+    origin = math.floor(min(x[0], y[0]) / width) * width
+    s_starts, s_ids = _boxes(x, origin, width)
+    t_starts, t_ids = _boxes(y, origin, width)
+    kmax = int(math.ceil(radius / width)) + 1  # |y - x| <= radius needs |box offset| <= kmax
+    H = _hermite_table(kmax, width * scale, p)
+    A = _hermite_moments(x, q, s_starts, s_ids, origin, width, scale, p)
+    empty = _empty_boxes(q, s_starts)
+    sign = np.empty(p)  # Taylor coefficients carry (-1)^m / m!
+    sign[0] = 1.0
+    for m in range(1, p):
+        sign[m] = -sign[m - 1] / m
+    nbs = s_ids.shape[0]
+    out = np.zeros((nk, y.shape[0]))
+    B = np.empty((nk, p))
+    maxc = 0
+    for tb in range(t_ids.shape[0]):
+        maxc = max(maxc, t_starts[tb + 1] - t_starts[tb])
+    v = np.empty(maxc)
+    acc = np.empty(maxc)
+    lo = 0
+    for tb in range(t_ids.shape[0]):
+        bt = t_ids[tb]
+        while lo < nbs and s_ids[lo] < bt - kmax:
+            lo += 1
+        t_lo, t_hi = t_starts[tb], t_starts[tb + 1]
+        ct = origin + (bt + 0.5) * width
+        B[:, :] = 0.0
+        sb = lo
+        while sb < nbs and s_ids[sb] <= bt + kmax:
+            s_lo, s_hi = s_starts[sb], s_starts[sb + 1]
+            if empty[sb].all():
+                sb += 1
+                continue
+            if (s_hi - s_lo) * (t_hi - t_lo) * (30 + nk) <= p * p * nk:
+                # sparse box pair: the exact pairwise sum is cheaper than a translation
+                for i in range(t_lo, t_hi):
+                    for j in range(s_lo, s_hi):
+                        d = (y[i] - x[j]) * scale
+                        g = math.exp(-d * d)
+                        for k in range(nk):
+                            out[k, i] += g * q[k, j]
+            else:
+                h = H[bt - s_ids[sb] + kmax]
+                for k in range(nk):
+                    if empty[sb, k]:
+                        continue  # all weights zero (empty particles at early MTPT times)
+                    for n in range(p):
+                        a = A[sb, k, n]
+                        for m in range(p):
+                            B[k, m] += a * h[n + m]
+            sb += 1
+        cnt = t_hi - t_lo
+        for ii in range(cnt):
+            v[ii] = (y[t_lo + ii] - ct) * scale
+        for k in range(nk):
+            if not B[k].any():
+                continue
+            for ii in range(cnt):
+                acc[ii] = B[k, p - 1] * sign[p - 1]
+            for m in range(p - 2, -1, -1):
+                b = B[k, m] * sign[m]
+                for ii in range(cnt):
+                    acc[ii] = acc[ii] * v[ii] + b
+            for ii in range(cnt):
+                out[k, t_lo + ii] += acc[ii]
+    return out
+
+
+def fgt_box_width(sigma: float, ratio: float) -> float:
+    """The largest k 2^e <= ratio sigma with k in 4..7, so within 25 % of it: box centres
+    (b + 1/2) k 2^e and their offsets d k 2^e are exact in floating point."""
+    target = ratio * sigma
+    e = math.floor(math.log2(target)) - 2  # 4 * 2^e <= target < 8 * 2^e
+    return max(k * 2.0**e for k in (4, 5, 6, 7) if k * 2.0**e <= target)
+
+
+def fgt_plan(y, x, sigma, radius, nk, tolerance=FGT_TOLERANCE) -> tuple[float, int]:
+    """(box width, terms) of the FGT with the least modelled work: N p per weight vector
+    for moments and evaluation against target boxes x boxes in reach x p^2 translations
+    (FGT_TRANSLATION_COST per term pair, measured). Dense particles favour narrow boxes
+    (fewer terms), sparse ones wide boxes (fewer translations)."""
+    span = max(x[-1], y[-1]) - min(x[0], y[0])
+    best = None
+    for ratio in FGT_BOX_RATIOS:
+        width = fgt_box_width(sigma, ratio)
+        p = fgt_terms(_ratio_ceiling(width / sigma), tolerance)
+        boxes = min(float(y.size), span / width + 1.0)
+        reach = 2 * (math.ceil(radius / width) + 1) + 1
+        work = nk * ((x.size + y.size) * p + FGT_TRANSLATION_COST * boxes * reach * p * p)
+        if best is None or work < best[0]:
+            best = (work, width, p)
+    return best[1], best[2]
+
+
+def _ratio_ceiling(ratio: float) -> float:
+    """ratio rounded up to 1/64: the bound grows with the ratio, so terms for the rounded
+    ratio are safe, and fgt_terms is cached on few distinct values."""
+    return math.ceil(ratio * 64.0) / 64.0
+
+
+def fgt_error_bound(ratio: float, p: int) -> float:
+    """Bound on |FGT - exact| per unit of summed |weights| in reach, for boxes ``ratio`` sigma
+    wide and p Hermite / Taylor terms.
+
+    In units where the kernel is exp(-(Y - X)^2), a source at X = c_s + u and a target at
+    Y = c_t + v (|u|, |v| <= a / 2, a = ratio / sqrt 2) interact through
+    exp(-(t + v - u)^2) = sum_{n,m} h_{n+m}(t) u^n (-v)^m / (n! m!) (h_k = Hermite functions,
+    t = c_t - c_s). With |h_k(t)| <= K 2^(k/2) sqrt(k!) exp(-t^2 / 2), K = 1.09 (Cramer's
+    inequality) and (n + m)! <= 2^(n+m) n! m!, a term is at most K a^n a^m / sqrt(n! m!),
+    so the terms dropped (n >= p or m >= p) sum to at most 2 K S(a) T_p(a), where
+    S(a) = sum_n a^n / sqrt(n!) and T_p(a) = a^p / sqrt(p!) / (1 - a / sqrt(p + 1)) bounds
+    the tail from p on (when a < sqrt(p + 1)).
+    """
+    a = ratio / math.sqrt(2.0)
+    if a >= math.sqrt(p + 1.0):
+        return math.inf
+    return 2.0 * 1.09 * _hermite_sum(a) * _tail(a, p)
+
+
+def _hermite_sum(a: float) -> float:
+    """S(a) = sum_n a^n / sqrt(n!), summed until the terms fall below 1e-20 of it."""
+    total, n = 0.0, 0
+    while True:
+        term = math.exp(n * math.log(a) - 0.5 * math.lgamma(n + 1.0))
+        total += term
+        if n > a * a and term < 1e-20 * total:
+            return total
+        n += 1
+
+
+def _tail(a: float, p: int) -> float:
+    """a^p / sqrt(p!) / (1 - a / sqrt(p + 1)) >= sum_{n >= p} a^n / sqrt(n!), a < sqrt(p + 1)."""
+    return math.exp(p * math.log(a) - 0.5 * math.lgamma(p + 1.0)) / (1.0 - a / math.sqrt(p + 1.0))
+
+
+@functools.lru_cache(maxsize=4096)
+def fgt_terms(ratio: float, tolerance: float) -> int:
+    """Fewest Hermite / Taylor terms p with fgt_error_bound(ratio, p) <= tolerance."""
+    if not ratio > 0:
+        raise ValueError(f"box width ratio must be > 0, got {ratio!r}")
+    a = ratio / math.sqrt(2.0)
+    scale = 2.0 * 1.09 * _hermite_sum(a)
+    p = max(1, math.floor(a * a))  # the tail bound needs a < sqrt(p + 1)
+    while scale * _tail(a, p) > tolerance:
+        p += 1
+    return p
+
+
+def neighbour_count(y: np.ndarray, x: np.ndarray, radius: float, samples: int | None = None) -> float:
+    """Mean number of sources within ``radius`` of a target (sorted inputs); over ``samples``
+    evenly spaced targets when given (an estimate, cheap for large N)."""
+    if y.size == 0 or x.size == 0:
+        return 0.0
+    if samples is not None and y.size > samples:
+        y = y[:: y.size // samples]
+    hi = np.searchsorted(x, y + radius, side="right")
+    lo = np.searchsorted(x, y - radius, side="left")
+    return float(np.mean(hi - lo))
+
+
+def choose_method(y, x, sigma, truncation) -> str:
+    """Pick ``direct`` or ``fgt`` for this transform (see module docstring)."""
+    if truncation is not None:
+        return "direct"
+    if neighbour_count(y, x, CUTOFF_SIGMAS * sigma, samples=512) <= DIRECT_MAX_NEIGHBOURS:
+        return "direct"
+    return "fgt"
+
+
+def gauss_transform(
+    y: np.ndarray,
+    x: np.ndarray,
+    q: np.ndarray,
+    sigma: float,
+    truncation: float | None = None,
+    method: str = "auto",
+    skip_self: bool = False,
+    tolerance: float = FGT_TOLERANCE,
+) -> np.ndarray:
+    """Return out[k, i] = sum_j exp(-(y_i - x_j)^2 / (2 sigma^2)) q[k, j].
+
+    ``y`` and ``x`` must be sorted ascending; ``q`` has shape (k, len(x)) or (len(x),).
+    ``truncation``: None for the whole Gaussian, else drop pairs with |y - x| > truncation * sigma.
+    ``skip_self`` (only when ``y is x``): leave out the j == i term (direct method only).
+    """
+    same = y is x
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    x = y if same else np.ascontiguousarray(x, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    squeeze = q.ndim == 1
+    q2 = np.ascontiguousarray(np.atleast_2d(q))
+    if q2.shape[1] != x.shape[0]:
+        raise ValueError(f"weights have {q2.shape[1]} columns for {x.shape[0]} sources")
+    if not (sigma > 0 and math.isfinite(sigma)):
+        raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
+    if not FGT_TOLERANCE_RANGE[0] <= tolerance <= FGT_TOLERANCE_RANGE[1]:
+        raise ValueError(f"tolerance={tolerance!r} is not allowed: a number in "
+                         f"[{FGT_TOLERANCE_RANGE[0]:g}, {FGT_TOLERANCE_RANGE[1]:g}]")
+    if method == "auto":
+        method = choose_method(y, x, sigma, truncation)
+    radius = (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
+    if method == "direct" and same and not skip_self:
+        out = _direct_symmetric(x, q2, float(sigma), float(radius))
+    elif method == "direct":
+        out = _direct(y, x, q2, float(sigma), float(radius), bool(skip_self))
+    elif method == "fgt":
+        if truncation is not None:
+            raise ValueError("the fgt method evaluates the untruncated kernel only")
+        if skip_self:
+            raise ValueError("skip_self is only supported by the direct method")
+        if x.size == 0 or y.size == 0:
+            out = np.zeros((q2.shape[0], y.size))
+        else:
+            width, p = fgt_plan(y, x, sigma, radius, q2.shape[0], tolerance)
+            out = _fgt(y, x, q2, float(sigma), float(radius), width, p)
+    elif method == "taylor":
+        if truncation is not None:
+            raise ValueError("the taylor method evaluates the untruncated kernel only")
+        if skip_self:
+            raise ValueError("skip_self is only supported by the direct method")
+        if x.size == 0:
+            out = np.zeros((q2.shape[0], y.size))
+        else:
+            centres, A = _taylor_moments(x, q2, float(sigma), float(x[0]), P_TERMS)
+            out = _taylor_eval(y, centres, A, float(sigma), float(radius))
+    else:
+        raise ValueError(f"method must be 'auto', 'direct', 'fgt' or 'taylor', got {method!r}")
+    return out[0] if squeeze else out

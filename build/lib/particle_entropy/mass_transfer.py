@@ -1,0 +1,152 @@
+"""MTPT mass transfer with the symmetric transfer matrix (Eqs. 16-21).
+
+W_ij = exp(-(x_i - x_j)^2 / (2 sigma^2)) (Eq. 17 or 21, the prefactor cancels on normalising),
+r_i = sum_j W_ij, and P_ij = (W_ij / r_i + W_ij / r_j) / 2: the average of the row- and the
+column-normalised kernel matrix, self term included. The update (Eq. 19) is
+
+    m_i <- m_i + beta * sum_j P_ij (m_j - m_i),
+
+built from the products W 1, W (1/r), W m and W (m/r), computed in two Gauss-transform
+passes a step (W 1, then W [1/r, m, m/r] together); P is never stored.
+The explicit update keeps masses non-negative while beta * sum_{j != i} P_ij <= 1 for every
+particle i holding mass (empty particles only receive). Where it is not (the SPH beta
+exceeds 1), the step is split into ``substeps`` equal pieces of beta with the same P, each
+positivity-preserving for every particle (a split step carries mass several kernel widths);
+the count is returned so that callers record it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .gauss import CUTOFF_SIGMAS, FGT_TOLERANCE, choose_method, gauss_transform
+
+
+@dataclass(frozen=True)
+class TransferResult:
+    mass: np.ndarray
+    substeps: int
+    max_offdiag_beta: float  # beta * max_i sum_{j != i} P_ij, before splitting
+
+
+def transfer_matrix_dense(x: np.ndarray, sigma: float, truncation: float | None = None) -> np.ndarray:
+    """Dense P (Eq. 18, symmetrised) for small N: references and tests only."""
+    d = x[:, None] - x[None, :]
+    W = np.exp(-0.5 * (d / sigma) ** 2)
+    if truncation is not None:
+        W[np.abs(d) > truncation * sigma] = 0.0
+    r = W.sum(axis=1)
+    return 0.5 * (W / r[:, None] + W / r[None, :])
+
+
+def mass_transfer(
+    x: np.ndarray,
+    m: np.ndarray,
+    sigma: float,
+    beta: float,
+    truncation: float | None = None,
+    method: str = "auto",
+    tolerance: float = FGT_TOLERANCE,
+) -> TransferResult:
+    """One mass-transfer step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 19); x sorted.
+
+    Only particles within the kernel's reach of a mass-holding particle can change, so
+    while they are few (early times of a delta initial condition) the step is computed on
+    them alone; the result is the same sum.
+    """
+    if x.size < 2 or beta == 0.0:
+        return TransferResult(m.copy(), 1, 0.0)
+    if method == "auto":  # one choice for all transforms of this step
+        method = choose_method(x, x, sigma, truncation)
+    reach = (CUTOFF_SIGMAS if truncation is None else truncation) * sigma
+    active = _reach_of_mass(x, m, reach)
+    if active is not None:
+        res = _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance)
+        if res is not None:
+            return res
+    return _transfer_all(x, m, sigma, beta, truncation, method, tolerance)
+
+
+def _reach_of_mass(x, m, reach) -> np.ndarray | None:
+    """Mask of particles within ``reach`` of a particle with m != 0, when at most half are."""
+    holders = np.flatnonzero(m)
+    if 2 * holders.size > x.size:
+        return None
+    lo = np.searchsorted(x, x[holders] - reach, side="left")
+    hi = np.searchsorted(x, x[holders] + reach, side="right")
+    cover = np.zeros(x.size + 1, dtype=np.int64)
+    np.add.at(cover, lo, 1)
+    np.add.at(cover, hi, -1)
+    active = np.cumsum(cover[:-1]) > 0
+    return active if 2 * np.count_nonzero(active) <= x.size else None
+
+
+def _substeps(beta, offdiag, holds_mass):
+    """Substeps that keep every mass-holding particle's m_i (1 - b offdiag_i) >= 0 (b = beta /
+    substeps), with a hair of margin for round-off; returns (substeps, beta * max offdiag)."""
+    c = float(beta * offdiag[holds_mass].max()) if holds_mass.any() else 0.0
+    return max(1, math.ceil(c / (1.0 - 1e-9))), c
+
+
+def _update(m, keep, b, Wm, Wmr, inv_r):
+    """m keep + b/2 (sum_{j != i} W_ij m_j / r_i + sum_{j != i} W_ij m_j / r_j)."""
+    # Both sums are of non-negative terms. The fast transform leaves them within its
+    # tolerance (1e-17 of the summed mass in reach by default), which can dip below 0 where
+    # all neighbours are empty; 0 is their bound.
+    s1 = np.maximum(Wm - m, 0.0)
+    s2 = Wmr - m * inv_r
+    np.maximum(s2, 0.0, out=s2)
+    s1 *= inv_r
+    s1 += s2
+    s1 *= 0.5 * b
+    s1 += m * keep
+    return s1
+
+
+def _weights(inv_r, m):
+    """The (3, N) right-hand sides [1/r, m, m/r] of the second pass."""
+    q = np.empty((3, m.size))
+    q[0] = inv_r
+    q[1] = m
+    np.multiply(m, inv_r, out=q[2])
+    return q
+
+
+def _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance):
+    """The step on the particles within reach of mass (targets) with all particles as
+    sources of the row sums r; None when it needs substeps (mass then travels further)."""
+    xa = np.ascontiguousarray(x[active])
+    ma = m[active]
+    r = gauss_transform(xa, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
+    inv_r = 1.0 / r
+    # every particle within reach of a mass holder is in xa: its sums over xa are complete
+    W3 = gauss_transform(xa, xa, _weights(inv_r, ma), sigma, truncation, method, tolerance=tolerance)
+    offdiag = 0.5 * (1.0 + W3[0]) - inv_r
+    substeps, c = _substeps(beta, offdiag, ma != 0)
+    if substeps > 1:
+        return None
+    out = m.copy()
+    out[active] = _update(ma, 1.0 - beta * offdiag, beta, W3[1], W3[2], inv_r)
+    return TransferResult(out, 1, c)
+
+
+def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
+    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
+    inv_r = 1.0 / r
+    # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
+    W3 = gauss_transform(x, x, _weights(inv_r, m), sigma, truncation, method, tolerance=tolerance)
+    offdiag = 0.5 * (1.0 + W3[0]) - inv_r  # sum_{j != i} P_ij, since P_ii = W_ii / r_i = 1 / r_i
+    substeps, c = _substeps(beta, offdiag, m != 0)
+    if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
+        substeps, c = _substeps(beta, offdiag, np.ones(x.size, dtype=bool))
+    b = beta / substeps
+    keep = 1.0 - b * offdiag  # >= 0 where it matters, by the choice of substeps
+    Wm, Wmr = W3[1], W3[2]
+    for k in range(substeps):
+        if k > 0:
+            Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
+        m = _update(m, keep, b, Wm, Wmr, inv_r)
+    return TransferResult(m, substeps, c)

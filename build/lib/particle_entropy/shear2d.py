@@ -1,0 +1,331 @@
+"""2-D shear flow with spatially variable, anisotropic dispersion (Appendix B, Fig. 10).
+
+Domain 0 < x < length (periodic in x), 0 < y < 1 (walls). Velocity v_y = 0,
+v_x = y - y^2 (Poiseuille, zero at both walls) and dispersion tensor
+D(y) = diag(alpha_L v_x, alpha_T v_x), so D -> 0 at the walls. A strip
+strip_lo < x < strip_hi carries concentration 1 / (strip_hi - strip_lo) (mass 1), spread in
+equal shares over the particles that start inside it. Three ways to disperse it, each on top
+of advection by v_x (with periodic wrap in x):
+
+``rw_nodrift``  random walks dX = v dt + B sqrt(2 dt) xi, B B^T = D(X), no drift term;
+``rw_drift``    the same plus the Ito drift div D = (0, alpha_T (1 - 2y)) (Eq. 1 of the paper's
+                Introduction: particles must be pseudo-advected by v + div D);
+``mt``          no random walk: masses exchange by Eq. 16 with the collision kernel of Eq. 17
+                written with the pair-averaged tensor D_ij = (D_i + D_j) / 2.
+
+Walkers reflect at the walls (y -> -y below 0, 2 - y above 1).
+
+Units: lengths [L], times [T], masses dimensionless (total 1). Columns of the result tables
+are described in ``STEP_COLUMNS`` and ``STATE_COLUMNS``.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import asdict, dataclass
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+from numba import njit
+from scipy.spatial import cKDTree
+
+from .records import Recorder
+from .runconfig import SettingError, check_range
+
+CASES = ("rw_nodrift", "rw_drift", "mt")
+WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
+V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
+KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
+
+STEP_COLUMNS = {
+    "step": "time-step index, 0 = initial condition",
+    "time": "time at the end of the step [T]",
+    "mass_total": "total particle mass (1 at t = 0)",
+    "mass_min": "smallest particle mass",
+    "wall_fraction": f"rw: fraction of all particles, mt: fraction of mass, within {WALL_BAND} of a wall "
+    f"(uniform in y: {2 * WALL_BAND})",
+    "mean_y": "rw: mean y of all particles; mt: mass-weighted mean y [L]",
+    "substeps": "mass-transfer substeps taken to keep masses non-negative (0: no transfer)",
+    "max_offdiag_beta": "beta * max_i sum_{j != i} P_ij before splitting (0: no transfer)",
+    "n_pairs": "particle pairs within the kernel cut-off (mt; 0 for random walks)",
+    "wall_s": "wall-clock seconds spent in the step",
+}
+STATE_COLUMNS = {
+    "x": "final position along the flow, in [0, length) [L]",
+    "y": "final lateral position, in [0, 1] [L]",
+    "mass": "final particle mass",
+    "case": "one of " + ", ".join(CASES),
+    "seed": "random seed",
+}
+
+
+@dataclass(frozen=True)
+class ShearConfig:
+    case: str = "mt"
+    n: int = 20_000  # particles, uniform over the whole domain
+    length: float = 400.0  # periodic domain length in x [L]
+    strip_lo: float = 90.0  # initial strip 90 < x < 110 [L]
+    strip_hi: float = 110.0
+    alpha_L: float = 1e-2  # longitudinal dispersivity [L]
+    alpha_T: float = 1e-3  # transverse dispersivity [L]
+    dt: float = 1.0  # [T]
+    t_final: float = 500.0  # [T]
+    beta: float = 0.5  # mass-transfer coefficient of Eq. 16
+    seed: int = 0
+
+    def __post_init__(self):
+        self.check()
+
+    def check(self) -> None:
+        """Raise SettingError naming the first setting outside its allowed range."""
+        if self.case not in CASES:
+            raise SettingError("case", self.case, f"one of {', '.join(CASES)}")
+        if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or self.n < 1:
+            raise SettingError("n", self.n, "an integer >= 1")
+        check_range("length", self.length, 0.0, math.inf, open_low=True)
+        check_range("strip_lo", self.strip_lo, 0.0, self.length)
+        check_range("strip_hi", self.strip_hi, self.strip_lo, self.length, open_low=True)
+        check_range("alpha_L", self.alpha_L, 0.0, math.inf, open_low=True)
+        check_range("alpha_T", self.alpha_T, 0.0, math.inf)
+        check_range("dt", self.dt, 0.0, math.inf, open_low=True)
+        check_range("t_final", self.t_final, 0.0, math.inf)
+        steps = self.t_final / self.dt
+        if abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
+            raise SettingError("t_final", self.t_final, f"a whole number of steps dt={self.dt!r}")
+        check_range("beta", self.beta, 0.0, 1.0)
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise SettingError("seed", self.seed, "an integer >= 0")
+        if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
+            # the minimum-image distance in x is only exact while the kernel fits in half the box
+            raise SettingError("length", self.length, "for mt > 2 sqrt(alpha_L) kernel_cutoff "
+                               f"= {2.0 * math.sqrt(self.alpha_L) * kernel_cutoff(self):.4g}")
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.t_final / self.dt))
+
+    def rng(self) -> np.random.Generator:
+        """Generator keyed by (seed, case); no global state."""
+        ss = np.random.SeedSequence(entropy=int(self.seed), spawn_key=(zlib.crc32(self.case.encode()),))
+        return np.random.default_rng(ss)
+
+    def case_columns(self) -> dict:
+        """The case parameters written beside every row of the step table."""
+        d = asdict(self)
+        return {"case": d.pop("case"), "seed": int(d.pop("seed")), **{k: v for k, v in d.items()}}
+
+
+# ---------------------------------------------------------------- flow and dispersion
+
+
+def velocity(y: np.ndarray) -> np.ndarray:
+    """Poiseuille velocity v_x = y - y^2 (Appendix B) [L/T], clipped at 0 against round-off."""
+    return np.maximum(y - y * y, 0.0)
+
+
+def initial_state(cfg: ShearConfig, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Uniform positions over the domain; mass 1 shared equally by the particles in the strip."""
+    x = rng.uniform(0.0, cfg.length, cfg.n)
+    y = rng.uniform(0.0, 1.0, cfg.n)
+    inside = (x > cfg.strip_lo) & (x < cfg.strip_hi)
+    m = np.zeros(cfg.n)
+    if inside.any():
+        m[inside] = 1.0 / inside.sum()
+    return x, y, m
+
+
+def reflect(y: np.ndarray) -> np.ndarray:
+    """Fold y into [0, 1] by mirror reflection at the walls y = 0 and y = 1."""
+    y = np.mod(y, 2.0)
+    return np.where(y > 1.0, 2.0 - y, y)
+
+
+def random_walk_step(x, y, cfg: ShearConfig, rng: np.random.Generator, drift: bool):
+    """One Ito-Euler step dX = (v + [div D]) dt + B sqrt(2 dt) xi, B = diag(sqrt(alpha_L v), sqrt(alpha_T v)).
+
+    div D = (0, alpha_T (1 - 2y)) for D = diag(alpha_L v_x(y), alpha_T v_x(y)); B is finite
+    (zero) at the walls, so no NaN arises there.
+    """
+    v = velocity(y)
+    xi = rng.standard_normal((2, x.size))
+    x_new = x + v * cfg.dt + np.sqrt(2.0 * cfg.alpha_L * v * cfg.dt) * xi[0]
+    y_new = y + np.sqrt(2.0 * cfg.alpha_T * v * cfg.dt) * xi[1]
+    if drift:
+        y_new = y_new + cfg.alpha_T * (1.0 - 2.0 * y) * cfg.dt
+    return np.mod(x_new, cfg.length), reflect(y_new)
+
+
+# ---------------------------------------------------------------- mass transfer
+
+
+def kernel_cutoff(cfg: ShearConfig, v_max: float = V_MAX) -> float:
+    """Cut-off s_c in scaled distance s^2 = dx^2/alpha_L + dy^2/alpha_T for the kernel of Eq. 17.
+
+    With the pair's W_ij = exp(-s^2 / (8 vbar dt)) / vbar (Eq. 17 with D_ij = vbar diag(alpha_L,
+    alpha_T), constants common to all pairs dropped) and vbar = (v_i + v_j)/2 >= v_i/2, a pair
+    beyond s_c has W_ij / W_ii <= 2 exp(-s_c^2 / (8 v_max dt)) = KERNEL_TOL, so each neglected
+    P_ij is below 1e-16 of the row and column sums it is normalised by.
+    """
+    return math.sqrt(8.0 * v_max * cfg.dt * math.log(2.0 / KERNEL_TOL))
+
+
+def neighbour_pairs(x, y, cfg: ShearConfig, cutoff: float) -> np.ndarray:
+    """Pairs (i, j), i < j, with scaled distance <= cutoff, periodic in x: an (n_pairs, 2) array.
+
+    Found by cKDTree on (x/sqrt(alpha_L), y/sqrt(alpha_T)) with a periodic box in x. With
+    alpha_T = 0 the kernel is a delta in y, so only pairs at identical y can interact: the tree
+    then searches x alone and ``pair_kernel`` gives the pairs with dy != 0 zero weight.
+    """
+    sx = 1.0 / math.sqrt(cfg.alpha_L)
+    if cfg.alpha_T > 0:
+        sy = 1.0 / math.sqrt(cfg.alpha_T)
+        pts = np.column_stack([np.mod(x * sx, cfg.length * sx), y * sy])
+        # y is not periodic: a box far larger than 1 * sy + cutoff never wraps
+        box = [cfg.length * sx, 4.0 * (sy + cutoff)]
+    else:
+        pts = np.mod(x * sx, cfg.length * sx)[:, None]
+        box = [cfg.length * sx]
+    # round-off may put a point exactly on the box edge; cKDTree needs [0, box)
+    pts[:, 0] = np.where(pts[:, 0] >= box[0], 0.0, pts[:, 0])
+    pairs = cKDTree(pts, boxsize=box).query_pairs(cutoff, output_type="ndarray")
+    return pairs.reshape(-1, 2).astype(np.int64, copy=False)
+
+
+def pair_kernel(x, y, pairs, cfg: ShearConfig) -> np.ndarray:
+    """Off-diagonal kernel W_ij of Eq. 17 with the tensor D_ij = (D_i + D_j)/2, up to a common constant.
+
+    D_ij = vbar diag(alpha_L, alpha_T) with vbar = (v_i + v_j)/2, so W_ij = exp(-s^2/(8 vbar dt))
+    / vbar with s^2 = dx^2/alpha_L + dy^2/alpha_T. The constant 1/(8 pi dt sqrt(alpha_L alpha_T))
+    is common to all pairs and to the self terms and cancels on normalising (Eq. 18); the 1/vbar
+    factor varies by pair and is kept. dx is the minimum image in x. Pairs with vbar = 0 (both
+    on a wall, D_ij = 0) get W_ij = 0, the kernel's limit for r != 0; with alpha_T = 0 so do
+    pairs with dy != 0.
+    """
+    return _pair_kernel(x, y, velocity(y), pairs, cfg.length, cfg.alpha_L, cfg.alpha_T, cfg.dt)
+
+
+@njit(cache=True)
+def _pair_kernel(x, y, v, pairs, length, alpha_L, alpha_T, dt):
+    w = np.zeros(pairs.shape[0])
+    for k in range(pairs.shape[0]):
+        i, j = pairs[k, 0], pairs[k, 1]
+        vbar = 0.5 * (v[i] + v[j])
+        if vbar <= 0.0:
+            continue
+        dx = abs(x[i] - x[j])
+        dx = min(dx, length - dx)
+        dy = y[i] - y[j]
+        q = dx * dx / alpha_L
+        if alpha_T > 0.0:
+            q += dy * dy / alpha_T
+        elif dy != 0.0:
+            continue
+        w[k] = math.exp(-q / (8.0 * vbar * dt)) / vbar
+    return w
+
+
+@njit(cache=True)
+def _transfer(pairs, w, v, m, beta):
+    """Eqs. 16-18 on a pair list: returns (new masses, substeps, beta * max_i sum_{j != i} P_ij)."""
+    n = m.size
+    off = np.zeros(n)
+    for k in range(pairs.shape[0]):
+        off[pairs[k, 0]] += w[k]
+        off[pairs[k, 1]] += w[k]
+    inv_r = np.zeros(n)  # 1 / r_i, r_i = W_ii + sum_{j != i} W_ij, W_ii = 1 / v_i (infinite at v_i = 0)
+    for i in range(n):
+        if v[i] > 0.0:
+            inv_r[i] = 1.0 / (1.0 / v[i] + off[i])
+    p = np.empty(pairs.shape[0])
+    offdiag = np.zeros(n)
+    for k in range(pairs.shape[0]):
+        i, j = pairs[k, 0], pairs[k, 1]
+        p[k] = 0.5 * w[k] * (inv_r[i] + inv_r[j])  # P_ij = P_ji
+        offdiag[i] += p[k]
+        offdiag[j] += p[k]
+    c_max = beta * offdiag.max() if n > 0 else 0.0
+    # split so that b * offdiag stays a hair below 1 (round-off margin)
+    substeps = max(1, math.ceil(c_max / (1.0 - 1e-9)))
+    b = beta / substeps
+    for _ in range(substeps):
+        gain = np.zeros(n)
+        for k in range(pairs.shape[0]):
+            i, j = pairs[k, 0], pairs[k, 1]
+            gain[i] += p[k] * m[j]
+            gain[j] += p[k] * m[i]
+        m = m * (1.0 - b * offdiag) + b * gain  # non-negative terms only
+    return m, substeps, c_max
+
+
+def transfer_step(x, y, m, cfg: ShearConfig, cutoff: float | None = None):
+    """One step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 16) with P = (W/rowsum + W/colsum)/2 (Eq. 18).
+
+    Self weights W_ii = 1 / v_i (Eq. 17 at r = 0, constants dropped as in ``pair_kernel``); for
+    v_i = 0 (a particle on a wall) W_ii is infinite, so 1 / r_i = 0: its row of W/rowsum
+    vanishes and it exchanges only through the column-normalised half of P, with partners of
+    finite D_ij; without such partners it is isolated. The step is split into ``substeps``
+    equal parts of beta when beta * max_i sum_{j != i} P_ij > 1, so masses stay non-negative.
+    Returns (m, substeps, max_offdiag_beta, n_pairs).
+    """
+    if cutoff is None:
+        cutoff = kernel_cutoff(cfg)
+    pairs = neighbour_pairs(x, y, cfg, cutoff)
+    w = pair_kernel(x, y, pairs, cfg)
+    m, substeps, c_max = _transfer(pairs, w, velocity(y), np.asarray(m, dtype=np.float64), float(cfg.beta))
+    return m, int(substeps), float(c_max), int(pairs.shape[0])
+
+
+# ---------------------------------------------------------------- driver
+
+
+def wall_fraction(y: np.ndarray, weights: np.ndarray | None = None) -> float:
+    """Fraction of particles (or of ``weights``) within WALL_BAND of y = 0 or y = 1."""
+    near = (y < WALL_BAND) | (y > 1.0 - WALL_BAND)
+    if weights is None:
+        return float(near.mean())
+    return float(weights[near].sum() / weights.sum())
+
+
+def run_shear(cfg: ShearConfig, progress: Callable[[str], None] | None = None,
+              init: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Run one case of Appendix B to t_final; returns (per-step table, final particle table).
+
+    ``init`` = (x, y, mass) replaces the random initial condition (tests, constructed cases).
+    """
+    cfg.check()
+    rng = cfg.rng()
+    if init is None:
+        x, y, m = initial_state(cfg, rng)
+    else:
+        x, y, m = (np.array(a, dtype=np.float64, copy=True) for a in init)
+        x = np.mod(x, cfg.length)
+        if not (np.all((y >= 0) & (y <= 1)) and np.all(m >= 0) and x.shape == y.shape == m.shape):
+            raise SettingError("init", "(x, y, mass)", "equal-length arrays with 0 <= y <= 1 and mass >= 0")
+    is_mt = cfg.case == "mt"
+    cutoff = kernel_cutoff(cfg) if is_mt else math.nan
+    rec = Recorder(cfg.case_columns(), cfg.n_steps, progress)
+
+    def record(step, substeps=0, c_max=0.0, n_pairs=0):
+        if is_mt:
+            total = m.sum()
+            mean_y = float(np.dot(m, y) / total) if total > 0 else math.nan
+            wf = wall_fraction(y, m) if total > 0 else math.nan
+        else:
+            mean_y, wf = float(y.mean()), wall_fraction(y)
+        rec.add(step=step, time=step * cfg.dt, mass_total=float(m.sum()), mass_min=float(m.min()),
+                wall_fraction=wf, mean_y=mean_y, substeps=substeps, max_offdiag_beta=c_max, n_pairs=n_pairs)
+
+    record(0)
+    for step in range(1, cfg.n_steps + 1):
+        if is_mt:
+            x = np.mod(x + velocity(y) * cfg.dt, cfg.length)
+            m, substeps, c_max, n_pairs = transfer_step(x, y, m, cfg, cutoff)
+            record(step, substeps, c_max, n_pairs)
+        else:
+            x, y = random_walk_step(x, y, cfg, rng, drift=cfg.case == "rw_drift")
+            record(step)
+    steps = rec.table()
+    state = pd.DataFrame({"x": x, "y": y, "mass": m, "case": cfg.case, "seed": int(cfg.seed)})
+    return steps, state

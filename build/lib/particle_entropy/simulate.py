@@ -1,0 +1,94 @@
+"""Run one simulation and return its per-step table (and, on request, its final state)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from . import fd, measures as M, mtpt, pt
+from .records import Recorder
+from .runconfig import RunConfig
+from .timegrid import time_steps, times
+
+
+def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
+    return {
+        "H_C_analytic": M.analytic_h_c(cfg.D, t, dV),
+        "E_analytic": M.analytic_dilution(cfg.D, t),
+        "settled": bool(t > M.settling_time(dV, cfg.D)),
+    }
+
+
+def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
+    """Simulate ``cfg`` (defaults resolved and checked) -> (per-step table, final state or None)."""
+    cfg = cfg.resolved()
+    dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
+    runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
+    size = cfg.n + 1 if cfg.method == "fd" else cfg.n
+    rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
+    state = runner(cfg, dts, times(dts, cfg.t_final), rec)
+    table = rec.table()
+    if not want_state:
+        return table, None
+    state_df = pd.DataFrame(state)
+    for k, v in cfg.case_columns().items():
+        state_df[k] = v
+    return table, state_df
+
+
+def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:
+    rec.add(step=step, time=t, dt=dt, **meas, **_analytic_columns(cfg, t, meas["dV"]))
+
+
+def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    rng = cfg.rng()
+    x = pt.initial_positions(cfg)
+    _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
+    for k, dt in enumerate(dts, start=1):
+        t = ts[k]
+        x = np.sort(pt.walk(x, cfg.D, dt, rng))
+        _row(rec, cfg, k, t, dt, pt.measure(cfg, x, t))
+    return pt.final_state(cfg, x, t)
+
+
+def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    rng = cfg.rng()
+    x, m = mtpt.initial_state(cfg, rng)
+    _row(rec, cfg, 0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
+    for k, dt in enumerate(dts, start=1):
+        t = ts[k]
+        x, m, h, beta, sub = mtpt.step(cfg, x, m, dt, t, rng)
+        _row(rec, cfg, k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
+    dV = cfg.omega / cfg.n
+    return {"x": x, "mass": m, "c": m / dV}
+
+
+def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    x, dx = fd.grid(cfg)
+    c = fd.initial_concentration(cfg)
+    extra = {"beta": 0.0, "h": dx, "substeps": 1}
+    _row(rec, cfg, 0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
+    solver_type = fd.ExplicitSolver if cfg.kernel == "explicit" else fd.ImplicitSolver
+    solvers: dict = {}
+    for k, dt in enumerate(dts, start=1):
+        t = ts[k]
+        if dt not in solvers:  # one factorisation per distinct step size (one for a fixed dt)
+            solvers[dt] = solver_type(cfg.n - 1, cfg.D * dt / dx**2)
+        c[1:-1] = solvers[dt].solve(c[1:-1])
+        _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
+    return {"x": x, "c": c}
+
+
+
+def run_seeds(cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False) -> pd.DataFrame:
+    """Run ``cfg`` for each seed and concatenate the per-step tables (or final states)."""
+    parts = []
+    for seed in seeds:
+        if progress:
+            progress(f"seed {seed}")
+        table, final = run(replace(cfg, seed=int(seed)), progress=progress, want_state=state)
+        parts.append(final if state else table)
+    return pd.concat(parts, ignore_index=True)
