@@ -162,8 +162,8 @@ def test_fgt_box_widths_match_dense(rng, ratio, density):
     sigma = density * 10.0 / n
     q = _weights(rng, n)
     width = 2.0 ** math.floor(math.log2(ratio * sigma))  # exact box geometry: a power of two
-    p = gauss.fgt_terms(width / sigma, gauss.FGT_TOLERANCE)
-    out = gauss._fgt(x, x, q, sigma, CUTOFF_SIGMAS * sigma, width, p)
+    terms = gauss.fgt_offset_terms(sigma, CUTOFF_SIGMAS * sigma, width)
+    out = gauss._fgt(x, x, q, sigma, CUTOFF_SIGMAS * sigma, width, terms)
     _assert_matches(out, x, x, q, sigma)
 
 
@@ -217,6 +217,7 @@ def test_fgt_plan_narrow_boxes_for_dense_sources_wide_for_sparse():
     x = np.linspace(-5.0, 5.0, 30000)  # 1300 sources per sigma = 0.44, 19 per sigma = 0.0063
     w_dense, p_dense = gauss.fgt_plan(x, x, 0.44, CUTOFF_SIGMAS * 0.44, 1)
     w_sparse, p_sparse = gauss.fgt_plan(x, x, 0.0063, CUTOFF_SIGMAS * 0.0063, 1)
+    p_dense, p_sparse = p_dense[0], p_sparse[0]
     assert w_dense / 0.44 < w_sparse / 0.0063 and p_dense < p_sparse
     for w in (w_dense, w_sparse):
         mantissa = w / 2.0 ** math.floor(math.log2(w) - 2)

@@ -277,7 +277,7 @@ def _empty_boxes(q, starts):
 
 
 @njit(cache=True)
-def _fgt(y, x, q, sigma, radius, width, p):
+def _fgt(y, x, q, sigma, radius, width, terms):
     """Fast Gauss transform (Greengard-Strain): Hermite moments of source boxes translated to
     Taylor coefficients about target-box centres; boxes ``width`` (see fgt_box_width) wide on one
     grid, so a translation depends only on the box offset and is tabulated once."""
@@ -290,7 +290,8 @@ def _fgt(y, x, q, sigma, radius, width, p):
     origin = math.floor(min(x[0], y[0]) / width) * width
     s_starts, s_ids = _boxes(x, origin, width)
     t_starts, t_ids = _boxes(y, origin, width)
-    kmax = int(math.ceil(radius / width)) + 1  # |y - x| <= radius needs |box offset| <= kmax
+    kmax = terms.shape[0] - 1  # |y - x| <= radius needs |box offset| <= kmax
+    p = terms[0]  # terms[d]: Hermite / Taylor terms for box pairs d boxes apart (most at 0)
     H = _hermite_table(kmax, width * scale, p)
     A = _hermite_moments(x, q, s_starts, s_ids, origin, width, scale, p)
     empty = _empty_boxes(q, s_starts)
@@ -320,7 +321,8 @@ def _fgt(y, x, q, sigma, radius, width, p):
             if empty[sb].all():
                 sb += 1
                 continue
-            if (s_hi - s_lo) * (t_hi - t_lo) * (30 + nk) <= p * p * nk:
+            pp = terms[abs(bt - s_ids[sb])]
+            if (s_hi - s_lo) * (t_hi - t_lo) * (30 + nk) <= pp * pp * nk:
                 # sparse box pair: the exact pairwise sum is cheaper than a translation
                 for i in range(t_lo, t_hi):
                     for j in range(s_lo, s_hi):
@@ -333,9 +335,9 @@ def _fgt(y, x, q, sigma, radius, width, p):
                 for k in range(nk):
                     if empty[sb, k]:
                         continue  # all weights zero (empty particles at early MTPT times)
-                    for n in range(p):
+                    for n in range(pp):
                         a = A[sb, k, n]
-                        for m in range(p):
+                        for m in range(pp):
                             B[k, m] += a * h[n + m]
             sb += 1
         cnt = t_hi - t_lo
@@ -363,22 +365,32 @@ def fgt_box_width(sigma: float, ratio: float) -> float:
     return max(k * 2.0**e for k in (4, 5, 6, 7) if k * 2.0**e <= target)
 
 
-def fgt_plan(y, x, sigma, radius, nk, tolerance=FGT_TOLERANCE) -> tuple[float, int]:
-    """(box width, terms) of the FGT with the least modelled work: N p per weight vector
-    for moments and evaluation against target boxes x boxes in reach x p^2 translations
-    (FGT_TRANSLATION_COST per term pair, measured). Dense particles favour narrow boxes
-    (fewer terms), sparse ones wide boxes (fewer translations)."""
+def fgt_plan(y, x, sigma, radius, nk, tolerance=FGT_TOLERANCE) -> tuple[float, np.ndarray]:
+    """(box width, terms per box offset) of the FGT with the least modelled work: N p per
+    weight vector for moments and evaluation against target boxes x sum over offsets of p_d^2
+    translations (FGT_TRANSLATION_COST per term pair, measured). Dense particles favour narrow
+    boxes (fewer terms), sparse ones wide boxes (fewer translations)."""
     span = max(x[-1], y[-1]) - min(x[0], y[0])
     best = None
     for ratio in FGT_BOX_RATIOS:
         width = fgt_box_width(sigma, ratio)
-        p = fgt_terms(_ratio_ceiling(width / sigma), tolerance)
+        terms = fgt_offset_terms(sigma, radius, width, tolerance)
         boxes = min(float(y.size), span / width + 1.0)
-        reach = 2 * (math.ceil(radius / width) + 1) + 1
-        work = nk * ((x.size + y.size) * p + FGT_TRANSLATION_COST * boxes * reach * p * p)
+        pairs = float(terms[0] ** 2 + 2 * (terms[1:] ** 2).sum())
+        work = nk * ((x.size + y.size) * terms[0] + FGT_TRANSLATION_COST * boxes * pairs)
         if best is None or work < best[0]:
-            best = (work, width, p)
+            best = (work, width, terms)
     return best[1], best[2]
+
+
+def fgt_offset_terms(sigma, radius, width, tolerance=FGT_TOLERANCE) -> np.ndarray:
+    """Terms for box pairs d = 0, 1, ..., kmax boxes apart. The bound of fgt_error_bound
+    carries a factor exp(-t^2 / 2) at centre offset t = d width / (sqrt 2 sigma) (Cramer's
+    inequality), so farther pairs meet the tolerance with fewer terms."""
+    kmax = int(math.ceil(radius / width)) + 1
+    ratio = _ratio_ceiling(width / sigma)
+    t = np.arange(kmax + 1) * (width / (math.sqrt(2.0) * sigma))
+    return np.array([fgt_terms(ratio, tolerance * math.exp(min(0.5 * ti * ti, 700.0))) for ti in t], dtype=np.int64)
 
 
 def _ratio_ceiling(ratio: float) -> float:
@@ -500,8 +512,8 @@ def gauss_transform(
         if x.size == 0 or y.size == 0:
             out = np.zeros((q2.shape[0], y.size))
         else:
-            width, p = fgt_plan(y, x, sigma, radius, q2.shape[0], tolerance)
-            out = _fgt(y, x, q2, float(sigma), float(radius), width, p)
+            width, terms = fgt_plan(y, x, sigma, radius, q2.shape[0], tolerance)
+            out = _fgt(y, x, q2, float(sigma), float(radius), width, terms)
     elif method == "taylor":
         if truncation is not None:
             raise ValueError("the taylor method evaluates the untruncated kernel only")
