@@ -248,3 +248,16 @@ def test_inline_exp_matches_libm_to_an_ulp():
     normal = ref > np.finfo(float).tiny
     assert np.all(np.abs(got[normal] - ref[normal]) <= 2.3e-16 * ref[normal])
     assert np.all(got[a > 746.0] == 0.0) and got[0] == 1.0
+
+
+def test_distant_box_pairs_get_fewer_terms_within_the_bound():
+    """terms[d] for pairs d boxes apart: the most at d = 0, never more farther out, and each
+    meets the tolerance once the bound's exp(-t^2 / 2) at centre offset t is applied."""
+    sigma, width = 0.01, 0.025
+    terms = gauss.fgt_offset_terms(sigma, CUTOFF_SIGMAS * sigma, width)
+    assert len(terms) == math.ceil(CUTOFF_SIGMAS * sigma / width) + 2
+    assert np.all(np.diff(terms) <= 0) and terms[-1] < terms[0]
+    ratio = math.ceil(width / sigma * 64) / 64
+    for d, p in enumerate(terms):
+        t = d * width / (math.sqrt(2) * sigma)
+        assert math.exp(-t * t / 2) * gauss.fgt_error_bound(ratio, int(p)) <= gauss.FGT_TOLERANCE
