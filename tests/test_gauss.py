@@ -259,5 +259,5 @@ def test_distant_box_pairs_get_fewer_terms_within_the_bound():
     assert np.all(np.diff(terms) <= 0) and terms[-1] < terms[0]
     ratio = math.ceil(width / sigma * 64) / 64
     for d, p in enumerate(terms):
-        t = d * width / (math.sqrt(2) * sigma)
+        t = d * math.floor(width / sigma * 64) / 64 / math.sqrt(2)
         assert math.exp(-t * t / 2) * gauss.fgt_error_bound(ratio, int(p)) <= gauss.FGT_TOLERANCE

@@ -388,9 +388,17 @@ def fgt_offset_terms(sigma, radius, width, tolerance=FGT_TOLERANCE) -> np.ndarra
     carries a factor exp(-t^2 / 2) at centre offset t = d width / (sqrt 2 sigma) (Cramer's
     inequality), so farther pairs meet the tolerance with fewer terms."""
     kmax = int(math.ceil(radius / width)) + 1
-    ratio = _ratio_ceiling(width / sigma)
-    t = np.arange(kmax + 1) * (width / (math.sqrt(2.0) * sigma))
-    return np.array([fgt_terms(ratio, tolerance * math.exp(min(0.5 * ti * ti, 700.0))) for ti in t], dtype=np.int64)
+    ratio = width / sigma
+    # the bound grows with the ratio and the factor falls with t: round both the safe way
+    return _offset_terms(_ratio_ceiling(ratio), math.floor(ratio * 64.0) / 64.0, kmax, tolerance)
+
+
+@functools.lru_cache(maxsize=4096)
+def _offset_terms(ratio_up, ratio_down, kmax, tolerance):
+    t = np.arange(kmax + 1) * (ratio_down / math.sqrt(2.0))
+    terms = np.array([fgt_terms(ratio_up, tolerance * math.exp(min(0.5 * ti * ti, 700.0))) for ti in t], dtype=np.int64)
+    terms.flags.writeable = False  # shared by the cache
+    return terms
 
 
 def _ratio_ceiling(ratio: float) -> float:

@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .gauss import CUTOFF_SIGMAS, FGT_TOLERANCE, choose_method, gauss_transform
 
@@ -72,9 +73,9 @@ def mass_transfer(
 
 def _reach_of_mass(x, m, reach) -> np.ndarray | None:
     """Mask of particles within ``reach`` of a particle with m != 0, when at most half are."""
-    holders = np.flatnonzero(m)
-    if 2 * holders.size > x.size:
+    if 2 * np.count_nonzero(m) > x.size:
         return None
+    holders = np.flatnonzero(m)
     lo = np.searchsorted(x, x[holders] - reach, side="left")
     hi = np.searchsorted(x, x[holders] + reach, side="right")
     cover = np.zeros(x.size + 1, dtype=np.int64)
@@ -84,69 +85,90 @@ def _reach_of_mass(x, m, reach) -> np.ndarray | None:
     return active if 2 * np.count_nonzero(active) <= x.size else None
 
 
-def _substeps(beta, offdiag, holds_mass):
-    """Substeps that keep every mass-holding particle's m_i (1 - b offdiag_i) >= 0 (b = beta /
-    substeps), with a hair of margin for round-off; returns (substeps, beta * max offdiag)."""
-    c = float(beta * offdiag[holds_mass].max()) if holds_mass.any() else 0.0
-    return max(1, math.ceil(c / (1.0 - 1e-9))), c
+def _substeps(c):
+    """Substeps that keep m_i (1 - b offdiag_i) >= 0 (b = beta / substeps) given
+    c = beta * max offdiag, with a hair of margin for round-off."""
+    return max(1, math.ceil(c / (1.0 - 1e-9)))
 
 
-def _update(m, keep, b, Wm, Wmr, inv_r):
-    """m keep + b/2 (sum_{j != i} W_ij m_j / r_i + sum_{j != i} W_ij m_j / r_j)."""
+@njit(cache=True)
+def _weights(r, m):
+    """1/r and the (3, N) right-hand sides [1/r, m, m/r] of the second pass."""
+    n = m.shape[0]
+    inv_r = np.empty(n)
+    q = np.empty((3, n))
+    for i in range(n):
+        ir = 1.0 / r[i]
+        inv_r[i] = ir
+        q[0, i] = ir
+        q[1, i] = m[i]
+        q[2, i] = m[i] * ir
+    return inv_r, q
+
+
+@njit(cache=True)
+def _offdiag(W_inv_r, inv_r, m, beta):
+    """sum_{j != i} P_ij = (1 + sum_j W_ij / r_j) / 2 - 1 / r_i (P_ii = 1 / r_i), and beta times
+    its maximum over mass-holding particles and over all particles."""
+    n = m.shape[0]
+    out = np.empty(n)
+    c_mass = 0.0
+    c_all = 0.0
+    for i in range(n):
+        o = 0.5 * (1.0 + W_inv_r[i]) - inv_r[i]
+        out[i] = o
+        c_all = max(c_all, beta * o)
+        if m[i] != 0.0:
+            c_mass = max(c_mass, beta * o)
+    return out, c_mass, c_all
+
+
+@njit(cache=True)
+def _update(m, offdiag, b, Wm, Wmr, inv_r):
+    """m (1 - b offdiag) + b/2 (sum_{j != i} W_ij m_j / r_i + sum_{j != i} W_ij m_j / r_j)."""
     # Both sums are of non-negative terms. The fast transform leaves them within its
     # tolerance (1e-17 of the summed mass in reach by default), which can dip below 0 where
     # all neighbours are empty; 0 is their bound.
-    s1 = np.maximum(Wm - m, 0.0)
-    s2 = Wmr - m * inv_r
-    np.maximum(s2, 0.0, out=s2)
-    s1 *= inv_r
-    s1 += s2
-    s1 *= 0.5 * b
-    s1 += m * keep
-    return s1
-
-
-def _weights(inv_r, m):
-    """The (3, N) right-hand sides [1/r, m, m/r] of the second pass."""
-    q = np.empty((3, m.size))
-    q[0] = inv_r
-    q[1] = m
-    np.multiply(m, inv_r, out=q[2])
-    return q
+    n = m.shape[0]
+    out = np.empty(n)
+    for i in range(n):
+        s1 = max(Wm[i] - m[i], 0.0)
+        s2 = max(Wmr[i] - m[i] * inv_r[i], 0.0)
+        out[i] = m[i] * (1.0 - b * offdiag[i]) + 0.5 * b * (s1 * inv_r[i] + s2)
+    return out
 
 
 def _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance):
     """The step on the particles within reach of mass (targets) with all particles as
     sources of the row sums r; None when it needs substeps (mass then travels further)."""
     xa = np.ascontiguousarray(x[active])
-    ma = m[active]
+    ma = np.ascontiguousarray(m[active])
     r = gauss_transform(xa, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
-    inv_r = 1.0 / r
+    inv_r, q = _weights(r, ma)
     # every particle within reach of a mass holder is in xa: its sums over xa are complete
-    W3 = gauss_transform(xa, xa, _weights(inv_r, ma), sigma, truncation, method, tolerance=tolerance)
-    offdiag = 0.5 * (1.0 + W3[0]) - inv_r
-    substeps, c = _substeps(beta, offdiag, ma != 0)
-    if substeps > 1:
+    W3 = gauss_transform(xa, xa, q, sigma, truncation, method, tolerance=tolerance)
+    offdiag, c, _ = _offdiag(W3[0], inv_r, ma, beta)
+    if _substeps(c) > 1:
         return None
     out = m.copy()
-    out[active] = _update(ma, 1.0 - beta * offdiag, beta, W3[1], W3[2], inv_r)
+    out[active] = _update(ma, offdiag, beta, W3[1], W3[2], inv_r)
     return TransferResult(out, 1, c)
 
 
 def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
     r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
-    inv_r = 1.0 / r
+    inv_r, q = _weights(r, m)
     # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
-    W3 = gauss_transform(x, x, _weights(inv_r, m), sigma, truncation, method, tolerance=tolerance)
-    offdiag = 0.5 * (1.0 + W3[0]) - inv_r  # sum_{j != i} P_ij, since P_ii = W_ii / r_i = 1 / r_i
-    substeps, c = _substeps(beta, offdiag, m != 0)
+    W3 = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
+    offdiag, c, c_all = _offdiag(W3[0], inv_r, m, beta)
+    substeps = _substeps(c)
     if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
-        substeps, c = _substeps(beta, offdiag, np.ones(x.size, dtype=bool))
+        c = c_all
+        substeps = _substeps(c)
     b = beta / substeps
-    keep = 1.0 - b * offdiag  # >= 0 where it matters, by the choice of substeps
     Wm, Wmr = W3[1], W3[2]
     for k in range(substeps):
         if k > 0:
             Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
-        m = _update(m, keep, b, Wm, Wmr, inv_r)
+        m = _update(m, offdiag, b, Wm, Wmr, inv_r)
     return TransferResult(m, substeps, c)
