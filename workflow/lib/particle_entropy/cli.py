@@ -7,7 +7,7 @@ import math
 import sys
 
 from .gauss import FGT_TOLERANCE
-from .runconfig import KERNELS, METHODS, PAPER, RunConfig, SettingError
+from .runconfig import KERNELS, METHODS, PAPER, SCHEMES, TRANSFER_METHODS, RunConfig, SettingError
 
 
 def _truncation(text: str):
@@ -44,12 +44,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=0, help="random seed (>= 0)")
     s.add_argument("--omega", type=float, default=PAPER["omega"], help="particle domain length Omega [L]")
     s.add_argument("--fd-length", type=float, default=PAPER["fd_length"], help="FD domain length [L], centred on 0")
-    s.add_argument("--transfer-method", choices=("auto", "direct", "fgt", "taylor"), default="auto",
+    s.add_argument("--transfer-method", choices=TRANSFER_METHODS, default="auto",
                    help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)")
     s.add_argument("--transfer-tolerance", type=float, default=FGT_TOLERANCE,
                    help="error bound of the fast Gauss transform, relative to the summed |weights| in reach "
                         f"[-] (default {FGT_TOLERANCE:g}: round-off, mass conserved to 1e-13)")
-    s.add_argument("--scheme", choices=("symmetric", "sequential"), default="symmetric",
+    s.add_argument("--scheme", choices=SCHEMES, default="symmetric",
                    help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop")
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
     s.add_argument("--state-out", default=None, help="optional Parquet path for the final state (x, mass, c)")

@@ -284,9 +284,9 @@ def _fgt(y, x, q, sigma, radius, width, terms):
     nk = q.shape[0]
     scale = 1.0 / (math.sqrt(2.0) * sigma)  # kernel = exp(-(Y - X)^2) in scaled units
     # Box geometry is exact: width is k 2^e with a small integer k and origin a multiple of
-    # it, so every centre (b + 1/2) width is a float and centre offsets are exactly d * width. The Hermite
-    # table therefore matches the centres used for moments and evaluation, even when
-    # sigma << |x| (the offsets x - c and y - c are taken in the original units).
+    # it, so every centre (b + 1/2) width is a float and centre offsets are exactly
+    # d * width. The Hermite table therefore matches the centres used for moments and
+    # evaluation, even when sigma << |x| (offsets x - c, y - c are in the original units).
     origin = math.floor(min(x[0], y[0]) / width) * width
     s_starts, s_ids = _boxes(x, origin, width)
     t_starts, t_ids = _boxes(y, origin, width)
@@ -423,7 +423,12 @@ def fgt_error_bound(ratio: float, p: int) -> float:
     a = ratio / math.sqrt(2.0)
     if a >= math.sqrt(p + 1.0):
         return math.inf
-    return 2.0 * 1.09 * _hermite_sum(a) * _tail(a, p)
+    return _bound_prefactor(a) * _tail(a, p)
+
+
+def _bound_prefactor(a: float) -> float:
+    """2 K S(a) of fgt_error_bound, K = 1.09 (Cramer's inequality)."""
+    return 2.0 * 1.09 * _hermite_sum(a)
 
 
 def _hermite_sum(a: float) -> float:
@@ -448,7 +453,7 @@ def fgt_terms(ratio: float, tolerance: float) -> int:
     if not ratio > 0:
         raise ValueError(f"box width ratio must be > 0, got {ratio!r}")
     a = ratio / math.sqrt(2.0)
-    scale = 2.0 * 1.09 * _hermite_sum(a)
+    scale = _bound_prefactor(a)  # once: only the tail depends on p
     p = max(1, math.floor(a * a))  # the tail bound needs a < sqrt(p + 1)
     while scale * _tail(a, p) > tolerance:
         p += 1
