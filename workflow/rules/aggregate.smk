@@ -8,9 +8,11 @@ rule summarise_case:
     input:
         summary_runs,
     output:
-        "results/tables/cases/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{nreal}.parquet",
+        SUMMARY_PATTERN,
     log:
-        "logs/summarise_case/{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}/r~{nreal}.log",
+        f"logs/summarise_case/{CASE_DIR}/r~{{nreal}}.log",
+    params:
+        code=SUMMARY_CODE,
     resources:
         mem_mb=500,
     run:
@@ -19,8 +21,9 @@ rule summarise_case:
 
 
 rule comic_tables:
+    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models."""
     input:
-        comic_summaries(),
+        summaries_of("fig8", "fig9"),
     output:
         comic="results/tables/comic.parquet",
         minima="results/tables/comic_minima.parquet",
@@ -28,6 +31,7 @@ rule comic_tables:
         "logs/comic_tables.log",
     params:
         times=config["comic_times"],
+        code=COMIC_CODE,
     conda:
         "../../envs/particle-entropy.yaml"
     script:
@@ -37,7 +41,7 @@ rule comic_tables:
 rule comic_tables_fig9:
     """Fig. 9's own COMIC table, so that its target pulls no FD run."""
     input:
-        [summary_path(c) for c in figure_cases(config, "fig9")] if "fig9" in FIGURES else [],
+        summaries_of("fig9"),
     output:
         comic="results/tables/fig9/comic.parquet",
         minima="results/tables/fig9/comic_minima.parquet",
@@ -45,6 +49,7 @@ rule comic_tables_fig9:
         "logs/comic_tables_fig9.log",
     params:
         times=config["comic_times"],
+        code=COMIC_CODE,
     conda:
         "../../envs/particle-entropy.yaml"
     script:
@@ -55,8 +60,8 @@ rule paper_claims:
     input:
         minima="results/tables/comic_minima.parquet",
         comic="results/tables/comic.parquet",
-        summaries=[summary_path(c) for f in ("fig3", "fig5") if f in FIGURES for c in figure_cases(config, f)],
-        runs=[run_path(c, config["base_seed"]) for c in figure_cases(config, "fig1")] if "fig1" in FIGURES else [],
+        summaries=summaries_of("fig3", "fig5"),
+        runs=section_inputs("fig1") if "fig1" in FIGURES else [],
     output:
         table="results/tables/paper_claims.parquet",
         md="results/paper_claims.md",
@@ -64,6 +69,8 @@ rule paper_claims:
         "logs/paper_claims.log",
     params:
         claims=config["claims"],
+        case_defaults=config.get("case_defaults", {}),
+        code=CLAIMS_CODE,
     conda:
         "../../envs/particle-entropy.yaml"
     script:
@@ -72,13 +79,14 @@ rule paper_claims:
 
 rule tradeoff_table:
     input:
-        [summary_path(c) for c in spec_cases(config["tradeoff"], config)] if "tradeoff" in config else [],
+        summaries_of("tradeoff"),
     output:
         "results/tables/tradeoff.parquet",
     log:
         "logs/tradeoff_table.log",
     params:
         times=config.get("tradeoff", {}).get("times", []),
+        code=TRADEOFF_CODE,
     conda:
         "../../envs/particle-entropy.yaml"
     script:

@@ -1,33 +1,41 @@
-# Config validation, the sweep table (one row per simulation) and target helpers.
-import math
+# Config validation, the cases of every config section, target helpers and code versions.
 import sys
 from pathlib import Path
 
-import pandas as pd
 from snakemake.utils import validate
 
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
 validate(config, str(Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
 
 from particle_entropy.aggregate import summarise_files  # noqa: E402
+from particle_entropy.case import Case  # noqa: E402
+from particle_entropy.codeversion import code_version  # noqa: E402
+from particle_entropy.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES  # noqa: E402
 from particle_entropy.sweeps import (  # noqa: E402
-    spec_cases,
-    case_runs,
+    CASE_DIR,
+    FIGURE_DATA_PATTERN,
+    FIGURE_READS,
+    PAPER_FIGURES,
+    RUN_PATTERN,
+    SUMMARY_PATTERN,
+    Ensemble,
+    case_run_paths,
     check_sweeps,
-    figure_cases,
+    figure_ensembles,
     run_path,
-    summary_path,
+    run_settings,
+    spec_ensembles,
 )
 
 check_sweeps(config)
-FIGURES = sorted(config["figures"])
+FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
-ALL_FIGURES = [f for f in ["fig1", "fig2", "fig3", "fig4", "fig5", "fig6", "fig7", "fig8", "fig9"] if f in FIGURES]
 
 
 wildcard_constraints:
-    method="pt|mtpt|fd",
-    kernel="bins|fixed|adaptive|collision|sph|implicit|explicit",
+    method="|".join(METHODS),
+    kernel="|".join(ALL_KERNELS),
+    scheme="|".join(SCHEMES),
     n=r"\d+",
     eta=r"[0-9.eE+-]+",
     trunc=r"none|[0-9.eE+-]+",
@@ -35,11 +43,12 @@ wildcard_constraints:
     first=r"\d+",
     last=r"\d+",
     nreal=r"\d+",
+    kind="runs|snapshots",
     fig=r"fig\d+",
 
 
 def all_targets():
-    figs = [f"figures/{f}.{ext}" for f in ALL_FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
+    figs = [f"figures/{f}.{ext}" for f in FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
     if "tradeoff" in config:
         figs += ["figures/tradeoff.png", "figures/tradeoff.pdf", "results/tables/tradeoff.parquet"]
     return figs + [
@@ -50,27 +59,39 @@ def all_targets():
     ]
 
 
-def figure_inputs(fig):
-    """What a figure reads: single runs (Figs. 1, 2), final states (Fig. 7), the COMIC table
-    (Fig. 9) or case summaries (ensemble figures and FD)."""
-    if fig == "fig9":
-        return ["results/tables/fig9/comic.parquet"]
-    cases = figure_cases(config, fig)
-    if config["figures"][fig].get("snapshot"):
-        return [run_path(c, config["base_seed"], kind="snapshots") for c in cases]
-    if fig in ("fig1", "fig2"):
-        return [run_path(c, config["base_seed"]) for c in cases]
-    return [summary_path(c) for c in cases]
+def ensembles(section):
+    """The ensembles of a figure (fig1 ... fig9) or of `tradeoff`."""
+    if section == "tradeoff":
+        return spec_ensembles(config["tradeoff"], config) if "tradeoff" in config else []
+    return figure_ensembles(config, section) if section in config["figures"] else []
+
+
+def section_inputs(section):
+    """What a figure reads, in the order of its cases: single runs, final states, the COMIC
+    table or case summaries (sweeps.FIGURE_READS)."""
+    reads = FIGURE_READS.get(section, "summaries")
+    base = config["base_seed"]
+    if reads == "comic":
+        return [f"results/tables/{section}/comic.parquet"]
+    if reads == "tradeoff":
+        return ["results/tables/tradeoff.parquet"]
+    if reads in ("runs", "snapshots"):
+        return [run_path(e.case, base, kind=reads) for e in ensembles(section)]
+    return [e.summary_path() for e in ensembles(section)]
+
+
+def section_cases(section):
+    """The cases of a section as wildcard dicts (a plot rule's parameter)."""
+    return [e.case.wildcards() for e in ensembles(section)]
 
 
 def summary_runs(wildcards):
     """The run tables that one case summary averages."""
-    return case_runs(wildcards, config)
+    return case_run_paths(Ensemble.from_wildcards(wildcards), config)
 
 
-def comic_summaries():
-    """Case summaries of the COMIC models: FD (Fig. 8) and the MTPT models of Fig. 9."""
-    return [summary_path(c) for f in ("fig8", "fig9") if f in FIGURES for c in figure_cases(config, f)]
+def summaries_of(*sections):
+    return [e.summary_path() for s in sections for e in ensembles(s)]
 
 
 def sim_mem_mb(wildcards):
@@ -82,9 +103,22 @@ def sim_runtime_min(wildcards):
     return seeds * (2 if int(wildcards.n) <= 3000 else 10)
 
 
-def first_step(wildcards):
-    """FD runs use their own fixed step (Fig. 8); particle runs start at dt0, or take the
-    fixed step time.fixed_dt when their growth factor is 1."""
-    if wildcards.method == "fd":
-        return config["time"]["fd_dt"]
-    return config["time"]["fixed_dt"] if float(wildcards.growth) == 1.0 else config["time"]["dt0"]
+def sim_settings(wildcards):
+    """Physics and numerics of a run (config.physics, config.time, config.numerics)."""
+    return run_settings(Case.from_wildcards(wildcards), config)
+
+
+# The code each task runs (its script, the library modules it uses and what they import), hashed:
+# a rule reruns when, and only when, the content of its code changes (params rerun trigger).
+SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
+SIM_CODE = {
+    m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"])
+    for m in METHODS
+}
+SUMMARY_CODE = code_version("aggregate")  # summarise_case's two-line run: block calls aggregate
+COMIC_CODE = code_version("aggregate", "io", files=[SCRIPTS / "comic_tables.py"])
+TRADEOFF_CODE = code_version("aggregate", "io", files=[SCRIPTS / "tradeoff_table.py"])
+CLAIMS_CODE = code_version("claims", "io", files=[SCRIPTS / "paper_claims.py"])
+PLOT_CODE = code_version("plots", "io", files=[SCRIPTS / "plot_figure.py"])
+SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
+SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])

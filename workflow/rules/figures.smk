@@ -1,38 +1,32 @@
-# One rule per figure: tables in, figures/figNN.png and .pdf out. Restyling reruns no simulation.
+# One rule per figure: tables in; figures/<fig>.png and .pdf and the plotted data
+# (results/figures/<fig>.parquet) out. Restyling reruns no simulation.
 
-for _fig in ALL_FIGURES:
+for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
 
     rule:
         name:
             f"plot_{_fig}"
         input:
-            figure_inputs(_fig),
+            section_inputs(_fig),
         output:
-            png=report(f"figures/{_fig}.png", caption=f"../report/{_fig}.rst", category="Figures"),
+            png=report(
+                f"figures/{_fig}.png",
+                caption=f"../report/{_fig}.rst",
+                category="Speed and accuracy" if _fig == "tradeoff" else "Figures",
+            ),
             pdf=f"figures/{_fig}.pdf",
+            data=FIGURE_DATA_PATTERN.format(fig=_fig),
         log:
             f"logs/plot/{_fig}.log",
         params:
             fig=_fig,
+            cases=section_cases(_fig),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
+            code=PLOT_CODE,
         resources:
             mem_mb=1000,
         conda:
             "../../envs/particle-entropy.yaml"
         script:
             "../scripts/plot_figure.py"
-
-
-rule plot_tradeoff:
-    input:
-        "results/tables/tradeoff.parquet",
-    output:
-        png=report("figures/tradeoff.png", caption="../report/tradeoff.rst", category="Speed and accuracy"),
-        pdf="figures/tradeoff.pdf",
-    log:
-        "logs/plot/tradeoff.log",
-    conda:
-        "../../envs/particle-entropy.yaml"
-    script:
-        "../scripts/plot_tradeoff.py"

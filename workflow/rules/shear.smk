@@ -1,6 +1,6 @@
 # Fig. 10 (Appendix B): 2-D shear flow, one job per case, then the figure.
 
-SHEAR_PARAMS = ["n", "length", "strip_lo", "strip_hi", "alpha_L", "alpha_T", "dt", "t_final"]
+SHEAR_PARAMS = ["n", "length", "strip_lo", "strip_hi", "alpha_L", "alpha_T", "beta", "dt", "t_final"]
 
 
 rule simulate_shear:
@@ -12,9 +12,10 @@ rule simulate_shear:
     benchmark:
         "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
     wildcard_constraints:
-        case="rw_nodrift|rw_drift|mt",
+        case="|".join(SHEAR_CASES),
     params:
-        **{k: config["shear"][k] for k in SHEAR_PARAMS},
+        **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
+        code=SHEAR_CODE,
     resources:
         mem_mb=2000,
         runtime=10,
@@ -30,8 +31,11 @@ rule plot_fig10:
     output:
         png=report("figures/fig10.png", caption="../report/fig10.rst", category="Figures"),
         pdf="figures/fig10.pdf",
+        data=FIGURE_DATA_PATTERN.format(fig="fig10"),
     log:
         "logs/plot/fig10.log",
+    params:
+        code=SHEAR_PLOT_CODE,
     resources:
         mem_mb=2000,
     conda:

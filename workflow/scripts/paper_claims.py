@@ -11,9 +11,10 @@ import pandas as pd  # noqa: E402
 from particle_entropy import claims as C  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 
-inp, tol = snakemake.input, snakemake.params.claims  # noqa: F821
-rows = C.single_run_claims([pd.read_parquet(p) for p in inp.runs])
-rows += C.ensemble_claims([pd.read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]))
+inp, par = snakemake.input, snakemake.params  # noqa: F821
+tol, defaults = par.claims, par.case_defaults
+rows = C.single_run_claims([pd.read_parquet(p) for p in inp.runs], defaults)
+rows += C.ensemble_claims([pd.read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]), defaults)
 rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), tol)
 claims = pd.DataFrame(rows)
 write_parquet(claims, snakemake.output.table)  # noqa: F821

@@ -1,4 +1,4 @@
-"""Draw one paper figure from its tables."""
+"""Draw one figure from its tables; write the figure and the data it plots (source data)."""
 
 import sys
 
@@ -11,20 +11,13 @@ matplotlib.use("Agg")
 import pandas as pd  # noqa: E402
 
 from particle_entropy import plots  # noqa: E402
+from particle_entropy.case import Case  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
 
-fig_name = snakemake.params.fig  # noqa: F821
+par, out = snakemake.params, snakemake.output  # noqa: F821
 tables = [pd.read_parquet(p) for p in snakemake.input]  # noqa: F821
-D, t_final = float(snakemake.params.D), float(snakemake.params.t_final)  # noqa: F821
-draw = {
-    "fig1": lambda: plots.fig1(tables),
-    "fig2": lambda: plots.fig2(tables),
-    "fig3": lambda: plots.fig3(tables),
-    "fig4": lambda: plots.fig4(tables),
-    "fig5": lambda: plots.fig5(tables),
-    "fig6": lambda: plots.fig6(tables, D=D),
-    "fig7": lambda: plots.fig7(tables, D=D, t=t_final),
-    "fig8": lambda: plots.fig8(tables),
-    "fig9": lambda: plots.fig9(tables[0], time=t_final),
-}[fig_name]
-plots.save_figure(draw(), snakemake.output.png, snakemake.output.pdf)  # noqa: F821
-print(f"drew {fig_name} from {len(tables)} tables", file=sys.stderr)
+cases = [Case.from_wildcards(c) for c in par.cases]
+figure, data = plots.FIGURES[par.fig](tables, cases, D=float(par.D), t_final=float(par.t_final))
+plots.save_figure(figure, out.png, out.pdf)
+write_parquet(data, out.data)
+print(f"drew {par.fig}: {len(cases)} cases from {len(tables)} tables, {len(data)} plotted points", file=sys.stderr)

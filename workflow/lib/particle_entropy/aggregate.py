@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table
 from .measures import comic
 
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
@@ -55,30 +56,17 @@ def summarise_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
     df = pd.DataFrame(out)
     for c in ["H_C_analytic", "E_analytic", "dV", "n_sse", "settled"]:
         df[c] = first[c].to_numpy()
-    for c in ["method", "kernel", "n", "eta", "truncation", "dt_growth", "D"]:
-        df[c] = first[c].iloc[0]
+    for c, v in {**case_of_table(first).columns(), "D": first["D"].iloc[0]}.items():
+        df[c] = v
     return df
 
 
-def model_name(method: str, kernel: str, eta: float, truncation: float = np.inf,
-               dt_growth: float | None = None, default_growth: float = 1.05) -> str:
-    """Human name of a model, e.g. 'mtpt collision eta=1', 'mtpt sph eta=1 trunc=3' or 'fd'."""
-    if method == "fd":
-        return "fd" if kernel == "implicit" else f"fd {kernel}"
-    name = f"pt {kernel}" if method == "pt" else f"{method} {kernel} eta={eta:g}"
-    if method == "mtpt" and np.isfinite(truncation):
-        name += f" trunc={truncation:g}"
-    if dt_growth is not None and dt_growth != default_growth:
-        name += f" growth={dt_growth:g}"
-    return name
-
-
 def _case_rows(summaries: list[pd.DataFrame], times: list[float]):
-    """(summary row, its case columns) for every summary at every requested time."""
+    """(summary row, its label and case columns, time) for every summary at every requested time."""
     for s in summaries:
+        case = case_of_table(s)
         for _, r in at_times(s, times).iterrows():
-            yield r, {"method": r["method"], "kernel": r["kernel"], "eta": float(r["eta"]), "n": int(r["n"]),
-                      "time": float(r["time_requested"])}
+            yield r, {"label": case.label(n=False), **case.columns(), "time": float(r["time_requested"])}
 
 
 def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
@@ -86,8 +74,7 @@ def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.Data
     rows = []
     for r, case in _case_rows(summaries, times):
         rows.append({
-            "model": model_name(r["method"], r["kernel"], r["eta"], r["truncation"], r["dt_growth"]),
-            **case, "truncation": float(r["truncation"]), "dt_growth": float(r["dt_growth"]),
+            **case,
             "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
             "work": r["work_mean"], "peak_rss_mb": r["peak_rss_mb_max"],
             "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
@@ -97,8 +84,8 @@ def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.Data
             "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
             "n_realisations": int(r["n_realisations"]),
         })
-    df = pd.DataFrame(rows).sort_values(["model", "time", "n"], ignore_index=True)
-    best = df.groupby(["model", "time"])["COMIC_mean"].transform("min")
+    df = _sorted(pd.DataFrame(rows))
+    best = df.groupby([*MODEL_COLUMNS, "time"])["COMIC_mean"].transform("min")
     df["is_comic_optimum"] = df["COMIC_mean"] == best
     return df
 
@@ -117,17 +104,24 @@ def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFra
     rows = []
     for r, case in _case_rows(summaries, times):
         rows.append({
-            "model": model_name(r["method"], r["kernel"], r["eta"]),
             **case, "time_step": float(r["time"]),
             "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
             **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
             "SSE_mean": r["SSE_mean"], "SSE_std": r["SSE_std"],
             "n_realisations": int(r["n_realisations"]),
         })
-    cols = ["model", "method", "kernel", "eta", "n", "time", "time_step", "COMIC_mean", "COMIC_std",
+    cols = ["label", *CASE_COLUMNS, "time", "time_step", "COMIC_mean", "COMIC_std",
             "COMIC_of_mean_SSE", "COMIC_of_mean_SSE_lo", "COMIC_of_mean_SSE_hi",
             "SSE_mean", "SSE_std", "n_realisations"]
-    return pd.DataFrame(rows, columns=cols).sort_values(["model", "time", "n"], ignore_index=True)
+    return _sorted(pd.DataFrame(rows, columns=cols))
+
+
+def _sorted(df: pd.DataFrame) -> pd.DataFrame:
+    """Rows ordered by model (registry order), time and N."""
+    if df.empty:
+        return df
+    parts = [g.sort_values(["time", "n"]) for _, g in by_model(df)]
+    return pd.concat(parts, ignore_index=True)
 
 
 def comic_of_mean_sse(sse_mean: float, sse_std: float, n: int, dV: float) -> dict:
@@ -143,19 +137,24 @@ def comic_of_mean_sse(sse_mean: float, sse_std: float, n: int, dV: float) -> dic
 def comic_minima(comic: pd.DataFrame) -> pd.DataFrame:
     """For each model and time: the N minimising mean COMIC, its COMIC, and its neighbours' values."""
     rows = []
-    for (model, time), g in comic.groupby(["model", "time"], sort=True):
-        g = g.sort_values("n", ignore_index=True)
-        k = int(np.argmin(g["COMIC_mean"].to_numpy()))
-        below = g.iloc[k - 1] if k > 0 else None
-        above = g.iloc[k + 1] if k + 1 < len(g) else None
-        rows.append({
-            "model": model, "time": time, "n_opt": int(g["n"][k]),
-            "COMIC_opt": g["COMIC_mean"][k], "COMIC_opt_std": g["COMIC_std"][k],
-            "n_opt_of_mean_SSE": int(g["n"][int(np.argmin(g["COMIC_of_mean_SSE"].to_numpy()))]),
-            "n_below": int(below["n"]) if below is not None else -1,
-            "COMIC_below": below["COMIC_mean"] if below is not None else np.nan,
-            "n_above": int(above["n"]) if above is not None else -1,
-            "COMIC_above": above["COMIC_mean"] if above is not None else np.nan,
-            "interior": below is not None and above is not None,
-        })
+    for model, rows_of_model in by_model(comic):
+        for time, g in rows_of_model.groupby("time", sort=True):
+            rows.append(_minimum(model, time, g.sort_values("n", ignore_index=True)))
     return pd.DataFrame(rows)
+
+
+def _minimum(model, time: float, g: pd.DataFrame) -> dict:
+    """The minimum of mean COMIC over N (rows ``g`` sorted by N) and its neighbours."""
+    k = int(np.argmin(g["COMIC_mean"].to_numpy()))
+    below = g.iloc[k - 1] if k > 0 else None
+    above = g.iloc[k + 1] if k + 1 < len(g) else None
+    return {
+        "label": model.label(), **model.columns(), "time": time, "n_opt": int(g["n"][k]),
+        "COMIC_opt": g["COMIC_mean"][k], "COMIC_opt_std": g["COMIC_std"][k],
+        "n_opt_of_mean_SSE": int(g["n"][int(np.argmin(g["COMIC_of_mean_SSE"].to_numpy()))]),
+        "n_below": int(below["n"]) if below is not None else -1,
+        "COMIC_below": below["COMIC_mean"] if below is not None else np.nan,
+        "n_above": int(above["n"]) if above is not None else -1,
+        "COMIC_above": above["COMIC_mean"] if above is not None else np.nan,
+        "interior": below is not None and above is not None,
+    }

@@ -31,10 +31,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
+
 CUTOFF_SIGMAS = 9.0
 P_TERMS = 24
-FGT_TOLERANCE = 1e-17
-FGT_TOLERANCE_RANGE = (1e-30, 0.1)
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
 # mean fewer translations (each p^2) but more terms p. A translation's term pair costs about
 # as much as a particle's term (benchmarks/bench_transfer.py --boxes).
@@ -540,3 +540,11 @@ def gauss_transform(
     else:
         raise ValueError(f"method must be 'auto', 'direct', 'fgt' or 'taylor', got {method!r}")
     return out[0] if squeeze else out
+
+
+def warm_up() -> None:
+    """Load the compiled transforms (numba's on-disk cache) for transfers and reconstructions."""
+    x = np.linspace(-1.0, 1.0, 64)
+    for m in ("direct", "fgt"):
+        gauss_transform(x, x, np.ones((3, x.size)), 0.5, method=m)  # transfer: targets = sources
+        gauss_transform(x[::2], x, np.ones((1, x.size)), 0.5, method=m)  # reconstructions, near mass

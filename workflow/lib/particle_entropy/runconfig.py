@@ -1,4 +1,4 @@
-"""One simulation's settings, their defaults (the paper's, experiments.md) and their checks."""
+"""One simulation's settings (a Case plus physics and numerics), their defaults and checks."""
 
 from __future__ import annotations
 
@@ -8,32 +8,16 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .gauss import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
-
-METHODS = ("pt", "mtpt", "fd")
-KERNELS = {"pt": ("bins", "fixed", "adaptive"), "mtpt": ("collision", "sph"), "fd": ("implicit", "explicit")}
-DEFAULT_KERNEL = {"pt": "bins", "mtpt": "collision", "fd": "implicit"}
-TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
-SCHEMES = ("symmetric", "sequential")
-
-PAPER = {
-    "D": 1e-3,  # diffusion coefficient [L^2/T]
-    "t_final": 1000.0,  # [T]
-    "dt0": 0.01,  # first step [T]
-    "dt_growth": 1.05,  # dt_{n+1} = growth * dt_n
-    "omega": 10.0,  # particle domain length, positions on [-omega/2, omega/2] [L]
-    "fd_length": 12.0,  # FD domain [-6, 6] [L]
-    "fd_dt": 0.05,  # FD fixed step [T]
-    "fixed_kernel_time": 1.0,  # fixed PT kernel has variance 2 D x this time [T]
-}
+from .case import Case, SettingError
+from .registry import (DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, KERNELS, METHODS, PAPER, SCHEMES,
+                       TRANSFER_METHODS)
 
 
-class SettingError(ValueError):
-    """A setting outside its allowed range; the message names setting, value and range."""
-
-    def __init__(self, name: str, value, allowed: str):
-        super().__init__(f"{name}={value!r} is not allowed: {allowed}")
-        self.name = name
+def first_step(method: str, dt_growth: float, dt0: float, fd_dt: float, fixed_dt: float) -> float:
+    """The first time step: FD its fixed fd_dt; particles dt0, or fixed_dt when the step is fixed."""
+    if method == "fd":
+        return fd_dt
+    return fixed_dt if dt_growth == 1.0 else dt0
 
 
 @dataclass(frozen=True)
@@ -44,23 +28,36 @@ class RunConfig:
     eta: float = 1.0
     D: float = PAPER["D"]
     t_final: float = PAPER["t_final"]
-    dt0: float | None = None  # None: the paper's (0.01 for particles, 0.05 for FD)
+    dt0: float | None = None  # None: first_step() with the paper's dt0, fd_dt, fixed_dt
     dt_growth: float | None = None  # None: 1.05 for particles, 1 (fixed) for FD
     truncation: float | None = None  # None: whole Gaussian; else kernel widths
     seed: int = 0
     omega: float = PAPER["omega"]
     fd_length: float = PAPER["fd_length"]
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
-    transfer_method: str = "auto"
-    transfer_tolerance: float = FGT_TOLERANCE  # FGT error <= this x sum of |weights| in reach
-    scheme: str = "symmetric"  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
+    transfer_method: str = PAPER["transfer_method"]
+    transfer_tolerance: float = PAPER["transfer_tolerance"]  # FGT error <= this x sum of |weights| in reach
+    scheme: str = PAPER["scheme"]  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
+
+    @classmethod
+    def for_case(cls, case: Case, **settings) -> "RunConfig":
+        """The run of ``case`` (which must have an N) with physics and numerics ``settings``."""
+        return cls(method=case.method, kernel=case.kernel, n=case.n, eta=case.eta, truncation=case.truncation,
+                   dt_growth=case.dt_growth, scheme=case.scheme, **settings)
+
+    @property
+    def case(self) -> Case:
+        """The case this run simulates (call on a resolved config)."""
+        return Case(self.method, self.kernel, int(self.n), float(self.eta), self.truncation,
+                    float(self.dt_growth), self.scheme)
 
     def resolved(self) -> "RunConfig":
         """Fill method-dependent defaults and check every setting."""
         kernel = self.kernel if self.kernel is not None else DEFAULT_KERNEL.get(self.method)
         fd = self.method == "fd"
-        dt0 = self.dt0 if self.dt0 is not None else (PAPER["fd_dt"] if fd else PAPER["dt0"])
         growth = self.dt_growth if self.dt_growth is not None else (1.0 if fd else PAPER["dt_growth"])
+        dt0 = self.dt0 if self.dt0 is not None else first_step(self.method, growth, PAPER["dt0"], PAPER["fd_dt"],
+                                                               PAPER["fixed_dt"])
         cfg = RunConfig(**{**asdict(self), "kernel": kernel, "dt0": dt0, "dt_growth": growth})
         cfg.check()
         return cfg
@@ -101,6 +98,7 @@ class RunConfig:
                 )
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
+        self.case  # noqa: B018 -- dimensions that do not apply to the method must be neutral
         if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:
             raise SettingError("transfer_method", self.transfer_method,
                                "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)")
@@ -112,17 +110,7 @@ class RunConfig:
 
     def case_columns(self) -> dict:
         """The case parameters written beside every row of a result table."""
-        return {
-            "method": self.method,
-            "kernel": self.kernel,
-            "n": int(self.n),
-            "eta": float(self.eta),
-            "D": float(self.D),
-            "truncation": float(self.truncation) if self.truncation is not None else math.inf,
-            "dt_growth": float(self.dt_growth),
-            "scheme": self.scheme,
-            "seed": int(self.seed),
-        }
+        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed)}
 
 
 def check_range(name, value, lo, hi, open_low=False):

@@ -46,18 +46,9 @@ _WARM: set = set()
 def warm_up(method: str) -> None:
     """Load the compiled kernels a method uses (numba's on-disk cache, ~0.1-0.4 s once per
     process) before the timed steps, so that step 1's wall time is the step's own."""
-    if method in _WARM:
-        return
-    from .gauss import gauss_transform
-
-    x = np.linspace(-1.0, 1.0, 64)
-    if method == "fd":
-        fd.ImplicitSolver(8, 0.1).solve(np.ones(8))
-    else:
-        for m in ("direct", "fgt"):
-            gauss_transform(x, x, np.ones((3, x.size)), 0.5, method=m)  # transfer: targets = sources
-            gauss_transform(x[::2], x, np.ones((1, x.size)), 0.5, method=m)  # reconstructions, near mass
-    _WARM.add(method)
+    if method not in _WARM:
+        {"pt": pt, "mtpt": mtpt, "fd": fd}[method].warm_up()
+        _WARM.add(method)
 
 
 def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:
@@ -101,7 +92,6 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
         c[1:-1] = solvers[dt].solve(c[1:-1])
         _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
     return {"x": x, "c": c}
-
 
 
 def run_seeds(cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False) -> pd.DataFrame:

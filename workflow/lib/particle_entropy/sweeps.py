@@ -1,106 +1,143 @@
-"""Expand the workflow config into cases and run paths (no Snakemake needed; tested directly).
+"""Expand the workflow config into ensembles (a Case and its realisation count) and their paths.
 
-A case is one model setting (method, kernel, N, eta, truncation, dt growth) with the number
-of realisations a figure averages; its runs are realisations r = 0 .. count-1, seeded
-base_seed + r. Small-N realisations are run in blocks of seeds (one job, one table with a
-`seed` column) to amortise job start-up; each seed's random stream depends only on the seed,
-so the blocking never changes a result. Paths hold parameters as written in config, so file
-names stay stable.
+Every config section that lists cases (each figure, the trade-off sweep) is expanded the same
+way: cases x n, dimensions a case leaves unset from ``case_defaults``. Realisation r of a
+case is seeded base_seed + r; small-N realisations run in blocks of seeds (one job, one table
+with a `seed` column) to amortise job start-up. Each seed's random stream depends only on the
+seed, so the blocking never changes a result. Paths hold parameters as written in config, so
+file names stay stable. No Snakemake needed: tested directly.
 """
 
 from __future__ import annotations
 
-RUN_DIR = "{method}/{kernel}/n~{n}/eta~{eta}/trunc~{trunc}/growth~{growth}"
-RUN_PATTERN = "results/{kind}/" + RUN_DIR + "/seeds~{first}-{last}.parquet"
-SUMMARY_PATTERN = "results/tables/cases/" + RUN_DIR + "/r~{nreal}.parquet"
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+from .case import CASE_DIR, Case, SettingError
+from .registry import PAPER
+from .runconfig import RunConfig, first_step
+
+RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
+SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
+FIGURE_DATA_PATTERN = "results/figures/{fig}.parquet"
+PAPER_FIGURES = tuple(f"fig{k}" for k in range(1, 10))  # the case-drawn figures; fig10 is the shear flow
+# What each case section's figure reads: single runs of base_seed, final states, its own COMIC
+# table, the trade-off table; every other figure reads case summaries (ensemble statistics).
+FIGURE_READS = {"fig1": "runs", "fig2": "runs", "fig7": "snapshots", "fig9": "comic", "tradeoff": "tradeoff"}
+# config.physics / config.time keys -> RunConfig settings shared by every case
+PHYSICS = ("D", "t_final", "omega", "fd_length", "fixed_kernel_time")
+NUMERICS = ("transfer_method", "transfer_tolerance")
 
 
-def _text(value) -> str:
-    """A config value as it appears in a file name: 1 -> '1', 0.5 -> '0.5', 'none' -> 'none'."""
-    if isinstance(value, float) and value.is_integer():
-        return str(int(value))
-    return str(value)
+@dataclass(frozen=True)
+class Ensemble:
+    """A case and the number of realisations a figure or table averages."""
+
+    case: Case
+    realisations: int
+
+    @classmethod
+    def from_wildcards(cls, w: Mapping) -> "Ensemble":
+        return cls(Case.from_wildcards(w), int(w["nreal"]))
+
+    def summary_path(self) -> str:
+        return SUMMARY_PATTERN.format(nreal=self.realisations, **self.case.wildcards())
 
 
-def realisations_for(spec: dict, n: int, config: dict) -> int:
-    """Realisations of one N in a figure: an integer, or the `realisations` table (capped)."""
+def run_path(case: Case, first: int, last: int | None = None, kind: str = "runs") -> str:
+    """Table of seeds first..last of ``case`` (kind: runs = per-step tables, snapshots = final states)."""
+    return RUN_PATTERN.format(kind=kind, first=first, last=first if last is None else last, **case.wildcards())
+
+
+def case_sections(config: Mapping) -> dict[str, Mapping]:
+    """Every config section that lists cases, by name: each figure, and `tradeoff`."""
+    out = {f"figures.{fig}": spec for fig, spec in config.get("figures", {}).items()}
+    if "tradeoff" in config:
+        out["tradeoff"] = config["tradeoff"]
+    return out
+
+
+def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
+    """Realisations of one N in a section: an integer, or the `realisations` table (capped)."""
     r = spec.get("realisations", 1)
     if r == "ensemble":
         table = {int(e["n"]): int(e["count"]) for e in config["realisations"]}
         if n not in table:
-            raise ValueError(f"figure uses realisations: ensemble but realisations has no entry for n={n}")
+            raise SettingError("n", n, "a particle number listed in `realisations` (the section uses "
+                                        "realisations: ensemble); add {n: %d, count: ...} there" % n)
         r = table[n]
         if "max_realisations" in spec:
             r = min(r, int(spec["max_realisations"]))
     return int(r)
 
 
-def figure_cases(config: dict, fig: str) -> list[dict]:
-    """Every case of a figure, with wildcard values as strings and its realisation count."""
-    return spec_cases(config["figures"][fig], config)
-
-
-def spec_cases(spec: dict, config: dict) -> list[dict]:
-    """Every case of a sweep spec (cases x n), with wildcard values as strings."""
+def spec_ensembles(spec: Mapping, config: Mapping) -> list[Ensemble]:
+    """Every case of a section (its cases x its n), with realisation counts; FD, being
+    deterministic, runs once whatever the ensemble size."""
     defaults = config.get("case_defaults", {})
-    cases = []
+    out = []
     for c in spec["cases"]:
-        fd = c["method"] == "fd"
         for n in spec["n"]:
-            cases.append({
-                "method": c["method"],
-                "kernel": c["kernel"],
-                "n": str(int(n)),
-                "eta": _text(c.get("eta", 1 if fd else defaults.get("eta", 1))),
-                "trunc": _text(c.get("truncation", "none" if fd else defaults.get("truncation", "none"))),
-                "growth": _text(c.get("dt_growth", 1 if fd else defaults.get("dt_growth", config["time"]["dt_growth"]))),
-                # FD is deterministic: one realisation whatever the ensemble size
-                "nreal": "1" if fd else str(realisations_for(spec, int(n), config)),
-            })
-    return cases
+            case = Case.from_spec(c, int(n), defaults)
+            out.append(Ensemble(case, 1 if case.method == "fd" else realisations_for(spec, int(n), config)))
+    return out
 
 
-def seed_blocks(case: dict, config: dict) -> list[tuple[int, int]]:
-    """Inclusive seed ranges of the jobs behind a case: blocks aligned to multiples of the
+def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
+    return spec_ensembles(config["figures"][fig], config)
+
+
+def seed_blocks(ens: Ensemble, config: Mapping) -> list[tuple[int, int]]:
+    """Inclusive seed ranges of the jobs behind an ensemble: blocks aligned to multiples of the
     block size (config seed_blocks.size, for N <= seed_blocks.max_n; else one seed a job)."""
     blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
-    size = int(blocks["size"]) if int(case["n"]) <= int(blocks["max_n"]) else 1
-    base, count = int(config["base_seed"]), int(case["nreal"])
+    size = int(blocks["size"]) if ens.case.n <= int(blocks["max_n"]) else 1
+    base, count = int(config["base_seed"]), ens.realisations
     return [(base + r, base + min(r + size, count) - 1) for r in range(0, count, size)]
 
 
-def run_path(case: dict, first: int, last: int | None = None, kind: str = "runs") -> str:
-    """Table of seeds first..last of ``case`` (kind: runs = per-step tables, snapshots = final states)."""
-    return RUN_PATTERN.format(kind=kind, first=first, last=first if last is None else last, **case)
+def case_run_paths(ens: Ensemble, config: Mapping) -> list[str]:
+    """Every run table behind an ensemble."""
+    return [run_path(ens.case, a, b) for a, b in seed_blocks(ens, config)]
 
 
-def case_run_paths(case: dict, config: dict) -> list[str]:
-    """Every run table behind a case."""
-    return [run_path(case, a, b) for a, b in seed_blocks(case, config)]
+def run_settings(case: Case, config: Mapping) -> dict:
+    """Physics and numerics of a run of ``case`` from config (its first step by first_step)."""
+    physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
+    out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
+    out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
+    out["dt0"] = float(first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"],
+                                  time.get("fixed_dt", PAPER["fixed_dt"])))
+    return out
 
 
-def summary_path(case: dict) -> str:
-    return SUMMARY_PATTERN.format(**case)
+def run_config(case: Case, config: Mapping, seed: int = 0) -> RunConfig:
+    """The checked RunConfig of one realisation of ``case``."""
+    return RunConfig.for_case(case, seed=seed, **run_settings(case, config)).resolved()
 
 
-def case_runs(wildcards, config: dict) -> list[str]:
-    """Run tables behind one case summary (wildcards: a case plus its realisation count)."""
-    return case_run_paths({k: wildcards[k] for k in ("method", "kernel", "n", "eta", "trunc", "growth", "nreal")}, config)
-
-
-def check_sweeps(config: dict) -> None:
-    """Semantic checks the JSON schema cannot express; the message names the key and value."""
-    allowed = {"pt": {"bins", "fixed", "adaptive"}, "mtpt": {"collision", "sph"}, "fd": {"implicit", "explicit"}}
-    for fig, spec in config["figures"].items():
+def check_sweeps(config: Mapping) -> None:
+    """Checks the JSON schema cannot express, before any job runs: every case of every section
+    must build a valid run (kernel for its method, dimensions that apply, FD grids, explicit
+    FD stability, an ensemble size for each N). The message names the section, key and value."""
+    for name, spec in case_sections(config).items():
         for i, c in enumerate(spec["cases"]):
-            if c["kernel"] not in allowed[c["method"]]:
-                raise ValueError(
-                    f"figures.{fig}.cases[{i}].kernel={c['kernel']!r} is not allowed for method "
-                    f"{c['method']!r}: one of {sorted(allowed[c['method']])}"
-                )
-            if c["method"] == "fd":
+            where = f"{name}.cases[{i}]"
+            try:
                 for n in spec["n"]:
-                    if int(n) % 2:
-                        raise ValueError(f"figures.{fig}.n={n} is not allowed for fd: an even number of intervals")
+                    case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
+                    run_config(case, config)
+            except SettingError as e:
+                raise SettingError(f"{where}.{e.name}", e.value, e.allowed) from None
         for n in spec["n"]:
-            realisations_for(spec, int(n), config)
+            try:
+                realisations_for(spec, int(n), config)
+            except SettingError as e:
+                raise SettingError(f"{name}.n", n, e.allowed) from None
+    t_final = float(config["physics"]["t_final"])
+    for key, times in (("comic_times", config.get("comic_times", [])),
+                       ("tradeoff.times", config.get("tradeoff", {}).get("times", []))):
+        for t in times:
+            if not (math.isfinite(float(t)) and 0 <= float(t) <= t_final):
+                raise SettingError(key, t, f"a time in [0, physics.t_final = {t_final:g}]")

@@ -1,0 +1,239 @@
+"""The one identity of a simulated model: a ``Case`` builds its path, its table columns, its
+legend label, and is rebuilt from a config spec, from wildcards or from a table row.
+
+A case is every dimension a user may sweep: method, kernel, N, eta, truncation, dt growth and
+scheme. With ``n=None`` it is a *model* (the same case at every N), the key COMIC tables,
+minima and figure panels group by. Dimensions that do not apply to a method hold a neutral
+value (FD: eta 1, whole kernel, fixed step, symmetric; PT: eta 1, whole kernel, symmetric),
+and a config that sets them otherwise is refused.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Iterator, Mapping
+
+import pandas as pd
+
+from .registry import KERNELS, METHODS, PAPER, SCHEMES
+
+# Case field -> (wildcard name, path segment); the path of a case is these segments in order.
+PATH_SEGMENTS = {
+    "method": ("method", "{}"),
+    "kernel": ("kernel", "{}"),
+    "n": ("n", "n~{}"),
+    "eta": ("eta", "eta~{}"),
+    "truncation": ("trunc", "trunc~{}"),
+    "dt_growth": ("growth", "growth~{}"),
+    "scheme": ("scheme", "scheme~{}"),
+}
+CASE_DIR = "/".join(seg.format("{" + w + "}") for w, seg in PATH_SEGMENTS.values())
+MODEL_COLUMNS = ("method", "kernel", "eta", "truncation", "dt_growth", "scheme")
+CASE_COLUMNS = ("method", "kernel", "n", "eta", "truncation", "dt_growth", "scheme")
+COLUMN_DOCS = {
+    "method": "pt (random walks), mtpt (mass transfer) or fd (finite differences)",
+    "kernel": "pt: bins | fixed | adaptive; mtpt: collision | sph; fd: implicit | explicit",
+    "n": "particles (FD: intervals)",
+    "eta": "fraction of D by mass transfer (PT, FD: 1)",
+    "truncation": "transfer kernel cut at this many kernel widths; inf = whole Gaussian",
+    "dt_growth": "time-step growth factor dt_{k+1} / dt_k (1: fixed step)",
+    "scheme": "symmetric (Eqs. 16-21) or sequential (the authors' pairwise loop)",
+}
+KERNEL_NAMES = {"bins": "binned", "fixed": "fixed kernel", "adaptive": "adaptive kernel",
+                "collision": "collision", "sph": "SPH", "implicit": "implicit", "explicit": "explicit"}
+# Which dimensions apply to which method; the others hold NEUTRAL values.
+APPLIES = {
+    "eta": ("mtpt",),
+    "truncation": ("mtpt",),
+    "dt_growth": ("pt", "mtpt"),
+    "scheme": ("mtpt",),
+}
+NEUTRAL = {"eta": 1.0, "truncation": None, "dt_growth": 1.0, "scheme": "symmetric"}
+DEFAULT = type("Default", (), {"__repr__": lambda self: "DEFAULT"})()  # an unset dimension
+
+
+class SettingError(ValueError):
+    """A setting outside its allowed range; the message names setting, value and range."""
+
+    def __init__(self, name: str, value, allowed: str):
+        super().__init__(f"{name}={value!r} is not allowed: {allowed}")
+        self.name, self.value, self.allowed = name, value, allowed
+
+
+def _number(name: str, value, lo: float, hi: float = math.inf, open_low: bool = False) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    v = float(value) if ok else math.nan
+    if not math.isfinite(v) or (v <= lo if open_low else v < lo) or v > hi:
+        rng = f"{'>' if open_low else '>='} {lo:g}" + ("" if hi == math.inf else f" and <= {hi:g}")
+        raise SettingError(name, value, f"a finite number {rng}")
+    return v
+
+
+def text(value) -> str:
+    """A value as it appears in a path: 1.0 -> '1', 0.5 -> '0.5', None -> 'none'."""
+    if value is None:
+        return "none"
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return str(value)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One simulated model at one N (``n=None``: the model at every N)."""
+
+    method: str
+    kernel: str
+    n: int | None = None
+    eta: float = DEFAULT  # DEFAULT: the paper's value where it applies, else the neutral one
+    truncation: float | None = DEFAULT
+    dt_growth: float = DEFAULT
+    scheme: str = DEFAULT
+
+    def __post_init__(self):
+        if self.method not in METHODS:
+            raise SettingError("method", self.method, f"one of {', '.join(METHODS)}")
+        for dim, methods in APPLIES.items():
+            if getattr(self, dim) is DEFAULT:
+                object.__setattr__(self, dim, PAPER[dim] if self.method in methods else NEUTRAL[dim])
+        if self.kernel not in KERNELS[self.method]:
+            raise SettingError("kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}")
+        if self.n is not None:
+            if isinstance(self.n, bool) or int(self.n) != self.n or self.n < 1:
+                raise SettingError("n", self.n, "an integer >= 1")
+            object.__setattr__(self, "n", int(self.n))
+        object.__setattr__(self, "eta", _number("eta", self.eta, 0.0, 1.0))
+        if self.truncation is not None:
+            object.__setattr__(self, "truncation", _number("truncation", self.truncation, 0.0, open_low=True))
+        object.__setattr__(self, "dt_growth", _number("dt_growth", self.dt_growth, 1.0))
+        if self.scheme not in SCHEMES:
+            raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
+        for dim, methods in APPLIES.items():
+            if self.method not in methods and getattr(self, dim) != NEUTRAL[dim]:
+                raise SettingError(dim, getattr(self, dim), f"{dim} applies to method {' and '.join(methods)} only "
+                                   f"(method {self.method} takes {text(NEUTRAL[dim])})")
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_spec(cls, spec: Mapping, n: int | None = None, defaults: Mapping | None = None) -> "Case":
+        """A config case ``{method, kernel, eta?, truncation?, dt_growth?, scheme?}`` at ``n``,
+        unset dimensions from ``defaults`` (config case_defaults, then the paper's)."""
+        unknown = set(spec) - {"method", "kernel", *APPLIES}
+        if unknown:
+            raise SettingError("case key", sorted(unknown)[0], f"one of method, kernel, {', '.join(APPLIES)}")
+        method = spec.get("method")
+        if method not in METHODS:
+            raise SettingError("method", method, f"one of {', '.join(METHODS)}")
+        merged = {**{k: PAPER[k] for k in APPLIES}, **(defaults or {})}
+        dims = {}
+        for dim, methods in APPLIES.items():
+            if dim in spec:
+                value = spec[dim]
+            else:
+                value = merged[dim] if method in methods else NEUTRAL[dim]
+            dims[dim] = None if value == "none" else value
+        return cls(method=method, kernel=spec.get("kernel"), n=n, **dims)
+
+    @classmethod
+    def from_wildcards(cls, w: Mapping) -> "Case":
+        """The case named by path wildcards (inverse of ``wildcards``)."""
+        return cls(method=w["method"], kernel=w["kernel"], n=int(w["n"]) if "n" in w.keys() else None,
+                   eta=float(w["eta"]), truncation=None if w["trunc"] == "none" else float(w["trunc"]),
+                   dt_growth=float(w["growth"]), scheme=w["scheme"])
+
+    @classmethod
+    def from_row(cls, row: Mapping) -> "Case":
+        """The case of a table row (inverse of ``columns``); without an ``n`` column, a model."""
+        trunc = float(row["truncation"])
+        n = row["n"] if "n" in row.keys() else None
+        return cls(method=str(row["method"]), kernel=str(row["kernel"]), n=None if n is None else int(n),
+                   eta=float(row["eta"]), truncation=None if math.isinf(trunc) else trunc,
+                   dt_growth=float(row["dt_growth"]), scheme=str(row["scheme"]))
+
+    # ------------------------------------------------------------------ representations
+    def wildcards(self) -> dict[str, str]:
+        """Path text of every dimension, keyed by wildcard name."""
+        if self.n is None:
+            raise SettingError("n", None, f"an integer: {self.label()} is a model, which has no path")
+        return {w: text(getattr(self, f)) for f, (w, _) in PATH_SEGMENTS.items()}
+
+    def path(self) -> str:
+        """Folder of this case's files: method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S."""
+        return CASE_DIR.format(**self.wildcards())
+
+    def columns(self) -> dict:
+        """Typed table columns (truncation: inf for the whole kernel; a model has no n)."""
+        cols = {"method": self.method, "kernel": self.kernel, "n": self.n, "eta": self.eta,
+                "truncation": math.inf if self.truncation is None else self.truncation,
+                "dt_growth": self.dt_growth, "scheme": self.scheme}
+        if self.n is None:
+            del cols["n"]
+        return cols
+
+    @property
+    def model(self) -> "Case":
+        """The same case at every N."""
+        return replace(self, n=None)
+
+    def at(self, n: int) -> "Case":
+        return replace(self, n=n)
+
+    def variant(self) -> dict:
+        """Dimensions that differ from the paper's defaults for this method."""
+        out = {}
+        for dim in ("truncation", "dt_growth", "scheme"):
+            if self.method in APPLIES[dim] and getattr(self, dim) != PAPER[dim]:
+                out[dim] = getattr(self, dim)
+        return out
+
+    def label(self, n: bool = True) -> str:
+        """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
+        parts = [f"{self.method.upper()} {KERNEL_NAMES[self.kernel]}"]
+        if self.method == "mtpt":
+            parts.append(f"η={self.eta:g}")
+        v = self.variant()
+        if "truncation" in v:
+            parts.append(f"truncation {v['truncation']:g}")
+        if "dt_growth" in v:
+            parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
+        if "scheme" in v:
+            parts.append(f"{v['scheme']} loop")
+        if n and self.n is not None:
+            parts.append(f"N={self.n:,}")
+        return ", ".join(parts)
+
+    def sort_key(self) -> tuple:
+        return (METHODS.index(self.method), KERNELS[self.method].index(self.kernel), -self.eta,
+                len(self.variant()), math.inf if self.truncation is None else self.truncation, self.dt_growth,
+                SCHEMES.index(self.scheme), self.n or 0)
+
+
+# ---------------------------------------------------------------------- tables of cases
+def case_mask(df: pd.DataFrame, case: Case) -> pd.Series:
+    """Rows of ``df`` belonging to ``case`` (a model matches every N)."""
+    mask = pd.Series(True, index=df.index)
+    for col, value in case.columns().items():
+        mask &= df[col] == value
+    return mask
+
+
+def rows_of(df: pd.DataFrame, case: Case) -> pd.DataFrame:
+    return df[case_mask(df, case)]
+
+
+def models_in(df: pd.DataFrame) -> list[Case]:
+    """The distinct models of a table, in the registry's order."""
+    keys = df[list(MODEL_COLUMNS)].drop_duplicates()
+    return sorted((Case.from_row(r) for _, r in keys.iterrows()), key=Case.sort_key)
+
+
+def by_model(df: pd.DataFrame) -> Iterator[tuple[Case, pd.DataFrame]]:
+    """(model, its rows) for every model of a table."""
+    for model in models_in(df):
+        yield model, rows_of(df, model)
+
+
+def case_of_table(df: pd.DataFrame) -> Case:
+    """The one case of a run table or case summary."""
+    return Case.from_row(df.iloc[0])

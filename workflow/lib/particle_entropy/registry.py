@@ -1,0 +1,41 @@
+"""The one registry of methods, kernels and schemes, and the one table of the paper's defaults.
+
+Wildcard constraints (workflow/rules/common.smk), CLI choices (cli.py) and the config schema's
+enums (a test holds them equal) all come from here; config.yaml holds the same defaults.
+"""
+
+from __future__ import annotations
+
+METHODS = ("pt", "mtpt", "fd")
+KERNELS = {
+    "pt": ("bins", "fixed", "adaptive"),  # reconstruction of the density from particles
+    "mtpt": ("collision", "sph"),  # transfer kernel (Eq. 17 / Eqs. 20, 21, 26)
+    "fd": ("implicit", "explicit"),  # time scheme of the finite differences
+}
+ALL_KERNELS = tuple(k for m in METHODS for k in KERNELS[m])
+DEFAULT_KERNEL = {m: KERNELS[m][0] for m in METHODS}  # bins, collision, implicit
+SCHEMES = ("symmetric", "sequential")  # Eqs. 16-21, or the authors' sequential pairwise loop
+TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
+SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
+
+FGT_TOLERANCE = 1e-17  # fast Gauss transform error / summed |weights| in reach: round-off
+FGT_TOLERANCE_RANGE = (1e-30, 0.1)
+
+# The paper's settings (experiments.md); config.yaml and the schema's defaults equal these.
+PAPER = {
+    "D": 1e-3,  # diffusion coefficient [L^2/T]
+    "t_final": 1000.0,  # [T]
+    "omega": 10.0,  # particle domain length, positions on [-omega/2, omega/2] [L]
+    "fd_length": 12.0,  # FD domain [-6, 6] [L]
+    "fixed_kernel_time": 1.0,  # fixed PT kernel has variance 2 D x this time [T]
+    "dt0": 0.01,  # first particle step [T]
+    "fd_dt": 0.05,  # FD fixed step [T]
+    "fixed_dt": 1.0,  # particle step when dt_growth = 1 [T]
+    "eta": 1.0,  # fraction of D by mass transfer
+    "truncation": None,  # None: whole Gaussian; else kernel widths (3 = authors' code)
+    "dt_growth": 1.05,  # dt_{n+1} = growth * dt_n
+    "scheme": "symmetric",
+    "transfer_method": "auto",
+    "transfer_tolerance": FGT_TOLERANCE,
+    "shear_beta": 0.5,  # Appendix B mass-transfer coefficient (Eq. 16)
+}
