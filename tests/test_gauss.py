@@ -163,7 +163,7 @@ def test_fgt_box_widths_match_dense(rng, ratio, density):
     q = _weights(rng, n)
     width = 2.0 ** math.floor(math.log2(ratio * sigma))  # exact box geometry: a power of two
     terms = gauss.fgt_offset_terms(sigma, CUTOFF_SIGMAS * sigma, width)
-    out = gauss._fgt(x, x, q, sigma, CUTOFF_SIGMAS * sigma, width, terms)
+    out = gauss._fgt(x, x, q, sigma, width, terms)
     _assert_matches(out, x, x, q, sigma)
 
 

@@ -3,15 +3,22 @@
 from __future__ import annotations
 
 import re
+import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
+
+from particle_entropy.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
+from particle_entropy.sweeps import (FIGURE_READS, Ensemble, case_run_paths, figure_ensembles, run_path,
+                                    spec_ensembles)
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -47,7 +54,8 @@ def test_shipped_config_is_valid():
 BAD = [
     (("physics", "D"), -1.0, "D"),
     (("physics", "t_final"), 0, "t_final"),
-    (("time", "dt_growth"), 0.9, "dt_growth"),
+    (("case_defaults", "dt_growth"), 0.9, "dt_growth"),
+    (("case_defaults", "scheme"), "parallel", "scheme"),
     (("base_seed",), -3, "base_seed"),
     (("figures", "fig9", "n"), [0, 100], "n"),
     (("figures", "fig5", "cases"), [{"method": "mtpt", "kernel": "collision", "eta": 1.5}], "eta"),
@@ -137,12 +145,17 @@ def test_tiny_run_builds_every_figure(tiny_run):
 
 def test_tiny_run_tables_have_documented_columns(tiny_run):
     comic = pd.read_parquet(tiny_run / "results/tables/comic.parquet")
-    assert {"model", "n", "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std", "n_realisations"} <= set(comic.columns)
-    assert set(comic["model"]) == {"fd", "mtpt collision eta=1", "mtpt sph eta=1", "mtpt collision eta=0.5"}
+    assert {"label", *CASE_COLUMNS, "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std",
+            "n_realisations"} <= set(comic.columns)
+    cfg = load(TINY)
+    expected = {e.case.model for f in ("fig8", "fig9") for e in figure_ensembles(cfg, f)}
+    assert set(models_in(comic)) == expected
     minima = pd.read_parquet(tiny_run / "results/tables/comic_minima.parquet")
-    assert {"model", "time", "n_opt", "COMIC_opt", "n_below", "n_above"} <= set(minima.columns)
-    for _, m in minima.iterrows():  # the reported optimum really is the smallest mean COMIC
-        g = comic[(comic["model"] == m["model"]) & (comic["time"] == m["time"])]
+    assert {"label", *MODEL_COLUMNS, "time", "n_opt", "COMIC_opt", "n_below", "n_above"} <= set(minima.columns)
+    for _, m in minima.iterrows():  # the reported optimum really is the smallest mean COMIC of its model
+        g = rows_of(comic, Case.from_row(m))
+        g = g[g["time"] == m["time"]]
+        assert len(g) == len(cfg["figures"]["fig9" if m["method"] == "mtpt" else "fig8"]["n"])
         assert m["COMIC_opt"] == g["COMIC_mean"].min()
     claims = pd.read_parquet(tiny_run / "results/tables/paper_claims.parquet")
     assert {"claim", "paper", "reproduced", "tolerance", "passed"} <= set(claims.columns)
@@ -192,13 +205,13 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
 # --- a figure target pulls only its own simulations ------------------------------------------
 
 def _expected_runs(cfg, fig):
-    from particle_entropy.sweeps import case_run_paths, figure_cases, spec_cases
-
-    cases = spec_cases(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_cases(cfg, fig)
-    if fig in ("fig1", "fig2", "fig7"):
-        return {f"results/runs/{c['method']}/{c['kernel']}/n~{c['n']}/eta~{c['eta']}/trunc~{c['trunc']}/"
-                f"growth~{c['growth']}/seeds~0-0.parquet" for c in cases} if fig != "fig7" else set()
-    return {p for c in cases for p in case_run_paths(c, cfg)}
+    ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
+    reads = FIGURE_READS.get(fig, "summaries")
+    if reads == "snapshots":
+        return set()
+    if reads == "runs":
+        return {run_path(e.case, cfg["base_seed"]) for e in ensembles}
+    return {p for e in ensembles for p in case_run_paths(e, cfg)}
 
 
 @pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
@@ -252,3 +265,102 @@ def test_report_holds_every_figure_with_its_caption(tiny_run):
     for k in range(1, 11):
         assert f"fig{k}.png" in html
     assert "Reproduces" in html and "tradeoff.png" in html
+
+
+# --- every case a section lists is drawn and tabulated, and cases stay apart -------------------
+
+PLOTTED = [f"fig{k}" for k in range(1, 10)] + ["tradeoff"]
+
+
+def _cases_in(table):
+    """The simulated cases a table holds (rows of analytic references left out)."""
+    sims = table[table["method"].isin(["pt", "mtpt", "fd"])]
+    return {Case.from_row(r) for _, r in sims[list(CASE_COLUMNS)].drop_duplicates().iterrows()}
+
+
+@pytest.mark.parametrize("fig", PLOTTED)
+def test_each_figure_writes_the_data_of_exactly_its_cases(tiny_run, fig):
+    cfg = load(TINY)
+    ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
+    data = pd.read_parquet(tiny_run / f"results/figures/{fig}.parquet")
+    assert {"series", *CASE_COLUMNS, "x", "y"} <= set(data.columns)
+    assert _cases_in(data) == {e.case for e in ensembles}
+
+
+def test_an_added_case_is_drawn_from_its_summary(tiny_run):
+    cfg = load(TINY)
+    spec = {"method": "mtpt", "kernel": "collision", "eta": 0.25, "truncation": 3}
+    assert spec in cfg["figures"]["fig5"]["cases"]  # the tiny config's added case
+    added = Case.from_spec(spec, 100, cfg["case_defaults"])
+    summary = pd.read_parquet(tiny_run / Ensemble(added, 2).summary_path())
+    rows = rows_of(pd.read_parquet(tiny_run / "results/figures/fig5.parquet"), added)
+    assert len(rows) > 10 and rows["series"].nunique() == 1
+    plotted = summary.set_index("time").loc[rows["x"].to_numpy(), "E_mean"].to_numpy()
+    np.testing.assert_array_equal(rows["y"].to_numpy(), plotted)  # the figure shows the summary's values
+
+
+def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
+    cfg = load(TINY)
+    base = Case.from_spec({"method": "mtpt", "kernel": "collision", "eta": 1}, None, cfg["case_defaults"])
+    truncated = replace(base, truncation=3.0)
+    sequential = replace(truncated, scheme="sequential")
+    models = (base, truncated, sequential)
+    tables = {name: pd.read_parquet(tiny_run / f"results/tables/{name}.parquet")
+              for name in ("comic", "comic_minima", "tradeoff")}
+    tables["fig9"] = pd.read_parquet(tiny_run / "results/figures/fig9.parquet")
+    for name, table in tables.items():
+        parts = [rows_of(table, m) for m in models]
+        assert all(len(p) for p in parts), name
+        assert sum(map(len, parts)) == len(pd.concat(parts).drop_duplicates()), name  # no row in two models
+        assert len({p["label" if "label" in p else "series"].iloc[0] for p in parts}) == 3, name
+    comic = tables["comic"]
+    at = lambda m: rows_of(comic, m).sort_values(["time", "n"])["COMIC_mean"].to_numpy()  # noqa: E731
+    assert not np.array_equal(at(truncated), at(sequential))  # the scheme changes the numbers
+    claims = pd.read_parquet(tiny_run / "results/tables/paper_claims.parquet")
+    for m in models:  # each model gets its own Fig. 9 claims
+        assert claims["claim"].str.startswith(m.label() + ": COMIC minimum").sum() == 2, m.label()
+
+
+def test_sequential_scheme_runs_the_authors_loop(tiny_run):
+    runs = list((tiny_run / "results/runs/mtpt/collision").glob("n~100/eta~1/trunc~3/growth~*/scheme~sequential/*.parquet"))
+    assert runs
+    table = pd.read_parquet(runs[0])
+    assert set(table["scheme"]) == {"sequential"} and set(table["truncation"]) == {3.0}
+
+
+# --- code edits rerun exactly what they change -------------------------------------------------
+
+def _planned_rules(proc):
+    return set(re.findall(r"^\s*(?:local)?rule (\w+):", proc.stdout + proc.stderr, flags=re.M)) - {"all"}
+
+
+def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
+    src = tmp_path / "src"  # a copy of the workflow whose library we edit
+    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
+    work = tmp_path / "work"
+    shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
+
+    def plan():
+        cmd = [sys.executable, "-m", "snakemake", "-s", str(src / "Snakefile"), "-d", str(work), "-n",
+               "--configfile", str(TINY)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        return _planned_rules(proc), proc
+
+    assert plan()[0] == set()  # the same code in another place: nothing to do
+    lib = src / "workflow/lib/particle_entropy"
+    for module, expected in [("plots.py", lambda r: r.startswith("plot_")),
+                             ("mass_transfer.py", None)]:
+        original = (lib / module).read_text()
+        (lib / module).write_text(original + "\n# an edit\n")
+        rules, proc = plan()
+        if expected is not None:
+            assert rules and all(expected(r) for r in rules), rules
+        else:  # mass transfer: MTPT simulations and what reads them, never a PT or FD run
+            sims = planned_outputs(proc)
+            assert sims and all(p.startswith("results/runs/mtpt/") for p in sims)
+            assert planned_outputs(proc, "results/snapshots/") == sorted(
+                str(p.relative_to(work)) for p in (work / "results/snapshots/mtpt").rglob("*.parquet"))
+            assert "simulate_shear" not in rules and "plot_fig10" not in rules
+        (lib / module).write_text(original)  # identical content again (a newer mtime): nothing to do
+        assert plan()[0] == set(), module

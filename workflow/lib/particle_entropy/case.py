@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass, replace
 from typing import Iterator, Mapping
 
+import numpy as np
 import pandas as pd
 
 from .registry import KERNELS, METHODS, PAPER, SCHEMES
@@ -100,7 +101,8 @@ class Case:
         if self.kernel not in KERNELS[self.method]:
             raise SettingError("kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}")
         if self.n is not None:
-            if isinstance(self.n, bool) or int(self.n) != self.n or self.n < 1:
+            integral = isinstance(self.n, (int, np.integer)) or (isinstance(self.n, float) and self.n.is_integer())
+            if isinstance(self.n, bool) or not integral or self.n < 1:
                 raise SettingError("n", self.n, "an integer >= 1")
             object.__setattr__(self, "n", int(self.n))
         object.__setattr__(self, "eta", _number("eta", self.eta, 0.0, 1.0))

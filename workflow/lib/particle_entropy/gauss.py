@@ -277,7 +277,7 @@ def _empty_boxes(q, starts):
 
 
 @njit(cache=True)
-def _fgt(y, x, q, sigma, radius, width, terms):
+def _fgt(y, x, q, sigma, width, terms):
     """Fast Gauss transform (Greengard-Strain): Hermite moments of source boxes translated to
     Taylor coefficients about target-box centres; boxes ``width`` (see fgt_box_width) wide on one
     grid, so a translation depends only on the box offset and is tabulated once."""
@@ -290,7 +290,7 @@ def _fgt(y, x, q, sigma, radius, width, terms):
     origin = math.floor(min(x[0], y[0]) / width) * width
     s_starts, s_ids = _boxes(x, origin, width)
     t_starts, t_ids = _boxes(y, origin, width)
-    kmax = terms.shape[0] - 1  # |y - x| <= radius needs |box offset| <= kmax
+    kmax = terms.shape[0] - 1  # pairs within the cut-off radius are at most kmax boxes apart
     p = terms[0]  # terms[d]: Hermite / Taylor terms for box pairs d boxes apart (most at 0)
     H = _hermite_table(kmax, width * scale, p)
     A = _hermite_moments(x, q, s_starts, s_ids, origin, width, scale, p)
@@ -526,7 +526,7 @@ def gauss_transform(
             out = np.zeros((q2.shape[0], y.size))
         else:
             width, terms = fgt_plan(y, x, sigma, radius, q2.shape[0], tolerance)
-            out = _fgt(y, x, q2, float(sigma), float(radius), width, terms)
+            out = _fgt(y, x, q2, float(sigma), width, terms)
     elif method == "taylor":
         if truncation is not None:
             raise ValueError("the taylor method evaluates the untruncated kernel only")

@@ -66,10 +66,6 @@ class Recorder:
                 f"step {row['step']}/{self.n_steps} t={row['time']:.6g} elapsed={now - self._t0:.1f}s"
             )
 
-    def restart_clock(self) -> None:
-        """Exclude set-up work done between steps from the next step's wall time."""
-        self._last = time.perf_counter()
-
     def table(self) -> pd.DataFrame:
         df = pd.DataFrame(self.rows)
         for k, v in self.case.items():

@@ -3,7 +3,7 @@
 Not the paper's equations: particle i in order exchanges with each partner j > i within the
 cut-off, partners in random order, dm = beta (m_i - m_j) W_ij / r_i with r_i the row sum of i
 alone, and masses clipped at zero after every exchange (so mass is not conserved exactly).
-experiments.md states these facts about that code; here they are re-implemented from that
+The project's ../shared/docs/experiments.md states these facts about that code; here they are re-implemented from that
 description to measure how far the symmetric matrix of Eqs. 16-21 is from it.
 """
 

@@ -130,7 +130,8 @@ def check_sweeps(config: Mapping) -> None:
                     run_config(case, config)
             except SettingError as e:
                 raise SettingError(f"{where}.{e.name}", e.value, e.allowed) from None
-        for n in spec["n"]:
+        particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
+        for n in spec["n"] if particles else []:
             try:
                 realisations_for(spec, int(n), config)
             except SettingError as e:

@@ -1,0 +1,177 @@
+"""The paper's claims judged on hand-built tables (claims.py): COMIC optima inside or outside their
+ranges, variants judged as their own models, SPH flatness, the adaptive-PT and eta claims, and the
+markdown summary line."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from particle_entropy.case import Case
+from particle_entropy.claims import comic_claims, ensemble_claims, single_run_claims, to_markdown
+
+TOL = {"fd_optimum_nodes": [1000, 10000], "collision_eta1_optimum": [1000, 10000],
+       "collision_eta05_optimum": [100, 1000], "sph_flat_max_spread": 2.0, "adaptive_pt_hc_tolerance": 0.05}
+TIMES = (250.0, 500.0, 1000.0)
+
+
+def _minima(rows: list[tuple[Case, float, int, int]]) -> pd.DataFrame:
+    """(model, time, n_opt, n_opt_of_mean_SSE) -> a minima table."""
+    return pd.DataFrame([{"label": m.label(), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k}
+                         for m, t, n, k in rows])
+
+
+def _comic(rows: list[tuple[Case, float, float]]) -> pd.DataFrame:
+    """(case with N, time, mean COMIC) -> a COMIC table."""
+    return pd.DataFrame([{"label": c.label(n=False), **c.columns(), "time": t, "COMIC_mean": v}
+                         for c, t, v in rows])
+
+
+EMPTY_COMIC = _comic([(Case("fd", "implicit", 30), 1000.0, 0.0)])  # no SPH rows: no flatness claim
+COLL1 = Case("mtpt", "collision")
+COLL1_T3 = Case("mtpt", "collision", truncation=3)
+COLL05 = Case("mtpt", "collision", eta=0.5)
+
+
+def _by_claim(claims: list[dict]) -> dict[str, bool]:
+    texts = [c["claim"] for c in claims]
+    assert len(texts) == len(set(texts)), "claim texts must be distinct"
+    return {c["claim"]: c["passed"] for c in claims}
+
+
+# --------------------------------------------------------------------------- FD optimum
+def test_fd_optimum_inside_passes_and_outside_fails():
+    minima = _minima([(Case("fd", "implicit"), t, n, n) for t, n in zip(TIMES, (3000, 3000, 30000), strict=True)]
+                     + [(Case("fd", "explicit"), t, n, n) for t, n in zip(TIMES, (300, 30000, 3000), strict=True)])
+    claims = _by_claim(comic_claims(minima, EMPTY_COMIC, TOL))
+    assert len(claims) == 2
+    implicit = [c for c in claims if Case("fd", "implicit").label() in c]
+    explicit = [c for c in claims if Case("fd", "explicit").label() in c]
+    assert len(implicit) == len(explicit) == 1
+    assert claims[implicit[0]] is True  # 2 of 3 times inside [1000, 10000]
+    assert claims[explicit[0]] is False  # 1 of 3
+
+
+# --------------------------------------------------------------------------- MTPT optima
+def test_collision_optima_inside_pass_and_outside_fail():
+    minima = _minima([
+        (COLL1, 250.0, 30, 30),  # an earlier time: not judged
+        (COLL1, 1000.0, 3000, 1000),  # inside [1000, 10000] both ways
+        (COLL05, 1000.0, 300, 3000),  # inside [100, 1000] by mean COMIC, outside by COMIC of mean SSE
+    ])
+    claims = comic_claims(minima, EMPTY_COMIC, TOL)
+    assert len(claims) == 4
+    by = _by_claim(claims)
+    eta1 = {k: v for k, v in by.items() if COLL1.label() + ":" in k}
+    eta05 = {k: v for k, v in by.items() if COLL05.label() + ":" in k}
+    assert len(eta1) == len(eta05) == 2
+    assert all(eta1.values())
+    assert sorted(eta05.values()) == [False, True]
+    assert by[next(k for k in eta05 if "mean of COMIC" in k)] is True
+    assert by[next(k for k in eta05 if "mean SSE" in k)] is False
+    assert all("t = 1000" in k for k in by)
+
+
+def test_truncated_variant_gets_its_own_claim_rows():
+    minima = _minima([(COLL1, 1000.0, 3000, 3000), (COLL1_T3, 1000.0, 300, 300)])
+    claims = comic_claims(minima, EMPTY_COMIC, TOL)
+    assert len(claims) == 4
+    by = _by_claim(claims)
+    variant = {k: v for k, v in by.items() if "truncation 3" in k}
+    paper = {k: v for k, v in by.items() if "truncation" not in k}
+    assert len(variant) == len(paper) == 2
+    assert all(COLL1_T3.label() in k for k in variant)
+    assert all(paper.values()) and not any(variant.values())
+    assert {c["reproduced"] for c in claims if "truncation 3" in c["claim"]} == {"300"}
+
+
+def test_sequential_variant_gets_its_own_claim_rows():
+    seq = Case("mtpt", "collision", eta=0.5, scheme="sequential")
+    minima = _minima([(COLL05, 1000.0, 300, 300), (seq, 1000.0, 3000, 3000)])
+    by = _by_claim(comic_claims(minima, EMPTY_COMIC, TOL))
+    assert len(by) == 4
+    assert [v for k, v in by.items() if "sequential" in k] == [False, False]
+    assert [v for k, v in by.items() if "sequential" not in k] == [True, True]
+
+
+# --------------------------------------------------------------------------- SPH flatness
+def test_sph_flatness_passes_flat_and_fails_spread():
+    flat, steep = Case("mtpt", "sph"), Case("mtpt", "sph", truncation=3)
+    rows = []
+    for n, a, b in [(30, -20.0, 0.0), (100, 1.0, 1.0), (300, 1.5, 3.5), (1000, 0.8, -0.2)]:
+        rows += [(flat.at(n), 1000.0, a), (steep.at(n), 1000.0, b)]  # N = 30 is outside the judged range
+        rows += [(flat.at(n), 250.0, 10.0 * n), (steep.at(n), 250.0, 0.0)]  # earlier time: not judged
+    minima = _minima([(Case("fd", "implicit"), 1000.0, 3000, 3000)])
+    by = _by_claim(comic_claims(minima, _comic(rows), TOL))
+    sph = {k: v for k, v in by.items() if "flat" in k}
+    assert len(sph) == 2
+    assert by[next(k for k in sph if "truncation" not in k)] is True  # spread 0.7 <= 2
+    assert by[next(k for k in sph if "truncation 3" in k)] is False  # spread 3.7 > 2
+
+
+# --------------------------------------------------------------------------- ensemble claims
+def _summary(case: Case, times, **columns) -> pd.DataFrame:
+    df = pd.DataFrame({"time": times, "n_realisations": 4, **columns})
+    for c, v in case.columns().items():
+        df[c] = v
+    return df
+
+
+@pytest.mark.parametrize("gap,passed", [(0.01, True), (-0.049, True), (0.1, False), (-0.06, False)])
+def test_adaptive_pt_matches_analytic_hc_within_tolerance(gap, passed):
+    times = [0.0, 500.0, 1000.0]
+    s = _summary(Case("pt", "adaptive", 300), times, H_C_mean=[0.0, 1.0, 2.0 + gap], H_C_analytic=[0.0, 1.5, 2.0])
+    claims = ensemble_claims([s], TOL["adaptive_pt_hc_tolerance"])
+    assert len(claims) == 1 and claims[0]["passed"] is passed
+
+
+def test_eta_claim_sph_changes_much_collision_little():
+    times = [0.0, 1000.0]
+    e = {("collision", 1.0): 1.00, ("collision", 0.1): 1.05, ("sph", 1.0): 1.0, ("sph", 0.1): 2.0}
+    summaries = [_summary(Case("mtpt", k, 300, eta=eta), times, E_mean=[0.0, v]) for (k, eta), v in e.items()]
+    claims = ensemble_claims(summaries, 0.05)
+    assert len(claims) == 1 and claims[0]["passed"] is True
+    e[("collision", 0.1)] = 1.9  # collision changes as much as SPH
+    summaries = [_summary(Case("mtpt", k, 300, eta=eta), times, E_mean=[0.0, v]) for (k, eta), v in e.items()]
+    assert ensemble_claims(summaries, 0.05)[0]["passed"] is False
+
+
+# --------------------------------------------------------------------------- single-run claims
+def _run(case: Case, h_d0: float, gap: float, late_gap: float, e_rel: float) -> pd.DataFrame:
+    """A synthetic run: H_C = analytic + gap for 0.1 <= t <= 10 and + late_gap at t = 1000."""
+    t = np.array([0.0, 0.1, 1.0, 10.0, 1000.0])
+    hc_an = np.array([-np.inf, -1.0, 0.0, 1.0, 3.0])
+    hc = hc_an + np.array([0.0, gap, gap, gap, late_gap])
+    e_an = np.array([0.0, 0.1, 0.3, 1.0, 10.0])
+    return _summary(case, t, H_D=[h_d0, 1, 1, 1, 1], H_C=hc, H_C_analytic=hc_an, E=e_an * (1 + e_rel),
+                    E_analytic=e_an)
+
+
+def test_single_run_claims_on_runs_built_to_pass():
+    runs = []
+    for n, e_rel in ((300, -0.3), (3000, -0.1)):
+        runs += [_run(Case("pt", "bins", n), math.log(n), 0.01, 0.5, 0.0),
+                 _run(Case("pt", "fixed", n), math.log(n), 0.2, 0.0, 0.0),
+                 _run(Case("mtpt", "collision", n), 0.0, -0.2, 0.0, e_rel)]
+    claims = single_run_claims(runs)
+    assert len(claims) == 2 * 5 + 1
+    assert all(c["passed"] for c in claims), [c["claim"] for c in claims if not c["passed"]]
+    # the same runs with a wrong sign of the fixed-kernel gap fail that claim only, per N
+    runs[1] = _run(Case("pt", "fixed", 300), math.log(300), -0.2, 0.0, 0.0)
+    failed = [c["claim"] for c in single_run_claims(runs) if not c["passed"]]
+    assert len(failed) == 1 and "fixed-kernel" in failed[0] and "N=300" in failed[0]
+
+
+# --------------------------------------------------------------------------- markdown
+def test_markdown_counts_passes():
+    claims = pd.DataFrame([{"claim": f"c{k}", "paper": "p", "reproduced": "r", "tolerance": "t", "passed": ok}
+                           for k, ok in enumerate([True, False, True, True, False])])
+    lines = to_markdown(claims).splitlines()
+    assert lines[0].startswith("# ")
+    assert "3 of 5 claims pass" in lines[2]
+    assert sum("| pass |" in line for line in lines) == 3 and sum("| FAIL |" in line for line in lines) == 2
+    all_pass = to_markdown(claims.assign(passed=True)).splitlines()
+    assert "5 of 5 claims pass" in all_pass[2]

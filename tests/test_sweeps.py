@@ -1,0 +1,232 @@
+"""Expanding the config into ensembles, seed blocks, run paths and run settings (sweeps.py), and the
+pre-flight checks of check_sweeps, on the shipped config, the tiny test config and small dicts."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from particle_entropy.case import Case, SettingError
+from particle_entropy.sweeps import (
+    Ensemble,
+    case_run_paths,
+    case_sections,
+    check_sweeps,
+    figure_ensembles,
+    realisations_for,
+    run_config,
+    run_path,
+    run_settings,
+    seed_blocks,
+    spec_ensembles,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+SHIPPED = yaml.safe_load((ROOT / "config.yaml").read_text())
+TINY = yaml.safe_load((ROOT / "tests" / "data" / "tiny_config.yaml").read_text())
+PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric"
+
+
+# --------------------------------------------------------------------------- seed blocks
+@pytest.mark.parametrize("base", [0, 7])
+@pytest.mark.parametrize("size", [1, 2, 3, 20])
+@pytest.mark.parametrize("count", [1, 2, 5, 19, 20, 21, 60, 80])
+def test_seed_blocks_are_aligned_and_cover_each_seed_once(base, size, count):
+    config = {"base_seed": base, "seed_blocks": {"size": size, "max_n": 1000}}
+    blocks = seed_blocks(Ensemble(Case("mtpt", "collision", 300), count), config)
+    seeds = [s for a, b in blocks for s in range(a, b + 1)]
+    assert seeds == list(range(base, base + count))  # exactly these, in order, none twice
+    for k, (a, b) in enumerate(blocks):
+        assert a <= b and b - a + 1 <= size
+        assert (a - base) == k * size  # block k starts at realisation k * size
+        if k < len(blocks) - 1:
+            assert b - a + 1 == size  # only the last block may be short
+    assert len(blocks) == -(-count // size)
+
+
+@pytest.mark.parametrize("size", [1, 3, 20])
+def test_smaller_ensembles_share_the_first_blocks_of_larger_ones(size):
+    config = {"base_seed": 0, "seed_blocks": {"size": size, "max_n": 1000}}
+    blocks = {r: seed_blocks(Ensemble(Case("pt", "bins", 30), r), config) for r in (20, 60, 80)}
+    for small, large in ((20, 60), (60, 80), (20, 80)):
+        full = [(a, b) for a, b in blocks[small] if b - a + 1 == size]  # a short last block cannot be shared
+        assert len(full) == small // size
+        assert blocks[large][:len(full)] == full
+
+
+def test_one_seed_per_job_above_max_n():
+    config = {"base_seed": 3, "seed_blocks": {"size": 20, "max_n": 1000}}
+    assert seed_blocks(Ensemble(Case("mtpt", "sph", 1001), 4), config) == [(3, 3), (4, 4), (5, 5), (6, 6)]
+    assert seed_blocks(Ensemble(Case("mtpt", "sph", 1000), 4), config) == [(3, 6)]
+
+
+def test_case_run_paths_written_by_hand():
+    ens = Ensemble(Case("mtpt", "collision", 30), 80)
+    assert case_run_paths(ens, SHIPPED) == [f"results/runs/{PAPER_DIR}/seeds~{a}-{a + 19}.parquet"
+                                            for a in (0, 20, 40, 60)]
+    big = Ensemble(Case("mtpt", "collision", 30000), 4)  # 30000 <= max_n: one block of 4
+    assert case_run_paths(big, SHIPPED) == [f"results/runs/{PAPER_DIR.replace('n~30/', 'n~30000/')}/seeds~0-3.parquet"]
+    assert run_path(Case("mtpt", "collision", 30), 5, kind="snapshots") == \
+        f"results/snapshots/{PAPER_DIR}/seeds~5-5.parquet"
+
+
+def test_summary_path_and_ensemble_wildcards():
+    ens = Ensemble(Case("mtpt", "collision", 30), 80)
+    assert ens.summary_path() == f"results/tables/cases/{PAPER_DIR}/r~80.parquet"
+    assert Ensemble.from_wildcards({**ens.case.wildcards(), "nreal": "80"}) == ens
+
+
+# --------------------------------------------------------------------------- realisations
+ENSEMBLE = {"cases": [{"method": "mtpt", "kernel": "collision"}], "n": [30, 10000], "realisations": "ensemble"}
+
+
+def test_realisations_from_the_table_and_capped():
+    # config.yaml: {n: 30, count: 80}, {n: 10000, count: 6}, {n: 30000, count: 4}
+    assert realisations_for(ENSEMBLE, 30, SHIPPED) == 80
+    assert realisations_for(ENSEMBLE, 10000, SHIPPED) == 6
+    capped = {**ENSEMBLE, "max_realisations": 20}
+    assert realisations_for(capped, 30, SHIPPED) == 20
+    assert realisations_for(capped, 10000, SHIPPED) == 6
+    assert realisations_for({**ENSEMBLE, "realisations": 5}, 30, SHIPPED) == 5
+    assert realisations_for({"cases": [], "n": [30]}, 30, SHIPPED) == 1  # unset: one realisation
+    with pytest.raises(SettingError):
+        realisations_for(ENSEMBLE, 31, SHIPPED)
+
+
+def test_fd_gets_one_realisation():
+    spec = {"cases": [{"method": "fd", "kernel": "implicit"}, {"method": "mtpt", "kernel": "sph"}],
+            "n": [30, 100], "realisations": "ensemble"}
+    got = {(e.case.method, e.case.n): e.realisations for e in spec_ensembles(spec, SHIPPED)}
+    assert got == {("fd", 30): 1, ("fd", 100): 1, ("mtpt", 30): 80, ("mtpt", 100): 80}
+
+
+def test_shipped_fig9_expands_to_the_realisations_table():
+    ens = figure_ensembles(SHIPPED, "fig9")
+    # config.yaml: 3 cases x 7 N; counts 80, 80, 60, 50, 20, 6, 4 for N = 30 ... 30000
+    counts = {30: 80, 100: 80, 300: 60, 1000: 50, 3000: 20, 10000: 6, 30000: 4}
+    assert len(ens) == 21
+    for e in ens:
+        assert e.realisations == counts[e.case.n]
+    assert {e.case.model for e in ens} == {Case("mtpt", "collision"), Case("mtpt", "sph"),
+                                           Case("mtpt", "collision", eta=0.5)}
+
+
+def test_shipped_fig3_is_capped_at_20():
+    assert {(e.case.kernel, e.case.n): e.realisations for e in figure_ensembles(SHIPPED, "fig3")} == {
+        ("adaptive", 300): 20, ("adaptive", 30000): 4, ("sph", 300): 20, ("sph", 30000): 4}
+
+
+def test_spec_ensembles_take_case_defaults_where_they_apply():
+    config = {**TINY, "case_defaults": {"eta": 1, "truncation": "none", "dt_growth": 1.3}}
+    spec = {"cases": [{"method": "fd", "kernel": "implicit"}, {"method": "pt", "kernel": "bins"},
+                      {"method": "mtpt", "kernel": "collision", "dt_growth": 1.01}], "n": [30]}
+    growth = [e.case.dt_growth for e in spec_ensembles(spec, config)]
+    assert growth == [1.0, 1.3, 1.01]
+
+
+def test_case_sections_of_the_shipped_config():
+    assert list(case_sections(SHIPPED)) == [f"figures.fig{k}" for k in range(1, 10)] + ["tradeoff"]
+    assert "tradeoff" not in case_sections({"figures": {}})
+
+
+# --------------------------------------------------------------------------- run settings
+SETTINGS = {"physics": {"D": 2e-3, "t_final": 50, "omega": 8, "fd_length": 10, "fixed_kernel_time": 2},
+            "time": {"dt0": 0.02, "fd_dt": 0.3, "fixed_dt": 2.0},
+            "numerics": {"transfer_method": "direct", "transfer_tolerance": 1e-10}}
+
+
+@pytest.mark.parametrize("case,dt0", [
+    (Case("fd", "implicit", 100), 0.3),
+    (Case("pt", "bins", 100, dt_growth=1), 2.0),
+    (Case("mtpt", "collision", 100, dt_growth=1), 2.0),
+    (Case("mtpt", "collision", 100), 0.02),
+    (Case("mtpt", "sph", 100, dt_growth=1.01), 0.02),
+    (Case("pt", "adaptive", 100), 0.02),
+])
+def test_run_settings_first_step(case, dt0):
+    s = run_settings(case, SETTINGS)
+    assert s["dt0"] == dt0
+    assert (s["D"], s["t_final"], s["omega"], s["fd_length"], s["fixed_kernel_time"]) == (2e-3, 50, 8, 10, 2)
+    assert (s["transfer_method"], s["transfer_tolerance"]) == ("direct", 1e-10)
+
+
+def test_run_settings_on_the_shipped_config():
+    assert run_settings(Case("fd", "implicit", 100), SHIPPED)["dt0"] == 0.05
+    assert run_settings(Case("mtpt", "collision", 100, dt_growth=1), SHIPPED)["dt0"] == 1.0
+    assert run_settings(Case("pt", "bins", 100), SHIPPED)["dt0"] == 0.01
+
+
+def test_run_config_is_the_case_at_the_seed():
+    case = Case("mtpt", "sph", 60, eta=0.5, truncation=3, scheme="sequential")
+    cfg = run_config(case, SETTINGS, seed=7)
+    assert cfg.case == case and cfg.seed == 7
+    assert (cfg.dt0, cfg.D, cfg.t_final, cfg.omega) == (0.02, 2e-3, 50, 8)
+
+
+# --------------------------------------------------------------------------- check_sweeps
+def test_check_sweeps_accepts_the_shipped_and_tiny_configs():
+    check_sweeps(SHIPPED)
+    check_sweeps(TINY)
+
+
+def _refused(config) -> str:
+    with pytest.raises(SettingError) as e:
+        check_sweeps(config)
+    return str(e.value)
+
+
+def test_check_sweeps_refuses_a_kernel_of_another_method():
+    config = copy.deepcopy(TINY)
+    config["figures"]["fig1"]["cases"][0]["kernel"] = "collision"
+    msg = _refused(config)
+    assert "figures.fig1.cases[0].kernel" in msg and "collision" in msg
+
+
+def test_check_sweeps_refuses_an_inapplicable_dimension_in_tradeoff():
+    config = copy.deepcopy(TINY)
+    config["tradeoff"]["cases"][1]["eta"] = 0.5  # pt adaptive
+    msg = _refused(config)
+    assert "tradeoff.cases[1].eta" in msg and "0.5" in msg
+
+
+def test_check_sweeps_refuses_an_odd_fd_n():
+    config = copy.deepcopy(TINY)
+    config["figures"]["fig8"]["n"] = [30, 61]
+    msg = _refused(config)
+    assert "figures.fig8.cases[0].n" in msg and "61" in msg
+
+
+def test_check_sweeps_refuses_explicit_fd_past_stability():
+    config = copy.deepcopy(TINY)
+    config["figures"]["fig8"]["cases"] = [{"method": "fd", "kernel": "explicit"}]
+    config["figures"]["fig8"]["n"] = [30, 200]
+    check_sweeps(config)  # n = 200: dx = 0.06, r = D dt / dx^2 = 1e-3 * 0.5 / 0.0036 = 0.14 <= 1/2
+    config["figures"]["fig8"]["n"] = [30, 2000]  # dx = 0.006: r = 13.9 > 1/2
+    msg = _refused(config)
+    assert "figures.fig8.cases[0]" in msg and "explicit" in msg
+
+
+def test_check_sweeps_refuses_a_missing_realisations_entry():
+    config = copy.deepcopy(TINY)
+    config["tradeoff"]["n"] = [30, 40]  # ensemble, and the table has no N = 40
+    msg = _refused(config)
+    assert "tradeoff.n" in msg and "40" in msg
+
+
+@pytest.mark.parametrize("key", ["comic_times", "tradeoff.times"])
+def test_check_sweeps_refuses_a_time_past_t_final(key):
+    config = copy.deepcopy(TINY)  # t_final 20
+    section = config["tradeoff"] if key == "tradeoff.times" else config
+    section[key.split(".")[-1]] = [5, 25]
+    msg = _refused(config)
+    assert key in msg and "25" in msg
+
+
+def test_fd_only_section_needs_no_realisations_entry():
+    cfg = copy.deepcopy(TINY)
+    cfg["figures"]["fig8"].update(realisations="ensemble", n=[30, 40])  # no realisations entry for n = 40
+    check_sweeps(cfg)
+    assert [e.realisations for e in figure_ensembles(cfg, "fig8")] == [1, 1]
