@@ -11,10 +11,10 @@ rule summarise_case:
         SUMMARY_PATTERN,
     log:
         f"logs/summarise_case/{CASE_DIR}/r~{{nreal}}.log",
-    params:
-        code=SUMMARY_CODE,
     resources:
         mem_mb=500,
+    params:
+        code=SUMMARY_CODE,
     run:
         count = summarise_files(list(input), output[0])
         Path(log[0]).write_text(f"summarised {count} realisations\n")
@@ -29,11 +29,11 @@ rule comic_tables:
         minima="results/tables/comic_minima.parquet",
     log:
         "logs/comic_tables.log",
+    conda:
+        "../../envs/particle-entropy.yaml"
     params:
         times=config["comic_times"],
         code=COMIC_CODE,
-    conda:
-        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/comic_tables.py"
 
@@ -47,11 +47,11 @@ rule comic_tables_fig9:
         minima="results/tables/fig9/comic_minima.parquet",
     log:
         "logs/comic_tables_fig9.log",
+    conda:
+        "../../envs/particle-entropy.yaml"
     params:
         times=config["comic_times"],
         code=COMIC_CODE,
-    conda:
-        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/comic_tables.py"
 
@@ -67,12 +67,12 @@ rule paper_claims:
         md="results/paper_claims.md",
     log:
         "logs/paper_claims.log",
+    conda:
+        "../../envs/particle-entropy.yaml"
     params:
         claims=config["claims"],
         case_defaults=config.get("case_defaults", {}),
         code=CLAIMS_CODE,
-    conda:
-        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/paper_claims.py"
 
@@ -84,10 +84,10 @@ rule tradeoff_table:
         "results/tables/tradeoff.parquet",
     log:
         "logs/tradeoff_table.log",
+    conda:
+        "../../envs/particle-entropy.yaml"
     params:
         times=config.get("tradeoff", {}).get("times", []),
         code=TRADEOFF_CODE,
-    conda:
-        "../../envs/particle-entropy.yaml"
     script:
         "../scripts/tradeoff_table.py"

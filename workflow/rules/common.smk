@@ -112,8 +112,7 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {
-    m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"])
-    for m in METHODS
+    m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"]) for m in METHODS
 }
 SUMMARY_CODE = code_version("aggregate")  # summarise_case's two-line run: block calls aggregate
 COMIC_CODE = code_version("aggregate", "io", files=[SCRIPTS / "comic_tables.py"])

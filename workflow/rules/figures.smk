@@ -18,15 +18,15 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             data=FIGURE_DATA_PATTERN.format(fig=_fig),
         log:
             f"logs/plot/{_fig}.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        resources:
+            mem_mb=1000,
         params:
             fig=_fig,
             cases=section_cases(_fig),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
             code=PLOT_CODE,
-        resources:
-            mem_mb=1000,
-        conda:
-            "../../envs/particle-entropy.yaml"
         script:
             "../scripts/plot_figure.py"

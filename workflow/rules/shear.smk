@@ -13,14 +13,14 @@ rule simulate_shear:
         "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
     wildcard_constraints:
         case="|".join(SHEAR_CASES),
-    params:
-        **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
-        code=SHEAR_CODE,
+    conda:
+        "../../envs/particle-entropy.yaml"
     resources:
         mem_mb=2000,
         runtime=10,
-    conda:
-        "../../envs/particle-entropy.yaml"
+    params:
+        **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
+        code=SHEAR_CODE,
     script:
         "../scripts/shear2d.py"
 
@@ -34,11 +34,11 @@ rule plot_fig10:
         data=FIGURE_DATA_PATTERN.format(fig="fig10"),
     log:
         "logs/plot/fig10.log",
-    params:
-        code=SHEAR_PLOT_CODE,
-    resources:
-        mem_mb=2000,
     conda:
         "../../envs/particle-entropy.yaml"
+    resources:
+        mem_mb=2000,
+    params:
+        code=SHEAR_PLOT_CODE,
     script:
         "../scripts/plot_fig10.py"

@@ -9,13 +9,13 @@ rule simulate:
         f"logs/simulate/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.log",
     benchmark:
         f"results/benchmarks/simulate/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
-    params:
-        settings=sim_settings,
-        code=lambda w: SIM_CODE[w.method],
+    conda:
+        "../../envs/particle-entropy.yaml"
     resources:
         mem_mb=sim_mem_mb,
         runtime=sim_runtime_min,
-    conda:
-        "../../envs/particle-entropy.yaml"
+    params:
+        settings=sim_settings,
+        code=lambda w: SIM_CODE[w.method],
     script:
         "../scripts/simulate.py"
