@@ -31,7 +31,8 @@ from particle_entropy import gauss, mtpt
 from particle_entropy.gauss import CUTOFF_SIGMAS, gauss_transform, neighbour_count
 from particle_entropy.mass_transfer import mass_transfer
 from particle_entropy.runconfig import RunConfig
-from particle_entropy.timegrid import time_steps, times as step_times
+from particle_entropy.timegrid import time_steps
+from particle_entropy.timegrid import times as step_times
 
 D = 1e-3
 WIDTHS = {"early": math.sqrt(4 * D * 0.01), "late": math.sqrt(4 * D * 0.01 * 1.05**174)}
@@ -115,8 +116,10 @@ def main() -> None:
     if a.boxes:
         box_widths(min_time)
         return
-    print("| N | width | masses | sigma | neighbours (9 sigma) | shipped ms | us per particle | windowed ms "
-          "| kdtree ms | authors ms | windowed / shipped | kdtree / shipped | authors / shipped |")
+    print(
+        "| N | width | masses | sigma | neighbours (9 sigma) | shipped ms | us per particle | windowed ms "
+        "| kdtree ms | authors ms | windowed / shipped | kdtree / shipped | authors / shipped |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for n in a.n:
         states = {}
@@ -149,9 +152,11 @@ def bench_row(n, label, kind, x, m, sigma, min_time):
         reasons.append("authors skipped: N > 3,000 (pure Python)")
     ms = {k: f"{1e3 * v:.3g}" for k, v in row.items()}
     ratio = {k: f"{row[k] / row['shipped']:.3g}x" for k in ("windowed", "kdtree", "authors") if k in row}
-    print(f"| {n:,} | {label} | {kind} | {sigma:.4f} | {nb:.0f} | {ms['shipped']} | {1e6 * row['shipped'] / n:.3g} "
-          f"| {ms.get('windowed', '-')} | {ms.get('kdtree', '-')} | {ms.get('authors', '-')} "
-          f"| {ratio.get('windowed', '-')} | {ratio.get('kdtree', '-')} | {ratio.get('authors', '-')} |")
+    print(
+        f"| {n:,} | {label} | {kind} | {sigma:.4f} | {nb:.0f} | {ms['shipped']} | {1e6 * row['shipped'] / n:.3g} "
+        f"| {ms.get('windowed', '-')} | {ms.get('kdtree', '-')} | {ms.get('authors', '-')} "
+        f"| {ratio.get('windowed', '-')} | {ratio.get('kdtree', '-')} | {ratio.get('authors', '-')} |"
+    )
     for r in reasons:
         print(f"<!-- N={n} {label} {kind}: {r} -->")
 
@@ -162,8 +167,11 @@ def box_widths(min_time, n=30000, ratios=(0.5, 1.0, 1.5, 2.5, 3.5)):
     sigma, for k weight vectors."""
     x = np.sort(np.random.default_rng(0).uniform(-5, 5, n))
     default = gauss.FGT_BOX_RATIOS
-    print("| weights | sources per sigma | " + " | ".join(f"fgt {r} sigma" for r in ratios)
-          + " | fgt planned | windowed |")
+    print(
+        "| weights | sources per sigma | "
+        + " | ".join(f"fgt {r} sigma" for r in ratios)
+        + " | fgt planned | windowed |"
+    )
     print("|---" * (len(ratios) + 4) + "|")
     try:
         for k in (1, 3):
@@ -173,8 +181,13 @@ def box_widths(min_time, n=30000, ratios=(0.5, 1.0, 1.5, 2.5, 3.5)):
                 cells = []
                 for r in ratios + (None,):
                     gauss.FGT_BOX_RATIOS = default if r is None else (r,)
-                    cells.append(timed(lambda: gauss_transform(x, x, q, sigma, method="fgt"), min_time))
-                direct = timed(lambda: gauss_transform(x, x, q, sigma, method="direct"), min_time) if per_sigma <= 30 else None
+                    fgt = lambda q=q, sigma=sigma: gauss_transform(x, x, q, sigma, method="fgt")  # noqa: E731
+                    cells.append(timed(fgt, min_time))
+                direct = (
+                    timed(lambda q=q, sigma=sigma: gauss_transform(x, x, q, sigma, method="direct"), min_time)
+                    if per_sigma <= 30
+                    else None
+                )
                 text = " | ".join(f"{1e3 * c:.3g}" for c in cells)
                 print(f"| {k} | {per_sigma} | {text} | {'-' if direct is None else f'{1e3 * direct:.3g}'} |")
     finally:

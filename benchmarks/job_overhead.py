@@ -27,8 +27,15 @@ def main() -> None:
             continue
         job_s = float(pd.read_csv(tsv, sep="\t")["s"].iloc[0])
         t = pd.read_parquet(table, columns=["wall_s", "seed", "n"])
-        rows.append({"job": str(rel), "n": int(t["n"].iloc[0]), "seeds": t["seed"].nunique(),
-                     "job_s": job_s, "sim_s": float(t["wall_s"].sum())})
+        rows.append(
+            {
+                "job": str(rel),
+                "n": int(t["n"].iloc[0]),
+                "seeds": t["seed"].nunique(),
+                "job_s": job_s,
+                "sim_s": float(t["wall_s"].sum()),
+            }
+        )
     df = pd.DataFrame(rows)
     df["overhead_s"] = df["job_s"] - df["sim_s"]
     print(f"{len(df)} simulate jobs, {df['seeds'].sum()} realisations")

@@ -44,8 +44,9 @@ def test_summary_means_and_stds_are_numpys(runs):
         v = np.stack([r[m].to_numpy(dtype=float) for r in runs])
         finite = np.isfinite(v).all(axis=0)
         np.testing.assert_allclose(s[f"{m}_mean"].to_numpy()[finite], v[:, finite].mean(axis=0), rtol=1e-13, atol=0)
-        np.testing.assert_allclose(s[f"{m}_std"].to_numpy()[finite], v[:, finite].std(axis=0, ddof=1),
-                                   rtol=1e-12, atol=1e-300)
+        np.testing.assert_allclose(
+            s[f"{m}_std"].to_numpy()[finite], v[:, finite].std(axis=0, ddof=1), rtol=1e-12, atol=1e-300
+        )
         # three identical -inf values (a zero SSE, t = 0): mean -inf, no spread
         same_inf = np.isneginf(v).all(axis=0)
         assert np.isneginf(s[f"{m}_mean"].to_numpy()[same_inf]).all()
@@ -102,13 +103,27 @@ NS = (30, 100, 300)
 def _summary(case: Case, comic: list[float], sse: list[float], sse_std: float = 0.0) -> pd.DataFrame:
     """A case summary at TIMES: COMIC_mean and SSE_mean per time, everything else fixed."""
     k = len(TIMES)
-    df = pd.DataFrame({
-        "step": np.arange(k), "time": TIMES, "n_realisations": 4,
-        "COMIC_mean": comic, "COMIC_std": 0.1, "SSE_mean": sse, "SSE_std": sse_std,
-        "n_sse": case.n, "dV": 10.0 / case.n, "H_C_mean": 1.0, "H_C_analytic": 0.75, "E_mean": 3.0,
-        "E_analytic": 2.0, "wall_cum_mean": np.arange(k) * 0.1, "wall_cum_std": 0.01, "work_mean": 5.0,
-        "peak_rss_mb_max": 100.0,
-    })
+    df = pd.DataFrame(
+        {
+            "step": np.arange(k),
+            "time": TIMES,
+            "n_realisations": 4,
+            "COMIC_mean": comic,
+            "COMIC_std": 0.1,
+            "SSE_mean": sse,
+            "SSE_std": sse_std,
+            "n_sse": case.n,
+            "dV": 10.0 / case.n,
+            "H_C_mean": 1.0,
+            "H_C_analytic": 0.75,
+            "E_mean": 3.0,
+            "E_analytic": 2.0,
+            "wall_cum_mean": np.arange(k) * 0.1,
+            "wall_cum_std": 0.01,
+            "work_mean": 5.0,
+            "peak_rss_mb_max": 100.0,
+        }
+    )
     for c, v in {**case.columns(), "D": 1e-3}.items():
         df[c] = v
     return df
@@ -204,8 +219,11 @@ def test_tradeoff_marks_one_optimum_per_model_and_time(variant):
     assert marked.groupby(["label", "time"]).size().eq(1).all()
     for model, name in ((PAPER, "paper"), (variant, "variant")):
         rows = marked[marked["label"] == model.label(n=False)]
-        assert dict(zip(rows["time"], rows["n"], strict=True)) == {5.0: OPT[name][4.8], 10.0: OPT[name][10.0],
-                                                      20.0: OPT[name][20.0]}
+        assert dict(zip(rows["time"], rows["n"], strict=True)) == {
+            5.0: OPT[name][4.8],
+            10.0: OPT[name][10.0],
+            20.0: OPT[name][20.0],
+        }
 
 
 def test_tradeoff_errors_and_costs():

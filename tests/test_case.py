@@ -23,8 +23,8 @@ def _grid() -> list[Case]:
         for kernel, growth in itertools.product(("bins", "fixed", "adaptive"), (1.0, 1.01, 1.05)):
             cases.append(Case("pt", kernel, n, dt_growth=growth))
         for kernel, eta, trunc, growth, scheme in itertools.product(
-                ("collision", "sph"), (0.1, 0.25, 0.5, 1.0), (None, 3.0), (1.0, 1.01, 1.05),
-                ("symmetric", "sequential")):
+            ("collision", "sph"), (0.1, 0.25, 0.5, 1.0), (None, 3.0), (1.0, 1.01, 1.05), ("symmetric", "sequential")
+        ):
             cases.append(Case("mtpt", kernel, n, eta=eta, truncation=trunc, dt_growth=growth, scheme=scheme))
     return cases
 
@@ -51,8 +51,7 @@ def test_case_is_frozen_and_hashable():
 
 def test_numbers_are_normalised():
     # an integer in config (eta: 1, truncation: 3) is the same case as its float
-    assert Case("mtpt", "collision", 30, eta=1, truncation=3) == Case("mtpt", "collision", 30, eta=1.0,
-                                                                      truncation=3.0)
+    assert Case("mtpt", "collision", 30, eta=1, truncation=3) == Case("mtpt", "collision", 30, eta=1.0, truncation=3.0)
     assert Case("mtpt", "collision", 30.0).n == 30 and isinstance(Case("mtpt", "collision", 30.0).n, int)
 
 
@@ -93,23 +92,34 @@ def test_model_and_at():
 
 
 # --------------------------------------------------------------------------- path text
-@pytest.mark.parametrize("case,path", [
-    (Case("mtpt", "collision", 300), "mtpt/collision/n~300/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
-    (Case("mtpt", "collision", 30000, eta=0.5),
-     "mtpt/collision/n~30000/eta~0.5/trunc~none/growth~1.05/scheme~symmetric"),
-    (Case("mtpt", "sph", 100, eta=0.1, truncation=3, dt_growth=1.01, scheme="sequential"),
-     "mtpt/sph/n~100/eta~0.1/trunc~3/growth~1.01/scheme~sequential"),
-    (Case("mtpt", "collision", 300, eta=0.25, truncation=2.5, dt_growth=1),
-     "mtpt/collision/n~300/eta~0.25/trunc~2.5/growth~1/scheme~symmetric"),
-    (Case("pt", "adaptive", 1000), "pt/adaptive/n~1000/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
-    (Case("fd", "implicit", 3000), "fd/implicit/n~3000/eta~1/trunc~none/growth~1/scheme~symmetric"),
-])
+@pytest.mark.parametrize(
+    "case,path",
+    [
+        (Case("mtpt", "collision", 300), "mtpt/collision/n~300/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
+        (
+            Case("mtpt", "collision", 30000, eta=0.5),
+            "mtpt/collision/n~30000/eta~0.5/trunc~none/growth~1.05/scheme~symmetric",
+        ),
+        (
+            Case("mtpt", "sph", 100, eta=0.1, truncation=3, dt_growth=1.01, scheme="sequential"),
+            "mtpt/sph/n~100/eta~0.1/trunc~3/growth~1.01/scheme~sequential",
+        ),
+        (
+            Case("mtpt", "collision", 300, eta=0.25, truncation=2.5, dt_growth=1),
+            "mtpt/collision/n~300/eta~0.25/trunc~2.5/growth~1/scheme~symmetric",
+        ),
+        (Case("pt", "adaptive", 1000), "pt/adaptive/n~1000/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
+        (Case("fd", "implicit", 3000), "fd/implicit/n~3000/eta~1/trunc~none/growth~1/scheme~symmetric"),
+    ],
+)
 def test_path_text_written_by_hand(case, path):
     assert case.path() == path
 
 
-@pytest.mark.parametrize("value,expected", [(1.0, "1"), (1, "1"), (0.5, "0.5"), (0.1, "0.1"), (1.05, "1.05"),
-                                            (3.0, "3"), (None, "none"), ("sph", "sph")])
+@pytest.mark.parametrize(
+    "value,expected",
+    [(1.0, "1"), (1, "1"), (0.5, "0.5"), (0.1, "0.1"), (1.05, "1.05"), (3.0, "3"), (None, "none"), ("sph", "sph")],
+)
 def test_text(value, expected):
     assert text(value) == expected
 
@@ -118,9 +128,19 @@ def test_text(value, expected):
 BASE = Case("mtpt", "collision", 300)
 
 
-@pytest.mark.parametrize("change", [{"kernel": "sph"}, {"n": 1000}, {"eta": 0.5}, {"truncation": 3.0},
-                                    {"dt_growth": 1.01}, {"dt_growth": 1.0}, {"scheme": "sequential"}],
-                         ids=lambda d: "-".join(f"{k}={v}" for k, v in d.items()))
+@pytest.mark.parametrize(
+    "change",
+    [
+        {"kernel": "sph"},
+        {"n": 1000},
+        {"eta": 0.5},
+        {"truncation": 3.0},
+        {"dt_growth": 1.01},
+        {"dt_growth": 1.0},
+        {"scheme": "sequential"},
+    ],
+    ids=lambda d: "-".join(f"{k}={v}" for k, v in d.items()),
+)
 def test_cases_one_dimension_apart_differ_everywhere(change):
     other = dataclasses.replace(BASE, **change)
     assert other != BASE
@@ -131,23 +151,26 @@ def test_cases_one_dimension_apart_differ_everywhere(change):
 
 
 # --------------------------------------------------------------------------- refusals
-@pytest.mark.parametrize("kwargs,name,value", [
-    ({"method": "mtpt", "kernel": "bins"}, "kernel", "bins"),
-    ({"method": "pt", "kernel": "collision"}, "kernel", "collision"),
-    ({"method": "walk", "kernel": "bins"}, "method", "walk"),
-    ({"method": "pt", "kernel": "bins", "scheme": "sequential"}, "scheme", "sequential"),
-    ({"method": "pt", "kernel": "fixed", "truncation": 3}, "truncation", "3"),
-    ({"method": "fd", "kernel": "implicit", "eta": 0.5}, "eta", "0.5"),
-    ({"method": "fd", "kernel": "implicit", "dt_growth": 1.05}, "dt_growth", "1.05"),
-    ({"method": "mtpt", "kernel": "collision", "eta": 1.5}, "eta", "1.5"),
-    ({"method": "mtpt", "kernel": "collision", "eta": -0.1}, "eta", "-0.1"),
-    ({"method": "mtpt", "kernel": "collision", "truncation": 0}, "truncation", "0"),
-    ({"method": "mtpt", "kernel": "collision", "truncation": -3}, "truncation", "-3"),
-    ({"method": "mtpt", "kernel": "collision", "dt_growth": 0.9}, "dt_growth", "0.9"),
-    ({"method": "mtpt", "kernel": "collision", "scheme": "matrix"}, "scheme", "matrix"),
-    ({"method": "mtpt", "kernel": "collision", "n": 0}, "n", "0"),
-    ({"method": "mtpt", "kernel": "collision", "n": 2.5}, "n", "2.5"),
-])
+@pytest.mark.parametrize(
+    "kwargs,name,value",
+    [
+        ({"method": "mtpt", "kernel": "bins"}, "kernel", "bins"),
+        ({"method": "pt", "kernel": "collision"}, "kernel", "collision"),
+        ({"method": "walk", "kernel": "bins"}, "method", "walk"),
+        ({"method": "pt", "kernel": "bins", "scheme": "sequential"}, "scheme", "sequential"),
+        ({"method": "pt", "kernel": "fixed", "truncation": 3}, "truncation", "3"),
+        ({"method": "fd", "kernel": "implicit", "eta": 0.5}, "eta", "0.5"),
+        ({"method": "fd", "kernel": "implicit", "dt_growth": 1.05}, "dt_growth", "1.05"),
+        ({"method": "mtpt", "kernel": "collision", "eta": 1.5}, "eta", "1.5"),
+        ({"method": "mtpt", "kernel": "collision", "eta": -0.1}, "eta", "-0.1"),
+        ({"method": "mtpt", "kernel": "collision", "truncation": 0}, "truncation", "0"),
+        ({"method": "mtpt", "kernel": "collision", "truncation": -3}, "truncation", "-3"),
+        ({"method": "mtpt", "kernel": "collision", "dt_growth": 0.9}, "dt_growth", "0.9"),
+        ({"method": "mtpt", "kernel": "collision", "scheme": "matrix"}, "scheme", "matrix"),
+        ({"method": "mtpt", "kernel": "collision", "n": 0}, "n", "0"),
+        ({"method": "mtpt", "kernel": "collision", "n": 2.5}, "n", "2.5"),
+    ],
+)
 def test_refusals_name_key_and_value(kwargs, name, value):
     with pytest.raises(SettingError) as e:
         Case(**kwargs)
@@ -181,8 +204,9 @@ def test_from_spec_takes_defaults_only_where_they_apply():
 
 
 def test_from_spec_spec_beats_defaults_and_none_means_whole_kernel():
-    mt = Case.from_spec({"method": "mtpt", "kernel": "collision", "eta": 1, "truncation": "none",
-                         "dt_growth": 1}, 30, DEFAULTS)
+    mt = Case.from_spec(
+        {"method": "mtpt", "kernel": "collision", "eta": 1, "truncation": "none", "dt_growth": 1}, 30, DEFAULTS
+    )
     assert (mt.eta, mt.truncation, mt.dt_growth, mt.scheme) == (1.0, None, 1.0, "sequential")
     # config case_defaults write truncation: none
     paper = Case.from_spec({"method": "mtpt", "kernel": "collision"}, 30, {"truncation": "none", "dt_growth": 1.05})
@@ -213,15 +237,24 @@ def test_variant_lists_only_the_dimensions_off_the_paper():
     assert Case("mtpt", "collision", 300).variant() == {}
     assert Case("mtpt", "collision", 300, eta=0.1).variant() == {}  # eta is a paper dimension (Fig. 5)
     assert Case("mtpt", "collision", 300, truncation=3, scheme="sequential").variant() == {
-        "truncation": 3.0, "scheme": "sequential"}
+        "truncation": 3.0,
+        "scheme": "sequential",
+    }
     assert Case("pt", "bins", 300, dt_growth=1).variant() == {"dt_growth": 1.0}
     assert Case("fd", "implicit", 300).variant() == {}
 
 
 def test_sort_key_orders_methods_kernels_eta_and_variants():
-    ordered = [Case("pt", "bins", 30), Case("pt", "adaptive", 30), Case("mtpt", "collision", 30),
-               Case("mtpt", "collision", 300), Case("mtpt", "collision", 30, truncation=3),
-               Case("mtpt", "collision", 30, eta=0.5), Case("mtpt", "sph", 30), Case("fd", "implicit", 30)]
+    ordered = [
+        Case("pt", "bins", 30),
+        Case("pt", "adaptive", 30),
+        Case("mtpt", "collision", 30),
+        Case("mtpt", "collision", 300),
+        Case("mtpt", "collision", 30, truncation=3),
+        Case("mtpt", "collision", 30, eta=0.5),
+        Case("mtpt", "sph", 30),
+        Case("fd", "implicit", 30),
+    ]
     shuffled = [ordered[i] for i in (7, 3, 5, 0, 6, 2, 4, 1)]
     assert sorted(shuffled, key=Case.sort_key) == ordered
 
@@ -230,11 +263,16 @@ def test_sort_key_orders_methods_kernels_eta_and_variants():
 def _table() -> pd.DataFrame:
     """A hand-built result table: two MTPT models differing only in truncation, one PT, one FD."""
     rows = []
-    for tag, case in [("a30", Case("mtpt", "collision", 30)), ("a100", Case("mtpt", "collision", 100)),
-                      ("t30", Case("mtpt", "collision", 30, truncation=3)),
-                      ("t100", Case("mtpt", "collision", 100, truncation=3)),
-                      ("p30", Case("pt", "bins", 30)), ("f30", Case("fd", "implicit", 30)),
-                      ("f100", Case("fd", "implicit", 100)), ("a30b", Case("mtpt", "collision", 30))]:
+    for tag, case in [
+        ("a30", Case("mtpt", "collision", 30)),
+        ("a100", Case("mtpt", "collision", 100)),
+        ("t30", Case("mtpt", "collision", 30, truncation=3)),
+        ("t100", Case("mtpt", "collision", 100, truncation=3)),
+        ("p30", Case("pt", "bins", 30)),
+        ("f30", Case("fd", "implicit", 30)),
+        ("f100", Case("fd", "implicit", 100)),
+        ("a30b", Case("mtpt", "collision", 30)),
+    ]:
         rows.append({**case.columns(), "tag": tag})
     return pd.DataFrame(rows)
 
@@ -247,8 +285,12 @@ def test_by_model_groups_rows_into_the_right_models():
         Case("mtpt", "collision", truncation=3): ["t100", "t30"],
         Case("fd", "implicit"): ["f100", "f30"],
     }
-    assert models_in(_table()) == [Case("pt", "bins"), Case("mtpt", "collision"),
-                                   Case("mtpt", "collision", truncation=3), Case("fd", "implicit")]
+    assert models_in(_table()) == [
+        Case("pt", "bins"),
+        Case("mtpt", "collision"),
+        Case("mtpt", "collision", truncation=3),
+        Case("fd", "implicit"),
+    ]
 
 
 def test_case_mask_and_rows_of_select_one_case_or_a_model():

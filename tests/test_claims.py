@@ -13,21 +13,26 @@ import pytest
 from particle_entropy.case import Case
 from particle_entropy.claims import comic_claims, ensemble_claims, single_run_claims, to_markdown
 
-TOL = {"fd_optimum_nodes": [1000, 10000], "collision_eta1_optimum": [1000, 10000],
-       "collision_eta05_optimum": [100, 1000], "sph_flat_max_spread": 2.0, "adaptive_pt_hc_tolerance": 0.05}
+TOL = {
+    "fd_optimum_nodes": [1000, 10000],
+    "collision_eta1_optimum": [1000, 10000],
+    "collision_eta05_optimum": [100, 1000],
+    "sph_flat_max_spread": 2.0,
+    "adaptive_pt_hc_tolerance": 0.05,
+}
 TIMES = (250.0, 500.0, 1000.0)
 
 
 def _minima(rows: list[tuple[Case, float, int, int]]) -> pd.DataFrame:
     """(model, time, n_opt, n_opt_of_mean_SSE) -> a minima table."""
-    return pd.DataFrame([{"label": m.label(), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k}
-                         for m, t, n, k in rows])
+    return pd.DataFrame(
+        [{"label": m.label(), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k} for m, t, n, k in rows]
+    )
 
 
 def _comic(rows: list[tuple[Case, float, float]]) -> pd.DataFrame:
     """(case with N, time, mean COMIC) -> a COMIC table."""
-    return pd.DataFrame([{"label": c.label(n=False), **c.columns(), "time": t, "COMIC_mean": v}
-                         for c, t, v in rows])
+    return pd.DataFrame([{"label": c.label(n=False), **c.columns(), "time": t, "COMIC_mean": v} for c, t, v in rows])
 
 
 EMPTY_COMIC = _comic([(Case("fd", "implicit", 30), 1000.0, 0.0)])  # no SPH rows: no flatness claim
@@ -44,8 +49,10 @@ def _by_claim(claims: list[dict]) -> dict[str, bool]:
 
 # --------------------------------------------------------------------------- FD optimum
 def test_fd_optimum_inside_passes_and_outside_fails():
-    minima = _minima([(Case("fd", "implicit"), t, n, n) for t, n in zip(TIMES, (3000, 3000, 30000), strict=True)]
-                     + [(Case("fd", "explicit"), t, n, n) for t, n in zip(TIMES, (300, 30000, 3000), strict=True)])
+    minima = _minima(
+        [(Case("fd", "implicit"), t, n, n) for t, n in zip(TIMES, (3000, 3000, 30000), strict=True)]
+        + [(Case("fd", "explicit"), t, n, n) for t, n in zip(TIMES, (300, 30000, 3000), strict=True)]
+    )
     claims = _by_claim(comic_claims(minima, EMPTY_COMIC, TOL))
     assert len(claims) == 2
     implicit = [c for c in claims if Case("fd", "implicit").label() in c]
@@ -57,11 +64,13 @@ def test_fd_optimum_inside_passes_and_outside_fails():
 
 # --------------------------------------------------------------------------- MTPT optima
 def test_collision_optima_inside_pass_and_outside_fail():
-    minima = _minima([
-        (COLL1, 250.0, 30, 30),  # an earlier time: not judged
-        (COLL1, 1000.0, 3000, 1000),  # inside [1000, 10000] both ways
-        (COLL05, 1000.0, 300, 3000),  # inside [100, 1000] by mean COMIC, outside by COMIC of mean SSE
-    ])
+    minima = _minima(
+        [
+            (COLL1, 250.0, 30, 30),  # an earlier time: not judged
+            (COLL1, 1000.0, 3000, 1000),  # inside [1000, 10000] both ways
+            (COLL05, 1000.0, 300, 3000),  # inside [100, 1000] by mean COMIC, outside by COMIC of mean SSE
+        ]
+    )
     claims = comic_claims(minima, EMPTY_COMIC, TOL)
     assert len(claims) == 4
     by = _by_claim(claims)
@@ -146,16 +155,17 @@ def _run(case: Case, h_d0: float, gap: float, late_gap: float, e_rel: float) -> 
     hc_an = np.array([-np.inf, -1.0, 0.0, 1.0, 3.0])
     hc = hc_an + np.array([0.0, gap, gap, gap, late_gap])
     e_an = np.array([0.0, 0.1, 0.3, 1.0, 10.0])
-    return _summary(case, t, H_D=[h_d0, 1, 1, 1, 1], H_C=hc, H_C_analytic=hc_an, E=e_an * (1 + e_rel),
-                    E_analytic=e_an)
+    return _summary(case, t, H_D=[h_d0, 1, 1, 1, 1], H_C=hc, H_C_analytic=hc_an, E=e_an * (1 + e_rel), E_analytic=e_an)
 
 
 def test_single_run_claims_on_runs_built_to_pass():
     runs = []
     for n, e_rel in ((300, -0.3), (3000, -0.1)):
-        runs += [_run(Case("pt", "bins", n), math.log(n), 0.01, 0.5, 0.0),
-                 _run(Case("pt", "fixed", n), math.log(n), 0.2, 0.0, 0.0),
-                 _run(Case("mtpt", "collision", n), 0.0, -0.2, 0.0, e_rel)]
+        runs += [
+            _run(Case("pt", "bins", n), math.log(n), 0.01, 0.5, 0.0),
+            _run(Case("pt", "fixed", n), math.log(n), 0.2, 0.0, 0.0),
+            _run(Case("mtpt", "collision", n), 0.0, -0.2, 0.0, e_rel),
+        ]
     claims = single_run_claims(runs)
     assert len(claims) == 2 * 5 + 1
     assert all(c["passed"] for c in claims), [c["claim"] for c in claims if not c["passed"]]
@@ -167,8 +177,12 @@ def test_single_run_claims_on_runs_built_to_pass():
 
 # --------------------------------------------------------------------------- markdown
 def test_markdown_counts_passes():
-    claims = pd.DataFrame([{"claim": f"c{k}", "paper": "p", "reproduced": "r", "tolerance": "t", "passed": ok}
-                           for k, ok in enumerate([True, False, True, True, False])])
+    claims = pd.DataFrame(
+        [
+            {"claim": f"c{k}", "paper": "p", "reproduced": "r", "tolerance": "t", "passed": ok}
+            for k, ok in enumerate([True, False, True, True, False])
+        ]
+    )
     lines = to_markdown(claims).splitlines()
     assert lines[0].startswith("# ")
     assert "3 of 5 claims pass" in lines[2]

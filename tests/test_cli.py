@@ -9,15 +9,42 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-OPTIONS = ["--method", "--kernel", "--n", "--eta", "--D", "--t-final", "--dt0", "--dt-growth",
-           "--truncation", "--seed", "--out", "--state-out"]
-TABLE_COLUMNS = ["step", "time", "dt", "H_D", "H_C", "E", "SSE", "COMIC", "mass_total", "mass_min",
-                 "beta", "h", "substeps", "wall_s"]
+OPTIONS = [
+    "--method",
+    "--kernel",
+    "--n",
+    "--eta",
+    "--D",
+    "--t-final",
+    "--dt0",
+    "--dt-growth",
+    "--truncation",
+    "--seed",
+    "--out",
+    "--state-out",
+]
+TABLE_COLUMNS = [
+    "step",
+    "time",
+    "dt",
+    "H_D",
+    "H_C",
+    "E",
+    "SSE",
+    "COMIC",
+    "mass_total",
+    "mass_min",
+    "beta",
+    "h",
+    "substeps",
+    "wall_s",
+]
 
 
 def _cli(*args, timeout=120):
-    return subprocess.run([sys.executable, "-m", "particle_entropy", *args],
-                          capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "particle_entropy", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def test_help_lists_every_option():
@@ -46,8 +73,21 @@ def test_help_lists_every_option():
 )
 def test_bad_values_exit_2_name_the_option_and_write_nothing(tmp_path, bad, option):
     out = tmp_path / "out.parquet"
-    res = _cli("simulate", "--method", "mtpt", "--n", "20", "--t-final", "1", *bad, "--out", str(out),
-               "--state-out", str(tmp_path / "state.parquet"), "--quiet")
+    res = _cli(
+        "simulate",
+        "--method",
+        "mtpt",
+        "--n",
+        "20",
+        "--t-final",
+        "1",
+        *bad,
+        "--out",
+        str(out),
+        "--state-out",
+        str(tmp_path / "state.parquet"),
+        "--quiet",
+    )
     assert res.returncode == 2, res.stderr[-2000:]
     options = option if isinstance(option, tuple) else (option,)
     assert any(o in res.stderr for o in options), res.stderr[-2000:]
@@ -58,8 +98,23 @@ def test_bad_values_exit_2_name_the_option_and_write_nothing(tmp_path, bad, opti
 def test_good_run_writes_table_and_state(tmp_path):
     out = tmp_path / "sub" / "run.parquet"
     state = tmp_path / "state.parquet"
-    res = _cli("simulate", "--method", "mtpt", "--n", "50", "--t-final", "1", "--seed", "3", "--truncation", "none",
-               "--out", str(out), "--state-out", str(state))
+    res = _cli(
+        "simulate",
+        "--method",
+        "mtpt",
+        "--n",
+        "50",
+        "--t-final",
+        "1",
+        "--seed",
+        "3",
+        "--truncation",
+        "none",
+        "--out",
+        str(out),
+        "--state-out",
+        str(state),
+    )
     assert res.returncode == 0, res.stderr[-2000:]
     tab = pq.read_table(out).to_pandas()
     for col in TABLE_COLUMNS:

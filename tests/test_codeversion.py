@@ -119,5 +119,6 @@ def test_mtpt_simulation_closure_holds_mass_transfer():
     mods = closure(["simulate", "mtpt"], exclude={"pt", "fd"})
     assert {"simulate", "mtpt", "mass_transfer"} <= set(mods)
     assert "pt" not in mods and "fd" not in mods
-    assert code_version("simulate", "mtpt", exclude={"pt", "fd"}) != code_version("simulate", "fd",
-                                                                                 exclude={"pt", "mtpt"})
+    assert code_version("simulate", "mtpt", exclude={"pt", "fd"}) != code_version(
+        "simulate", "fd", exclude={"pt", "mtpt"}
+    )

@@ -30,8 +30,9 @@ def finite_after_start(table):
 
 
 @pytest.mark.parametrize("n", [1, 2, 10])
-@pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("pt", "fixed"), ("pt", "adaptive"),
-                                           ("mtpt", "collision"), ("mtpt", "sph")])
+@pytest.mark.parametrize(
+    "method,kernel", [("pt", "bins"), ("pt", "fixed"), ("pt", "adaptive"), ("mtpt", "collision"), ("mtpt", "sph")]
+)
 def test_tiny_particle_numbers(n, method, kernel):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -89,7 +90,9 @@ def test_eta_zero_is_a_pure_random_walk_and_eta_one_never_moves():
     assert not np.array_equal(s0["x"].to_numpy(), init["x"].to_numpy())
 
 
-@pytest.mark.parametrize("dt0,growth,t_final", [(1e-6, 1.5, 1.0), (1e3, 1.05, 10.0), (1e3, 1.0, 3000.0), (0.5, 1.0, 0.2)])
+@pytest.mark.parametrize(
+    "dt0,growth,t_final", [(1e-6, 1.5, 1.0), (1e3, 1.05, 10.0), (1e3, 1.0, 3000.0), (0.5, 1.0, 0.2)]
+)
 def test_time_steps_from_tiny_to_huge(dt0, growth, t_final):
     tab = run(RunConfig(method="mtpt", kernel="collision", n=500, dt0=dt0, dt_growth=growth, t_final=t_final))[0]
     assert tab["time"].iloc[-1] == t_final
@@ -126,8 +129,24 @@ def test_explicit_fd_within_its_limit_matches_implicit():
 
 def test_cli_refuses_explicit_fd_past_limit(tmp_path):
     out = tmp_path / "x.parquet"
-    proc = subprocess.run([sys.executable, "-m", "particle_entropy", "simulate", "--method", "fd", "--kernel",
-                           "explicit", "--n", "3000", "--out", str(out)], capture_output=True, text=True)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "particle_entropy",
+            "simulate",
+            "--method",
+            "fd",
+            "--kernel",
+            "explicit",
+            "--n",
+            "3000",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 2 and "--dt0" in proc.stderr and not out.exists()
 
 

@@ -6,11 +6,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import dense_kernel
 
 from particle_entropy import gauss
 from particle_entropy.gauss import CUTOFF_SIGMAS, gauss_transform
-
-from conftest import dense_kernel
 
 # Both methods drop pairs farther apart than CUTOFF_SIGMAS sigma (documented); each dropped
 # term is below exp(-CUTOFF_SIGMAS^2 / 2) |q_j|. The error bound used below is therefore
@@ -188,9 +187,12 @@ def test_fgt_error_bound_dominates_the_dropped_terms(ratio):
                 h.append(2 * t * h[k] - 2 * k * h[k - 1])
             for u in (-a / 2, a / 2):
                 for v in (-a / 2, a / 2):
-                    kept = sum(h[n + m] * u**n * (-v) ** m / (math.factorial(n) * math.factorial(m))
-                               for n in range(p) for m in range(p))
-                    worst = max(worst, abs(math.exp(-(t + v - u) ** 2) - kept))
+                    kept = sum(
+                        h[n + m] * u**n * (-v) ** m / (math.factorial(n) * math.factorial(m))
+                        for n in range(p)
+                        for m in range(p)
+                    )
+                    worst = max(worst, abs(math.exp(-((t + v - u) ** 2)) - kept))
         assert worst <= gauss.fgt_error_bound(ratio, p)
 
 

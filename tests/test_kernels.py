@@ -17,7 +17,7 @@ def test_h_de_eq23():
     # by hand: 300^(-0.2) = 0.319577, sqrt(2) = 1.414214 -> 0.479067
     assert h_de(300, 1e-3, 1000.0) == pytest.approx(0.479067, abs=2e-6)
     # N = 30000, t = 10: 1.06 * 30000^(-0.2) * sqrt(0.02)
-    assert h_de(30000, 1e-3, 10.0) == pytest.approx(1.06 * 30000 ** -0.2 * math.sqrt(0.02), rel=1e-14)
+    assert h_de(30000, 1e-3, 10.0) == pytest.approx(1.06 * 30000**-0.2 * math.sqrt(0.02), rel=1e-14)
     assert h_de(300, 1e-3, 0.0) == 0.0
 
 
@@ -40,7 +40,7 @@ def test_collision_sigma_eq17():
     assert s * s == pytest.approx(4 * 0.5 * 1e-3 * 2.0, rel=1e-14)  # = 0.004
     assert s == pytest.approx(0.0632455532, abs=1e-10)
     r = np.linspace(0, 0.3, 7)
-    np.testing.assert_allclose(np.exp(-r**2 / (2 * s * s)), np.exp(-r**2 / (8 * eta * D * dt)), rtol=1e-14)
+    np.testing.assert_allclose(np.exp(-(r**2) / (2 * s * s)), np.exp(-(r**2) / (8 * eta * D * dt)), rtol=1e-14)
     assert collision_sigma(1.0, 1e-3, 0.01) == pytest.approx(math.sqrt(4e-5), rel=1e-14)
     assert collision_sigma(0.0, 1e-3, 0.01) == 0.0
 

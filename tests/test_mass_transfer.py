@@ -6,10 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from conftest import dense_kernel, dense_mass_update, dense_transfer_matrix
 
 from particle_entropy.mass_transfer import mass_transfer, transfer_matrix_dense
-
-from conftest import dense_kernel, dense_mass_update, dense_transfer_matrix
 
 
 def _positions(rng, n):

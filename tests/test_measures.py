@@ -7,10 +7,9 @@ import warnings
 
 import numpy as np
 import pytest
+from conftest import gaussian, no_runtime_warnings
 
 from particle_entropy import measures as M
-
-from conftest import gaussian, no_runtime_warnings
 
 
 # --------------------------------------------------------------------------- discrete entropy

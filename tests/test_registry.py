@@ -68,9 +68,18 @@ def test_registry_kernels_partition_all_kernels():
 # --------------------------------------------------------------------------- schema defaults
 def test_schema_walk_finds_the_defaults_of_every_section():
     paths = {p for p, _ in _defaults(SCHEMA)}
-    for expected in [("physics", "D"), ("physics", "fixed_kernel_time"), ("time", "fixed_dt"), ("base_seed",),
-                     ("seed_blocks", "size"), ("numerics", "transfer_tolerance"), ("case_defaults", "eta"),
-                     ("case_defaults", "truncation"), ("case_defaults", "scheme"), ("shear", "beta")]:
+    for expected in [
+        ("physics", "D"),
+        ("physics", "fixed_kernel_time"),
+        ("time", "fixed_dt"),
+        ("base_seed",),
+        ("seed_blocks", "size"),
+        ("numerics", "transfer_tolerance"),
+        ("case_defaults", "eta"),
+        ("case_defaults", "truncation"),
+        ("case_defaults", "scheme"),
+        ("shear", "beta"),
+    ]:
         assert expected in paths, expected
 
 
@@ -126,8 +135,17 @@ def _simulate_parser():
 
 def test_cli_defaults_equal_paper():
     a = build_parser().parse_args(["simulate", "--out", "x.parquet"])
-    for key in ["D", "t_final", "omega", "fd_length", "fixed_kernel_time", "eta", "scheme", "transfer_method",
-                "transfer_tolerance"]:
+    for key in [
+        "D",
+        "t_final",
+        "omega",
+        "fd_length",
+        "fixed_kernel_time",
+        "eta",
+        "scheme",
+        "transfer_method",
+        "transfer_tolerance",
+    ]:
         assert getattr(a, key) == PAPER[key], key
 
 

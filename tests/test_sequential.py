@@ -67,7 +67,7 @@ def test_masses_stay_non_negative_under_strong_transfer():
 @pytest.mark.parametrize("truncation", [None, 3.0])
 def test_mass_conserved_when_no_clipping_is_needed(truncation):
     x = np.linspace(-2, 2, 300)
-    m = np.exp(-x**2) + 0.5  # smooth and positive
+    m = np.exp(-(x**2)) + 0.5  # smooth and positive
     m /= m.sum()
     out = sequential_transfer(x, m, 0.03, 0.1, truncation, np.random.default_rng(3))
     assert np.all(out > 0)

@@ -8,14 +8,13 @@ import warnings
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import ensemble_stats, gaussian, no_runtime_warnings
 
 from particle_entropy.io import write_parquet
-from particle_entropy.records import TIMING_COLUMNS
 from particle_entropy.kernels import h_de
+from particle_entropy.records import TIMING_COLUMNS
 from particle_entropy.runconfig import RunConfig
 from particle_entropy.simulate import run
-
-from conftest import ensemble_stats, gaussian, no_runtime_warnings
 
 D = 1e-3
 T = 1000.0
@@ -26,8 +25,9 @@ T = 1000.0
 @pytest.mark.parametrize("eta", [1.0, 0.5, 0.1])
 @pytest.mark.parametrize("kernel", ["collision", "sph"])
 def test_mtpt_conserves_mass_at_every_step(kernel, eta, truncation):
-    tab, state = run(RunConfig(method="mtpt", kernel=kernel, n=300, eta=eta, truncation=truncation, seed=11),
-                     want_state=True)
+    tab, state = run(
+        RunConfig(method="mtpt", kernel=kernel, n=300, eta=eta, truncation=truncation, seed=11), want_state=True
+    )
     assert len(tab) == 176 and tab["time"].iloc[-1] == T
     assert np.max(np.abs(tab["mass_total"].to_numpy() - 1.0)) <= 1e-12
     assert np.all(tab["mass_min"].to_numpy() >= 0.0)
@@ -100,8 +100,9 @@ def _final_errors(cfg_kwargs, seeds):
         E.append(last["E"])
         E_an.append(last["E_analytic"])
         n = cfg_kwargs["n"]
-        assert last["H_C_analytic"] == pytest.approx(-math.log(10.0 / n) + 0.5 * math.log(4 * math.pi * D * T) + 0.5,
-                                                     rel=1e-14)
+        assert last["H_C_analytic"] == pytest.approx(
+            -math.log(10.0 / n) + 0.5 * math.log(4 * math.pi * D * T) + 0.5, rel=1e-14
+        )
         assert last["E"] == pytest.approx(last["dV"] * math.exp(last["H_C"]), rel=1e-13)
     assert np.allclose(E_an, math.sqrt(4 * math.pi * math.e * D * T), rtol=1e-14, atol=0)
     return np.array(errs)
@@ -132,8 +133,9 @@ def test_mtpt_collision_small_n_under_mixes():
 # --------------------------------------------------------------------------- FD convergence
 def _fd_error(n, dt, t_final, length):
     """Max-norm error of the final FD profile against N(0, 2Dt), relative to the peak."""
-    tab, state = run(RunConfig(method="fd", n=n, dt0=dt, dt_growth=1.0, t_final=t_final, fd_length=length),
-                     want_state=True)
+    tab, state = run(
+        RunConfig(method="fd", n=n, dt0=dt, dt_growth=1.0, t_final=t_final, fd_length=length), want_state=True
+    )
     t = tab["time"].iloc[-1]
     assert t == pytest.approx(t_final, rel=1e-12)
     x, c = state["x"].to_numpy(), state["c"].to_numpy()
@@ -243,7 +245,9 @@ def test_tables_have_no_nan_and_runs_emit_no_runtime_warning(kwargs):
     assert np.all(np.isfinite(later.to_numpy())), later.columns[~np.isfinite(later.to_numpy()).all(axis=0)].tolist()
     assert np.all(np.isfinite(num.drop(columns=[c for c in NUMERIC_SKIP if c in num]).iloc[0].to_numpy()))
     assert tab["step"].tolist() == list(range(len(tab)))
-    np.testing.assert_allclose(tab["time"].to_numpy()[1:], np.cumsum(tab["dt"].to_numpy()[1:]), rtol=1e-12)  # cumulative round-off of ~1000 additions; the last time is set to t_final exactly
+    np.testing.assert_allclose(
+        tab["time"].to_numpy()[1:], np.cumsum(tab["dt"].to_numpy()[1:]), rtol=1e-12
+    )  # cumulative round-off of ~1000 additions; the last time is set to t_final exactly
 
 
 # --------------------------------------------------------------------------- final row vs state
@@ -265,7 +269,7 @@ def test_pt_adaptive_final_entropy_is_kde_entropy():
     n = 300
     tab, st = run(RunConfig(method="pt", kernel="adaptive", n=n, seed=9), want_state=True)
     x = st["x"].to_numpy()
-    h = 1.06 * n ** -0.2 * math.sqrt(2 * D * T)
+    h = 1.06 * n**-0.2 * math.sqrt(2 * D * T)
     grid = np.arange(x.min() - 9 * h, x.max() + 9 * h, h / 40)
     f = np.exp(-0.5 * ((grid[:, None] - x[None, :]) / h) ** 2).sum(axis=1) / (n * h * math.sqrt(2 * math.pi))
     f = f[f > 0]

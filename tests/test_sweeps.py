@@ -54,7 +54,7 @@ def test_smaller_ensembles_share_the_first_blocks_of_larger_ones(size):
     for small, large in ((20, 60), (60, 80), (20, 80)):
         full = [(a, b) for a, b in blocks[small] if b - a + 1 == size]  # a short last block cannot be shared
         assert len(full) == small // size
-        assert blocks[large][:len(full)] == full
+        assert blocks[large][: len(full)] == full
 
 
 def test_one_seed_per_job_above_max_n():
@@ -65,12 +65,15 @@ def test_one_seed_per_job_above_max_n():
 
 def test_case_run_paths_written_by_hand():
     ens = Ensemble(Case("mtpt", "collision", 30), 80)
-    assert case_run_paths(ens, SHIPPED) == [f"results/runs/{PAPER_DIR}/seeds~{a}-{a + 19}.parquet"
-                                            for a in (0, 20, 40, 60)]
+    assert case_run_paths(ens, SHIPPED) == [
+        f"results/runs/{PAPER_DIR}/seeds~{a}-{a + 19}.parquet" for a in (0, 20, 40, 60)
+    ]
     big = Ensemble(Case("mtpt", "collision", 30000), 4)  # 30000 <= max_n: one block of 4
     assert case_run_paths(big, SHIPPED) == [f"results/runs/{PAPER_DIR.replace('n~30/', 'n~30000/')}/seeds~0-3.parquet"]
-    assert run_path(Case("mtpt", "collision", 30), 5, kind="snapshots") == \
-        f"results/snapshots/{PAPER_DIR}/seeds~5-5.parquet"
+    assert (
+        run_path(Case("mtpt", "collision", 30), 5, kind="snapshots")
+        == f"results/snapshots/{PAPER_DIR}/seeds~5-5.parquet"
+    )
 
 
 def test_summary_path_and_ensemble_wildcards():
@@ -97,8 +100,11 @@ def test_realisations_from_the_table_and_capped():
 
 
 def test_fd_gets_one_realisation():
-    spec = {"cases": [{"method": "fd", "kernel": "implicit"}, {"method": "mtpt", "kernel": "sph"}],
-            "n": [30, 100], "realisations": "ensemble"}
+    spec = {
+        "cases": [{"method": "fd", "kernel": "implicit"}, {"method": "mtpt", "kernel": "sph"}],
+        "n": [30, 100],
+        "realisations": "ensemble",
+    }
     got = {(e.case.method, e.case.n): e.realisations for e in spec_ensembles(spec, SHIPPED)}
     assert got == {("fd", 30): 1, ("fd", 100): 1, ("mtpt", 30): 80, ("mtpt", 100): 80}
 
@@ -110,19 +116,32 @@ def test_shipped_fig9_expands_to_the_realisations_table():
     assert len(ens) == 21
     for e in ens:
         assert e.realisations == counts[e.case.n]
-    assert {e.case.model for e in ens} == {Case("mtpt", "collision"), Case("mtpt", "sph"),
-                                           Case("mtpt", "collision", eta=0.5)}
+    assert {e.case.model for e in ens} == {
+        Case("mtpt", "collision"),
+        Case("mtpt", "sph"),
+        Case("mtpt", "collision", eta=0.5),
+    }
 
 
 def test_shipped_fig3_is_capped_at_20():
     assert {(e.case.kernel, e.case.n): e.realisations for e in figure_ensembles(SHIPPED, "fig3")} == {
-        ("adaptive", 300): 20, ("adaptive", 30000): 4, ("sph", 300): 20, ("sph", 30000): 4}
+        ("adaptive", 300): 20,
+        ("adaptive", 30000): 4,
+        ("sph", 300): 20,
+        ("sph", 30000): 4,
+    }
 
 
 def test_spec_ensembles_take_case_defaults_where_they_apply():
     config = {**TINY, "case_defaults": {"eta": 1, "truncation": "none", "dt_growth": 1.3}}
-    spec = {"cases": [{"method": "fd", "kernel": "implicit"}, {"method": "pt", "kernel": "bins"},
-                      {"method": "mtpt", "kernel": "collision", "dt_growth": 1.01}], "n": [30]}
+    spec = {
+        "cases": [
+            {"method": "fd", "kernel": "implicit"},
+            {"method": "pt", "kernel": "bins"},
+            {"method": "mtpt", "kernel": "collision", "dt_growth": 1.01},
+        ],
+        "n": [30],
+    }
     growth = [e.case.dt_growth for e in spec_ensembles(spec, config)]
     assert growth == [1.0, 1.3, 1.01]
 
@@ -133,19 +152,24 @@ def test_case_sections_of_the_shipped_config():
 
 
 # --------------------------------------------------------------------------- run settings
-SETTINGS = {"physics": {"D": 2e-3, "t_final": 50, "omega": 8, "fd_length": 10, "fixed_kernel_time": 2},
-            "time": {"dt0": 0.02, "fd_dt": 0.3, "fixed_dt": 2.0},
-            "numerics": {"transfer_method": "direct", "transfer_tolerance": 1e-10}}
+SETTINGS = {
+    "physics": {"D": 2e-3, "t_final": 50, "omega": 8, "fd_length": 10, "fixed_kernel_time": 2},
+    "time": {"dt0": 0.02, "fd_dt": 0.3, "fixed_dt": 2.0},
+    "numerics": {"transfer_method": "direct", "transfer_tolerance": 1e-10},
+}
 
 
-@pytest.mark.parametrize("case,dt0", [
-    (Case("fd", "implicit", 100), 0.3),
-    (Case("pt", "bins", 100, dt_growth=1), 2.0),
-    (Case("mtpt", "collision", 100, dt_growth=1), 2.0),
-    (Case("mtpt", "collision", 100), 0.02),
-    (Case("mtpt", "sph", 100, dt_growth=1.01), 0.02),
-    (Case("pt", "adaptive", 100), 0.02),
-])
+@pytest.mark.parametrize(
+    "case,dt0",
+    [
+        (Case("fd", "implicit", 100), 0.3),
+        (Case("pt", "bins", 100, dt_growth=1), 2.0),
+        (Case("mtpt", "collision", 100, dt_growth=1), 2.0),
+        (Case("mtpt", "collision", 100), 0.02),
+        (Case("mtpt", "sph", 100, dt_growth=1.01), 0.02),
+        (Case("pt", "adaptive", 100), 0.02),
+    ],
+)
 def test_run_settings_first_step(case, dt0):
     s = run_settings(case, SETTINGS)
     assert s["dt0"] == dt0

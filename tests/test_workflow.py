@@ -17,8 +17,7 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 from particle_entropy.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
-from particle_entropy.sweeps import (FIGURE_READS, Ensemble, case_run_paths, figure_ensembles, run_path,
-                                    spec_ensembles)
+from particle_entropy.sweeps import FIGURE_READS, Ensemble, case_run_paths, figure_ensembles, run_path, spec_ensembles
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -46,6 +45,7 @@ def planned_outputs(proc, prefix="results/runs/"):
 
 
 # --- schema --------------------------------------------------------------------------------
+
 
 def test_shipped_config_is_valid():
     validate(load(ROOT / "config.yaml"), str(SCHEMA))
@@ -102,6 +102,7 @@ def test_kernel_method_mismatch_is_refused(tmp_path):
 
 # --- dry runs on the full config -------------------------------------------------------------
 
+
 def test_full_dry_run_plans_every_figure(tmp_path):
     proc = snakemake(tmp_path, "-n", configfile=ROOT / "config.yaml")
     out = proc.stdout + proc.stderr
@@ -122,12 +123,19 @@ def test_one_figure_runs_only_its_jobs(tmp_path):
 
 
 def test_slurm_profile_parses(tmp_path):
-    proc = snakemake(tmp_path, "-n", "--profile", str(ROOT / "workflow/profiles/slurm"), "figures/fig8.png",
-                     configfile=ROOT / "config.yaml")
+    proc = snakemake(
+        tmp_path,
+        "-n",
+        "--profile",
+        str(ROOT / "workflow/profiles/slurm"),
+        "figures/fig8.png",
+        configfile=ROOT / "config.yaml",
+    )
     assert len(planned_outputs(proc)) == 7
 
 
 # --- a tiny end-to-end run --------------------------------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory):
@@ -145,8 +153,9 @@ def test_tiny_run_builds_every_figure(tiny_run):
 
 def test_tiny_run_tables_have_documented_columns(tiny_run):
     comic = pd.read_parquet(tiny_run / "results/tables/comic.parquet")
-    assert {"label", *CASE_COLUMNS, "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std",
-            "n_realisations"} <= set(comic.columns)
+    assert {"label", *CASE_COLUMNS, "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std", "n_realisations"} <= set(
+        comic.columns
+    )
     cfg = load(TINY)
     expected = {e.case.model for f in ("fig8", "fig9") for e in figure_ensembles(cfg, f)}
     assert set(models_in(comic)) == expected
@@ -162,8 +171,23 @@ def test_tiny_run_tables_have_documented_columns(tiny_run):
     assert (tiny_run / "results/paper_claims.md").read_text().count("| ") > len(claims)
     run = next((tiny_run / "results/runs/mtpt").rglob("*.parquet"))
     cols = set(pd.read_parquet(run).columns)
-    assert {"step", "time", "dt", "H_D", "H_C", "E", "SSE", "COMIC", "mass_total", "mass_min", "beta", "h",
-            "substeps", "wall_s", "seed"} <= cols
+    assert {
+        "step",
+        "time",
+        "dt",
+        "H_D",
+        "H_C",
+        "E",
+        "SSE",
+        "COMIC",
+        "mass_total",
+        "mass_min",
+        "beta",
+        "h",
+        "substeps",
+        "wall_s",
+        "seed",
+    } <= cols
 
 
 def test_summary_averages_its_realisations(tiny_run):
@@ -187,7 +211,8 @@ def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
     proc = snakemake(tiny_run, "-n", configfile=new)
     runs = planned_outputs(proc)
     assert runs and all("/n~400/" in r for r in runs)
-    assert len(runs) == 6  # 3 Fig. 9 models x 2 seeds, one seed a job (N = 400 > seed_blocks.max_n)
+    models = len(cfg["figures"]["fig9"]["cases"])
+    assert len(runs) == models * 2  # each Fig. 9 model x 2 seeds, one seed a job (N = 400 > seed_blocks.max_n)
     figs = set(planned_outputs(proc, prefix="figures/"))
     assert figs == {"figures/fig9.png", "figures/fig9.pdf"}
 
@@ -203,6 +228,7 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
 
 
 # --- a figure target pulls only its own simulations ------------------------------------------
+
 
 def _expected_runs(cfg, fig):
     ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
@@ -228,11 +254,13 @@ def test_fig10_target_runs_only_the_shear_cases(tmp_path):
     proc = snakemake(tmp_path, "-n", "figures/fig10.png", configfile=TINY)
     assert planned_outputs(proc) == []
     shear = planned_outputs(proc, prefix="results/shear/")
-    assert sorted(shear) == sorted(f"results/shear/{c}/seed~0/{f}.parquet" for c in ("rw_nodrift", "rw_drift", "mt")
-                                   for f in ("steps", "state"))
+    assert sorted(shear) == sorted(
+        f"results/shear/{c}/seed~0/{f}.parquet" for c in ("rw_nodrift", "rw_drift", "mt") for f in ("steps", "state")
+    )
 
 
 # --- a killed run resumes to the same tables ----------------------------------------------------
+
 
 def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     import os
@@ -240,8 +268,19 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     import time
 
     target = "results/tables/comic.parquet"
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2", target,
-           "--configfile", str(TINY)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-s",
+        str(ROOT / "Snakefile"),
+        "-d",
+        str(tmp_path),
+        "-j2",
+        target,
+        "--configfile",
+        str(TINY),
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.time() + 120
     while time.time() < deadline and len(list((tmp_path / "results").rglob("*.parquet"))) < 6:
@@ -305,8 +344,10 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
     truncated = replace(base, truncation=3.0)
     sequential = replace(truncated, scheme="sequential")
     models = (base, truncated, sequential)
-    tables = {name: pd.read_parquet(tiny_run / f"results/tables/{name}.parquet")
-              for name in ("comic", "comic_minima", "tradeoff")}
+    tables = {
+        name: pd.read_parquet(tiny_run / f"results/tables/{name}.parquet")
+        for name in ("comic", "comic_minima", "tradeoff")
+    }
     tables["fig9"] = pd.read_parquet(tiny_run / "results/figures/fig9.parquet")
     for name, table in tables.items():
         parts = [rows_of(table, m) for m in models]
@@ -322,13 +363,16 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
 
 
 def test_sequential_scheme_runs_the_authors_loop(tiny_run):
-    runs = list((tiny_run / "results/runs/mtpt/collision").glob("n~100/eta~1/trunc~3/growth~*/scheme~sequential/*.parquet"))
+    runs = list(
+        (tiny_run / "results/runs/mtpt/collision").glob("n~100/eta~1/trunc~3/growth~*/scheme~sequential/*.parquet")
+    )
     assert runs
     table = pd.read_parquet(runs[0])
     assert set(table["scheme"]) == {"sequential"} and set(table["truncation"]) == {3.0}
 
 
 # --- code edits rerun exactly what they change -------------------------------------------------
+
 
 def _planned_rules(proc):
     return set(re.findall(r"^\s*(?:local)?rule (\w+):", proc.stdout + proc.stderr, flags=re.M)) - {"all"}
@@ -342,15 +386,24 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
     shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
 
     def plan():
-        cmd = [sys.executable, "-m", "snakemake", "-s", str(src / "Snakefile"), "-d", str(work), "-n",
-               "--configfile", str(TINY)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(src / "Snakefile"),
+            "-d",
+            str(work),
+            "-n",
+            "--configfile",
+            str(TINY),
+        ]
         proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
         return _planned_rules(proc), proc
 
     assert plan()[0] == set()  # the same code in another place: nothing to do
     lib = src / "workflow/lib/particle_entropy"
-    for module, expected in [("plots.py", lambda r: r.startswith("plot_")),
-                             ("mass_transfer.py", None)]:
+    for module, expected in [("plots.py", lambda r: r.startswith("plot_")), ("mass_transfer.py", None)]:
         original = (lib / module).read_text()
         (lib / module).write_text(original + "\n# an edit\n")
         rules, proc = plan()
@@ -360,7 +413,8 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
             sims = planned_outputs(proc)
             assert sims and all(p.startswith("results/runs/mtpt/") for p in sims)
             assert planned_outputs(proc, "results/snapshots/") == sorted(
-                str(p.relative_to(work)) for p in (work / "results/snapshots/mtpt").rglob("*.parquet"))
+                str(p.relative_to(work)) for p in (work / "results/snapshots/mtpt").rglob("*.parquet")
+            )
             assert "simulate_shear" not in rules and "plot_fig10" not in rules
         (lib / module).write_text(original)  # identical content again (a newer mtime): nothing to do
         assert plan()[0] == set(), module

@@ -1,4 +1,5 @@
-"""Draw Fig. 10 (Appendix B shear flow) from the final particle tables of the three cases."""
+"""Draw Fig. 10 (Appendix B shear flow) from the final particle tables of the three cases; write
+the figure and the data it plots (source data)."""
 
 import sys
 
@@ -11,7 +12,11 @@ matplotlib.use("Agg")
 import pandas as pd  # noqa: E402
 
 from particle_entropy import plots_shear  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
 
+out = snakemake.output  # noqa: F821
 states = [pd.read_parquet(p) for p in snakemake.input]  # noqa: F821
-plots_shear.save_figure(plots_shear.fig10(states), snakemake.output.png, snakemake.output.pdf)  # noqa: F821
-print(f"drew fig10 from {len(states)} state tables", file=sys.stderr)
+figure, data = plots_shear.fig10(states)
+plots_shear.save_figure(figure, out.png, out.pdf)
+write_parquet(data, out.data)
+print(f"drew fig10 from {len(states)} state tables, {len(data)} plotted points", file=sys.stderr)

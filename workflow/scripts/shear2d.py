@@ -23,5 +23,8 @@ steps, state = run_shear(cfg, progress=lambda msg: print(msg, file=sys.stderr))
 write_parquet(steps, snakemake.output.steps)  # noqa: F821
 write_parquet(state, snakemake.output.state)  # noqa: F821
 last = steps.iloc[-1]
-print(f"{cfg.case} seed {cfg.seed}: wall_fraction {last.wall_fraction:.4f}, mass_total {last.mass_total:.15g}, "
-      f"mass_min {steps.mass_min.min():.3g}, {steps.wall_s.sum():.1f} s", file=sys.stderr)
+print(
+    f"{cfg.case} seed {cfg.seed}: wall_fraction {last.wall_fraction:.4f}, mass_total {last.mass_total:.15g}, "
+    f"mass_min {steps.mass_min.min():.3g}, {steps.wall_s.sum():.1f} s",
+    file=sys.stderr,
+)

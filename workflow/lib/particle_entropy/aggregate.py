@@ -73,16 +73,21 @@ def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.Data
     """Cost (wall time) beside error (RMSE, H_C and E errors) and COMIC per model, N and time."""
     rows = []
     for r, case in _case_rows(summaries, times):
-        rows.append({
-            **case,
-            "wall_s": r["wall_cum_mean"], "wall_s_std": r["wall_cum_std"],
-            "work": r["work_mean"], "peak_rss_mb": r["peak_rss_mb_max"],
-            "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
-            "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
-            "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
-            "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
-            "n_realisations": int(r["n_realisations"]),
-        })
+        rows.append(
+            {
+                **case,
+                "wall_s": r["wall_cum_mean"],
+                "wall_s_std": r["wall_cum_std"],
+                "work": r["work_mean"],
+                "peak_rss_mb": r["peak_rss_mb_max"],
+                "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
+                "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
+                "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
+                "COMIC_mean": r["COMIC_mean"],
+                "COMIC_std": r["COMIC_std"],
+                "n_realisations": int(r["n_realisations"]),
+            }
+        )
     df = _sorted(pd.DataFrame(rows))
     # one optimum per model and time, the smallest N among ties, as comic_minima reports it
     best = df.groupby([*MODEL_COLUMNS, "time"])["COMIC_mean"].idxmin()
@@ -103,16 +108,32 @@ def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFra
     """COMIC and SSE statistics per model, N and requested time (results/tables/comic.parquet)."""
     rows = []
     for r, case in _case_rows(summaries, times):
-        rows.append({
-            **case, "time_step": float(r["time"]),
-            "COMIC_mean": r["COMIC_mean"], "COMIC_std": r["COMIC_std"],
-            **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
-            "SSE_mean": r["SSE_mean"], "SSE_std": r["SSE_std"],
-            "n_realisations": int(r["n_realisations"]),
-        })
-    cols = ["label", *CASE_COLUMNS, "time", "time_step", "COMIC_mean", "COMIC_std",
-            "COMIC_of_mean_SSE", "COMIC_of_mean_SSE_lo", "COMIC_of_mean_SSE_hi",
-            "SSE_mean", "SSE_std", "n_realisations"]
+        rows.append(
+            {
+                **case,
+                "time_step": float(r["time"]),
+                "COMIC_mean": r["COMIC_mean"],
+                "COMIC_std": r["COMIC_std"],
+                **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
+                "SSE_mean": r["SSE_mean"],
+                "SSE_std": r["SSE_std"],
+                "n_realisations": int(r["n_realisations"]),
+            }
+        )
+    cols = [
+        "label",
+        *CASE_COLUMNS,
+        "time",
+        "time_step",
+        "COMIC_mean",
+        "COMIC_std",
+        "COMIC_of_mean_SSE",
+        "COMIC_of_mean_SSE_lo",
+        "COMIC_of_mean_SSE_hi",
+        "SSE_mean",
+        "SSE_std",
+        "n_realisations",
+    ]
     return _sorted(pd.DataFrame(rows, columns=cols))
 
 
@@ -149,8 +170,12 @@ def _minimum(model, time: float, g: pd.DataFrame) -> dict:
     below = g.iloc[k - 1] if k > 0 else None
     above = g.iloc[k + 1] if k + 1 < len(g) else None
     return {
-        "label": model.label(), **model.columns(), "time": time, "n_opt": int(g["n"][k]),
-        "COMIC_opt": g["COMIC_mean"][k], "COMIC_opt_std": g["COMIC_std"][k],
+        "label": model.label(),
+        **model.columns(),
+        "time": time,
+        "n_opt": int(g["n"][k]),
+        "COMIC_opt": g["COMIC_mean"][k],
+        "COMIC_opt_std": g["COMIC_std"][k],
         "n_opt_of_mean_SSE": int(g["n"][int(np.argmin(g["COMIC_of_mean_SSE"].to_numpy()))]),
         "n_below": int(below["n"]) if below is not None else -1,
         "COMIC_below": below["COMIC_mean"] if below is not None else np.nan,

@@ -11,8 +11,8 @@ and a config that sets them otherwise is refused.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
-from typing import Iterator, Mapping
 
 import numpy as np
 import pandas as pd
@@ -41,8 +41,15 @@ COLUMN_DOCS = {
     "dt_growth": "time-step growth factor dt_{k+1} / dt_k (1: fixed step)",
     "scheme": "symmetric (Eqs. 16-21) or sequential (the authors' pairwise loop)",
 }
-KERNEL_NAMES = {"bins": "binned", "fixed": "fixed kernel", "adaptive": "adaptive kernel",
-                "collision": "collision", "sph": "SPH", "implicit": "implicit", "explicit": "explicit"}
+KERNEL_NAMES = {
+    "bins": "binned",
+    "fixed": "fixed kernel",
+    "adaptive": "adaptive kernel",
+    "collision": "collision",
+    "sph": "SPH",
+    "implicit": "implicit",
+    "explicit": "explicit",
+}
 # Which dimensions apply to which method; the others hold NEUTRAL values.
 APPLIES = {
     "eta": ("mtpt",),
@@ -99,7 +106,9 @@ class Case:
             if getattr(self, dim) is DEFAULT:
                 object.__setattr__(self, dim, PAPER[dim] if self.method in methods else NEUTRAL[dim])
         if self.kernel not in KERNELS[self.method]:
-            raise SettingError("kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}")
+            raise SettingError(
+                "kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}"
+            )
         if self.n is not None:
             integral = isinstance(self.n, (int, np.integer)) or (isinstance(self.n, float) and self.n.is_integer())
             if isinstance(self.n, bool) or not integral or self.n < 1:
@@ -113,12 +122,16 @@ class Case:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         for dim, methods in APPLIES.items():
             if self.method not in methods and getattr(self, dim) != NEUTRAL[dim]:
-                raise SettingError(dim, getattr(self, dim), f"{dim} applies to method {' and '.join(methods)} only "
-                                   f"(method {self.method} takes {text(NEUTRAL[dim])})")
+                raise SettingError(
+                    dim,
+                    getattr(self, dim),
+                    f"{dim} applies to method {' and '.join(methods)} only "
+                    f"(method {self.method} takes {text(NEUTRAL[dim])})",
+                )
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_spec(cls, spec: Mapping, n: int | None = None, defaults: Mapping | None = None) -> "Case":
+    def from_spec(cls, spec: Mapping, n: int | None = None, defaults: Mapping | None = None) -> Case:
         """A config case ``{method, kernel, eta?, truncation?, dt_growth?, scheme?}`` at ``n``,
         unset dimensions from ``defaults`` (config case_defaults, then the paper's)."""
         unknown = set(spec) - {"method", "kernel", *APPLIES}
@@ -138,20 +151,32 @@ class Case:
         return cls(method=method, kernel=spec.get("kernel"), n=n, **dims)
 
     @classmethod
-    def from_wildcards(cls, w: Mapping) -> "Case":
+    def from_wildcards(cls, w: Mapping) -> Case:
         """The case named by path wildcards (inverse of ``wildcards``)."""
-        return cls(method=w["method"], kernel=w["kernel"], n=int(w["n"]) if "n" in w.keys() else None,
-                   eta=float(w["eta"]), truncation=None if w["trunc"] == "none" else float(w["trunc"]),
-                   dt_growth=float(w["growth"]), scheme=w["scheme"])
+        return cls(
+            method=w["method"],
+            kernel=w["kernel"],
+            n=int(w["n"]) if "n" in w.keys() else None,
+            eta=float(w["eta"]),
+            truncation=None if w["trunc"] == "none" else float(w["trunc"]),
+            dt_growth=float(w["growth"]),
+            scheme=w["scheme"],
+        )
 
     @classmethod
-    def from_row(cls, row: Mapping) -> "Case":
+    def from_row(cls, row: Mapping) -> Case:
         """The case of a table row (inverse of ``columns``); without an ``n`` column, a model."""
         trunc = float(row["truncation"])
         n = row["n"] if "n" in row.keys() else None
-        return cls(method=str(row["method"]), kernel=str(row["kernel"]), n=None if n is None else int(n),
-                   eta=float(row["eta"]), truncation=None if math.isinf(trunc) else trunc,
-                   dt_growth=float(row["dt_growth"]), scheme=str(row["scheme"]))
+        return cls(
+            method=str(row["method"]),
+            kernel=str(row["kernel"]),
+            n=None if n is None else int(n),
+            eta=float(row["eta"]),
+            truncation=None if math.isinf(trunc) else trunc,
+            dt_growth=float(row["dt_growth"]),
+            scheme=str(row["scheme"]),
+        )
 
     # ------------------------------------------------------------------ representations
     def wildcards(self) -> dict[str, str]:
@@ -166,19 +191,25 @@ class Case:
 
     def columns(self) -> dict:
         """Typed table columns (truncation: inf for the whole kernel; a model has no n)."""
-        cols = {"method": self.method, "kernel": self.kernel, "n": self.n, "eta": self.eta,
-                "truncation": math.inf if self.truncation is None else self.truncation,
-                "dt_growth": self.dt_growth, "scheme": self.scheme}
+        cols = {
+            "method": self.method,
+            "kernel": self.kernel,
+            "n": self.n,
+            "eta": self.eta,
+            "truncation": math.inf if self.truncation is None else self.truncation,
+            "dt_growth": self.dt_growth,
+            "scheme": self.scheme,
+        }
         if self.n is None:
             del cols["n"]
         return cols
 
     @property
-    def model(self) -> "Case":
+    def model(self) -> Case:
         """The same case at every N."""
         return replace(self, n=None)
 
-    def at(self, n: int) -> "Case":
+    def at(self, n: int) -> Case:
         return replace(self, n=n)
 
     def variant(self) -> dict:
@@ -206,9 +237,16 @@ class Case:
         return ", ".join(parts)
 
     def sort_key(self) -> tuple:
-        return (METHODS.index(self.method), KERNELS[self.method].index(self.kernel), -self.eta,
-                len(self.variant()), math.inf if self.truncation is None else self.truncation, self.dt_growth,
-                SCHEMES.index(self.scheme), self.n or 0)
+        return (
+            METHODS.index(self.method),
+            KERNELS[self.method].index(self.kernel),
+            -self.eta,
+            len(self.variant()),
+            math.inf if self.truncation is None else self.truncation,
+            self.dt_growth,
+            SCHEMES.index(self.scheme),
+            self.n or 0,
+        )
 
 
 # ---------------------------------------------------------------------- tables of cases

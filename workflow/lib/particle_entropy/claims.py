@@ -42,29 +42,74 @@ def single_run_claims(runs: list[pd.DataFrame], defaults: dict | None = None) ->
     paper = lambda method, kernel, n: Case.from_spec({"method": method, "kernel": kernel}, n, defaults)  # noqa: E731
     for n in sorted({int(r["n"].iloc[0]) for r in runs}):
         try:
-            pt, mt, fx = (_pick(runs, paper(m, k, n)) for m, k in (("pt", "bins"), ("mtpt", "collision"),
-                                                                  ("pt", "fixed")))
+            pt, mt, fx = (
+                _pick(runs, paper(m, k, n)) for m, k in (("pt", "bins"), ("mtpt", "collision"), ("pt", "fixed"))
+            )
         except KeyError:
             continue
-        out.append(_claim(f"classical PT has H_D = ln N at t = 0 (N={n})", f"{math.log(n):.6f}",
-                          f"{pt['H_D'].iloc[0]:.6f}", "1e-12", abs(pt["H_D"].iloc[0] - math.log(n)) < 1e-12))
-        out.append(_claim(f"MTPT represents the delta exactly, H_D(0) = 0 (N={n})", "0",
-                          f"{mt['H_D'].iloc[0]:.3g}", "exact", mt["H_D"].iloc[0] == 0.0))
+        out.append(
+            _claim(
+                f"classical PT has H_D = ln N at t = 0 (N={n})",
+                f"{math.log(n):.6f}",
+                f"{pt['H_D'].iloc[0]:.6f}",
+                "1e-12",
+                abs(pt["H_D"].iloc[0] - math.log(n)) < 1e-12,
+            )
+        )
+        out.append(
+            _claim(
+                f"MTPT represents the delta exactly, H_D(0) = 0 (N={n})",
+                "0",
+                f"{mt['H_D'].iloc[0]:.3g}",
+                "exact",
+                mt["H_D"].iloc[0] == 0.0,
+            )
+        )
         early, late = _near(pt, 1.0), _near(pt, 1000.0)
         e_err, l_err = abs(early.H_C - early.H_C_analytic), abs(late.H_C - late.H_C_analytic)
-        out.append(_claim(f"binned PT matches H_C early, diverges late (N={n})", "error(t=1000) > error(t=1)",
-                          f"|dH_C| {e_err:.3f} at t=1, {l_err:.3f} at t=1000", "late > early", l_err > e_err))
+        out.append(
+            _claim(
+                f"binned PT matches H_C early, diverges late (N={n})",
+                "error(t=1000) > error(t=1)",
+                f"|dH_C| {e_err:.3f} at t=1, {l_err:.3f} at t=1000",
+                "late > early",
+                l_err > e_err,
+            )
+        )
         d_fx, d_mt = _early_gap(fx), _early_gap(mt)
-        out.append(_claim(f"fixed-kernel PT over-estimates early mixing (N={n})", f"H_C > analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
-                          f"mean {d_fx:+.3f} nats", "> 0", d_fx > 0))
-        out.append(_claim(f"MTPT collision under-estimates early entropy (N={n})", f"H_C < analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
-                          f"mean {d_mt:+.3f} nats", "< 0", d_mt < 0))
+        out.append(
+            _claim(
+                f"fixed-kernel PT over-estimates early mixing (N={n})",
+                f"H_C > analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
+                f"mean {d_fx:+.3f} nats",
+                "> 0",
+                d_fx > 0,
+            )
+        )
+        out.append(
+            _claim(
+                f"MTPT collision under-estimates early entropy (N={n})",
+                f"H_C < analytic for {EARLY[0]:g} <= t <= {EARLY[1]:g}",
+                f"mean {d_mt:+.3f} nats",
+                "< 0",
+                d_mt < 0,
+            )
+        )
     ns = sorted({int(r["n"].iloc[0]) for r in runs})
     if len(ns) >= 2:
-        errs = {n: abs(_near(_pick(runs, paper("mtpt", "collision", n)), 10.0).pipe(lambda r: r.E / r.E_analytic - 1))
-                for n in ns}
-        out.append(_claim("MTPT collision converges faster for larger N", "relative E error at t = 10 falls with N",
-                          ", ".join(f"N={n}: {errs[n]:.3f}" for n in ns), "monotone", errs[ns[-1]] < errs[ns[0]]))
+        errs = {
+            n: abs(_near(_pick(runs, paper("mtpt", "collision", n)), 10.0).pipe(lambda r: r.E / r.E_analytic - 1))
+            for n in ns
+        }
+        out.append(
+            _claim(
+                "MTPT collision converges faster for larger N",
+                "relative E error at t = 10 falls with N",
+                ", ".join(f"N={n}: {errs[n]:.3f}" for n in ns),
+                "monotone",
+                errs[ns[-1]] < errs[ns[0]],
+            )
+        )
     return out
 
 
@@ -76,9 +121,15 @@ def ensemble_claims(summaries: list[pd.DataFrame], tol_hc: float, defaults: dict
         if case.method == "pt" and case.kernel == "adaptive":
             last = _near(s, 1000.0)
             d = last.H_C_mean - last.H_C_analytic
-            out.append(_claim(f"adaptive-kernel PT matches analytic H_C ({case.label()})", "close at t = 1000",
-                              f"{d:+.4f} nats ({int(last.n_realisations)} realisations)", f"{tol_hc} nats",
-                              abs(d) <= tol_hc))
+            out.append(
+                _claim(
+                    f"adaptive-kernel PT matches analytic H_C ({case.label()})",
+                    "close at t = 1000",
+                    f"{d:+.4f} nats ({int(last.n_realisations)} realisations)",
+                    f"{tol_hc} nats",
+                    abs(d) <= tol_hc,
+                )
+            )
     ns = sorted({int(s["n"].iloc[0]) for s in summaries if s["method"].iloc[0] == "mtpt"})
     for n in ns:
         try:
@@ -90,9 +141,15 @@ def ensemble_claims(summaries: list[pd.DataFrame], tol_hc: float, defaults: dict
                 change[k] = abs(math.log(e01 / e1))
         except KeyError:
             continue
-        out.append(_claim(f"eta = 0.1 changes collision little, SPH much (N={n})", "|d ln E| sph > collision",
-                          f"collision {change['collision']:.3f}, sph {change['sph']:.3f}", "sph > 2 x collision",
-                          change["sph"] > 2 * change["collision"]))
+        out.append(
+            _claim(
+                f"eta = 0.1 changes collision little, SPH much (N={n})",
+                "|d ln E| sph > collision",
+                f"collision {change['collision']:.3f}, sph {change['sph']:.3f}",
+                "sph > 2 x collision",
+                change["sph"] > 2 * change["collision"],
+            )
+        )
     return out
 
 
@@ -102,34 +159,61 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
     out = []
     for model, fd in by_model(minima[minima["method"] == "fd"]):
         lo, hi = tol["fd_optimum_nodes"]
-        inside = ((fd["n_opt"] >= lo) & (fd["n_opt"] <= hi))
-        out.append(_claim(f"{model.label()}: COMIC minimal near 3000 nodes at almost every time", "~3000",
-                          ", ".join(f"t={t:g}: {n}" for t, n in zip(fd["time"], fd["n_opt"])),
-                          f"N_opt in [{lo}, {hi}]", inside.mean() >= 0.5))
+        inside = (fd["n_opt"] >= lo) & (fd["n_opt"] <= hi)
+        out.append(
+            _claim(
+                f"{model.label()}: COMIC minimal near 3000 nodes at almost every time",
+                "~3000",
+                ", ".join(f"t={t:g}: {n}" for t, n in zip(fd["time"], fd["n_opt"])),
+                f"N_opt in [{lo}, {hi}]",
+                inside.mean() >= 0.5,
+            )
+        )
     final = minima[minima["time"] == minima["time"].max()]
     mtpt = final[final["method"] == "mtpt"]
-    for kernel, eta, key, paper in [("collision", 1.0, "collision_eta1_optimum", "~3000 (1000-10,000)"),
-                                    ("collision", 0.5, "collision_eta05_optimum", "~300")]:
+    for kernel, eta, key, paper in [
+        ("collision", 1.0, "collision_eta1_optimum", "~3000 (1000-10,000)"),
+        ("collision", 0.5, "collision_eta05_optimum", "~300"),
+    ]:
         for model, row in by_model(mtpt[(mtpt["kernel"] == kernel) & (mtpt["eta"] == eta)]):
             lo, hi = tol[key]
             for col, how in [("n_opt", "mean of COMIC"), ("n_opt_of_mean_SSE", "COMIC of mean SSE")]:
                 n_opt = int(row[col].iloc[0])
-                out.append(_claim(f"{model.label()}: COMIC minimum at t = {row['time'].iloc[0]:g} ({how})", paper,
-                                  str(n_opt), f"[{lo}, {hi}]", lo <= n_opt <= hi))
+                out.append(
+                    _claim(
+                        f"{model.label()}: COMIC minimum at t = {row['time'].iloc[0]:g} ({how})",
+                        paper,
+                        str(n_opt),
+                        f"[{lo}, {hi}]",
+                        lo <= n_opt <= hi,
+                    )
+                )
     last = comic[(comic["time"] == comic["time"].max()) & (comic["method"] == "mtpt")]
     for model, sph in by_model(last[(last["kernel"] == "sph") & (last["eta"] == 1.0)]):
         big = sph[sph["n"] >= 100]["COMIC_mean"]
         spread = float(big.max() - big.min())
-        out.append(_claim(f"{model.label()}: COMIC roughly flat for N >= 100", "flat", f"spread {spread:.2f} nats",
-                          f"<= {tol['sph_flat_max_spread']}", spread <= tol["sph_flat_max_spread"]))
+        out.append(
+            _claim(
+                f"{model.label()}: COMIC roughly flat for N >= 100",
+                "flat",
+                f"spread {spread:.2f} nats",
+                f"<= {tol['sph_flat_max_spread']}",
+                spread <= tol["sph_flat_max_spread"],
+            )
+        )
     return out
 
 
 def to_markdown(claims: pd.DataFrame) -> str:
     """A referee-friendly table of the claims."""
-    lines = ["# Paper claims: reproduced values", "",
-             f"{int(claims['passed'].sum())} of {len(claims)} claims pass.", "",
-             "| claim | paper | reproduced | tolerance | result |", "|---|---|---|---|---|"]
+    lines = [
+        "# Paper claims: reproduced values",
+        "",
+        f"{int(claims['passed'].sum())} of {len(claims)} claims pass.",
+        "",
+        "| claim | paper | reproduced | tolerance | result |",
+        "|---|---|---|---|---|",
+    ]
     for _, c in claims.iterrows():
         lines.append(f"| {c.claim} | {c.paper} | {c.reproduced} | {c.tolerance} | {'pass' if c.passed else 'FAIL'} |")
     return "\n".join(lines) + "\n"

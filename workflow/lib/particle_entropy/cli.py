@@ -30,33 +30,72 @@ def build_parser() -> argparse.ArgumentParser:
         "and write one row per time step (entropies, dilution index, SSE, COMIC, mass, cost) as Parquet.",
     )
     by_method = "; ".join(f"{m}: {'|'.join(KERNELS[m])}" for m in METHODS)
-    s.add_argument("--method", choices=METHODS, default="mtpt",
-                   help="pt: random walks; mtpt: mass transfer; fd: finite differences")
-    s.add_argument("--kernel", choices=ALL_KERNELS, default=None,
-                   help=f"{by_method}. Default: {', '.join(DEFAULT_KERNEL[m] for m in METHODS)}")
+    s.add_argument(
+        "--method",
+        choices=METHODS,
+        default="mtpt",
+        help="pt: random walks; mtpt: mass transfer; fd: finite differences",
+    )
+    s.add_argument(
+        "--kernel",
+        choices=ALL_KERNELS,
+        default=None,
+        help=f"{by_method}. Default: {', '.join(DEFAULT_KERNEL[m] for m in METHODS)}",
+    )
     s.add_argument("--n", type=int, default=300, help="particles (pt, mtpt) or FD intervals, dx = L / N [-]")
-    s.add_argument("--eta", type=float, default=PAPER["eta"], help="mtpt: fraction of D done by mass transfer, in [0, 1] [-]")
+    s.add_argument(
+        "--eta", type=float, default=PAPER["eta"], help="mtpt: fraction of D done by mass transfer, in [0, 1] [-]"
+    )
     s.add_argument("--D", type=float, default=PAPER["D"], help="diffusion coefficient [L^2/T]")
     s.add_argument("--t-final", type=float, default=PAPER["t_final"], help="final time [T]")
-    s.add_argument("--dt0", type=float, default=None,
-                   help=f"first time step [T] (default {PAPER['dt0']:g}; fixed step {PAPER['fixed_dt']:g} when "
-                        f"dt-growth is 1; fd: {PAPER['fd_dt']:g})")
-    s.add_argument("--dt-growth", type=float, default=None,
-                   help=f"dt_{{n+1}} = growth dt_n, 1 = fixed step [-] (default {PAPER['dt_growth']:g}; fd: 1)")
-    s.add_argument("--truncation", type=_truncation, default=None, metavar="{none,<widths>}",
-                   help="truncate the transfer kernel at this many kernel widths; none = whole Gaussian (Eqs. 17, 21)")
+    s.add_argument(
+        "--dt0",
+        type=float,
+        default=None,
+        help=f"first time step [T] (default {PAPER['dt0']:g}; fixed step {PAPER['fixed_dt']:g} when "
+        f"dt-growth is 1; fd: {PAPER['fd_dt']:g})",
+    )
+    s.add_argument(
+        "--dt-growth",
+        type=float,
+        default=None,
+        help=f"dt_{{n+1}} = growth dt_n, 1 = fixed step [-] (default {PAPER['dt_growth']:g}; fd: 1)",
+    )
+    s.add_argument(
+        "--truncation",
+        type=_truncation,
+        default=None,
+        metavar="{none,<widths>}",
+        help="truncate the transfer kernel at this many kernel widths; none = whole Gaussian (Eqs. 17, 21)",
+    )
     s.add_argument("--seed", type=int, default=0, help="random seed (>= 0)")
     s.add_argument("--omega", type=float, default=PAPER["omega"], help="particle domain length Omega [L]")
     s.add_argument("--fd-length", type=float, default=PAPER["fd_length"], help="FD domain length [L], centred on 0")
-    s.add_argument("--fixed-kernel-time", type=float, default=PAPER["fixed_kernel_time"],
-                   help="pt fixed kernel: reconstruct with variance 2 D x this time [T]")
-    s.add_argument("--transfer-method", choices=TRANSFER_METHODS, default=PAPER["transfer_method"],
-                   help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)")
-    s.add_argument("--transfer-tolerance", type=float, default=PAPER["transfer_tolerance"],
-                   help="error bound of the fast Gauss transform, relative to the summed |weights| in reach "
-                        f"[-] (default {PAPER['transfer_tolerance']:g}: round-off, mass conserved to 1e-13)")
-    s.add_argument("--scheme", choices=SCHEMES, default=PAPER["scheme"],
-                   help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop")
+    s.add_argument(
+        "--fixed-kernel-time",
+        type=float,
+        default=PAPER["fixed_kernel_time"],
+        help="pt fixed kernel: reconstruct with variance 2 D x this time [T]",
+    )
+    s.add_argument(
+        "--transfer-method",
+        choices=TRANSFER_METHODS,
+        default=PAPER["transfer_method"],
+        help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)",
+    )
+    s.add_argument(
+        "--transfer-tolerance",
+        type=float,
+        default=PAPER["transfer_tolerance"],
+        help="error bound of the fast Gauss transform, relative to the summed |weights| in reach "
+        f"[-] (default {PAPER['transfer_tolerance']:g}: round-off, mass conserved to 1e-13)",
+    )
+    s.add_argument(
+        "--scheme",
+        choices=SCHEMES,
+        default=PAPER["scheme"],
+        help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop",
+    )
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
     s.add_argument("--state-out", default=None, help="optional Parquet path for the final state (x, mass, c)")
     s.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
@@ -65,10 +104,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 def config_from_args(a: argparse.Namespace) -> RunConfig:
     return RunConfig(
-        method=a.method, kernel=a.kernel, n=a.n, eta=a.eta, D=a.D, t_final=a.t_final,
-        dt0=a.dt0, dt_growth=a.dt_growth, truncation=a.truncation, seed=a.seed,
-        omega=a.omega, fd_length=a.fd_length, fixed_kernel_time=a.fixed_kernel_time, transfer_method=a.transfer_method,
-        transfer_tolerance=a.transfer_tolerance, scheme=a.scheme,
+        method=a.method,
+        kernel=a.kernel,
+        n=a.n,
+        eta=a.eta,
+        D=a.D,
+        t_final=a.t_final,
+        dt0=a.dt0,
+        dt_growth=a.dt_growth,
+        truncation=a.truncation,
+        seed=a.seed,
+        omega=a.omega,
+        fd_length=a.fd_length,
+        fixed_kernel_time=a.fixed_kernel_time,
+        transfer_method=a.transfer_method,
+        transfer_tolerance=a.transfer_tolerance,
+        scheme=a.scheme,
     ).resolved()
 
 
@@ -89,6 +140,8 @@ def main(argv=None) -> int:
         write_parquet(state, a.state_out)
     last = table.iloc[-1]
     if progress:
-        progress(f"done: {len(table) - 1} steps, t={last['time']:.6g}, H_C={last['H_C']:.6g}, "
-                 f"mass error={abs(last['mass_total'] - 1):.3g}, wall={table['wall_s'].sum():.2f}s")
+        progress(
+            f"done: {len(table) - 1} steps, t={last['time']:.6g}, H_C={last['H_C']:.6g}, "
+            f"mass error={abs(last['mass_total'] - 1):.3g}, wall={table['wall_s'].sum():.2f}s"
+        )
     return 0 if math.isfinite(last["mass_total"]) else 1

@@ -18,7 +18,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def imports(module: str, package: Path = PACKAGE) -> frozenset[str]:
     """Package modules that ``module`` imports (``from . import x``, ``from .x import y``)."""
     tree = ast.parse((package / f"{module}.py").read_text())

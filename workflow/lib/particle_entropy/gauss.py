@@ -66,7 +66,50 @@ def _exp_neg(a):
 @njit(cache=True, inline="always")
 def _taylor_exp13(r):
     """sum_(n <= 13) r^n / n! (Horner, literal coefficients so the loop vectorises)."""
-    return (((((((((((((1.6059043836821613e-10) * r + 2.08767569878681e-09) * r + 2.505210838544172e-08) * r + 2.755731922398589e-07) * r + 2.7557319223985893e-06) * r + 2.48015873015873e-05) * r + 0.0001984126984126984) * r + 0.001388888888888889) * r + 0.008333333333333333) * r + 0.041666666666666664) * r + 0.16666666666666666) * r + 0.5) * r + 1.0) * r + 1.0
+    return (
+        (
+            (
+                (
+                    (
+                        (
+                            (
+                                (
+                                    (
+                                        (
+                                            (
+                                                ((1.6059043836821613e-10) * r + 2.08767569878681e-09) * r
+                                                + 2.505210838544172e-08
+                                            )
+                                            * r
+                                            + 2.755731922398589e-07
+                                        )
+                                        * r
+                                        + 2.7557319223985893e-06
+                                    )
+                                    * r
+                                    + 2.48015873015873e-05
+                                )
+                                * r
+                                + 0.0001984126984126984
+                            )
+                            * r
+                            + 0.001388888888888889
+                        )
+                        * r
+                        + 0.008333333333333333
+                    )
+                    * r
+                    + 0.041666666666666664
+                )
+                * r
+                + 0.16666666666666666
+            )
+            * r
+            + 0.5
+        )
+        * r
+        + 1.0
+    ) * r + 1.0
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
@@ -508,8 +551,10 @@ def gauss_transform(
     if not (sigma > 0 and math.isfinite(sigma)):
         raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
     if not FGT_TOLERANCE_RANGE[0] <= tolerance <= FGT_TOLERANCE_RANGE[1]:
-        raise ValueError(f"tolerance={tolerance!r} is not allowed: a number in "
-                         f"[{FGT_TOLERANCE_RANGE[0]:g}, {FGT_TOLERANCE_RANGE[1]:g}]")
+        raise ValueError(
+            f"tolerance={tolerance!r} is not allowed: a number in "
+            f"[{FGT_TOLERANCE_RANGE[0]:g}, {FGT_TOLERANCE_RANGE[1]:g}]"
+        )
     if method == "auto":
         method = choose_method(y, x, sigma, truncation)
     radius = (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma

@@ -7,11 +7,12 @@ import math
 
 import numpy as np
 
-from . import gauss, measures as M
+from . import gauss
+from . import measures as M
 from .kernels import beta_sph, collision_sigma, h_sph
 from .mass_transfer import mass_transfer
-from .sequential import sequential_transfer
 from .runconfig import RunConfig
+from .sequential import sequential_transfer
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):

@@ -6,7 +6,8 @@ import math
 
 import numpy as np
 
-from . import gauss, measures as M
+from . import gauss
+from . import measures as M
 from .gauss import gauss_transform
 from .kernels import h_de
 from .runconfig import RunConfig

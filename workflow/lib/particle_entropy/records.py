@@ -5,7 +5,7 @@ from __future__ import annotations
 import resource
 import sys
 import time
-from typing import Callable
+from collections.abc import Callable
 
 import pandas as pd
 
@@ -62,9 +62,7 @@ class Recorder:
         self.rows.append(row)
         if self.progress and (now - self._last_report > 5.0 or row["step"] == self.n_steps):
             self._last_report = now
-            self.progress(
-                f"step {row['step']}/{self.n_steps} t={row['time']:.6g} elapsed={now - self._t0:.1f}s"
-            )
+            self.progress(f"step {row['step']}/{self.n_steps} t={row['time']:.6g} elapsed={now - self._t0:.1f}s")
 
     def table(self) -> pd.DataFrame:
         df = pd.DataFrame(self.rows)

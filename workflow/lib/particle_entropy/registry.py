@@ -21,7 +21,8 @@ SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
 FGT_TOLERANCE = 1e-17  # fast Gauss transform error / summed |weights| in reach: round-off
 FGT_TOLERANCE_RANGE = (1e-30, 0.1)
 
-# The paper's settings (../shared/docs/experiments.md beside the repository); config.yaml and the schema's defaults equal these.
+# The paper's settings (../shared/docs/experiments.md beside the repository); config.yaml and
+# the schema's defaults equal these.
 PAPER = {
     "D": 1e-3,  # diffusion coefficient [L^2/T]
     "t_final": 1000.0,  # [T]

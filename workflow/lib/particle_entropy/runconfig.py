@@ -9,8 +9,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .case import Case, SettingError
-from .registry import (DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, KERNELS, METHODS, PAPER, SCHEMES,
-                       TRANSFER_METHODS)
+from .registry import DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, KERNELS, METHODS, PAPER, SCHEMES, TRANSFER_METHODS
 
 
 def first_step(method: str, dt_growth: float, dt0: float, fd_dt: float, fixed_dt: float) -> float:
@@ -40,24 +39,36 @@ class RunConfig:
     scheme: str = PAPER["scheme"]  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
 
     @classmethod
-    def for_case(cls, case: Case, **settings) -> "RunConfig":
+    def for_case(cls, case: Case, **settings) -> RunConfig:
         """The run of ``case`` (which must have an N) with physics and numerics ``settings``."""
-        return cls(method=case.method, kernel=case.kernel, n=case.n, eta=case.eta, truncation=case.truncation,
-                   dt_growth=case.dt_growth, scheme=case.scheme, **settings)
+        return cls(
+            method=case.method,
+            kernel=case.kernel,
+            n=case.n,
+            eta=case.eta,
+            truncation=case.truncation,
+            dt_growth=case.dt_growth,
+            scheme=case.scheme,
+            **settings,
+        )
 
     @property
     def case(self) -> Case:
         """The case this run simulates (call on a resolved config)."""
-        return Case(self.method, self.kernel, int(self.n), float(self.eta), self.truncation,
-                    float(self.dt_growth), self.scheme)
+        return Case(
+            self.method, self.kernel, int(self.n), float(self.eta), self.truncation, float(self.dt_growth), self.scheme
+        )
 
-    def resolved(self) -> "RunConfig":
+    def resolved(self) -> RunConfig:
         """Fill method-dependent defaults and check every setting."""
         kernel = self.kernel if self.kernel is not None else DEFAULT_KERNEL.get(self.method)
         fd = self.method == "fd"
         growth = self.dt_growth if self.dt_growth is not None else (1.0 if fd else PAPER["dt_growth"])
-        dt0 = self.dt0 if self.dt0 is not None else first_step(self.method, growth, PAPER["dt0"], PAPER["fd_dt"],
-                                                               PAPER["fixed_dt"])
+        dt0 = (
+            self.dt0
+            if self.dt0 is not None
+            else first_step(self.method, growth, PAPER["dt0"], PAPER["fd_dt"], PAPER["fixed_dt"])
+        )
         cfg = RunConfig(**{**asdict(self), "kernel": kernel, "dt0": dt0, "dt_growth": growth})
         cfg.check()
         return cfg
@@ -66,7 +77,9 @@ class RunConfig:
         if self.method not in METHODS:
             raise SettingError("method", self.method, f"one of {', '.join(METHODS)}")
         if self.kernel not in KERNELS[self.method]:
-            raise SettingError("kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}")
+            raise SettingError(
+                "kernel", self.kernel, f"for method {self.method}: one of {', '.join(KERNELS[self.method])}"
+            )
         if not isinstance(self.n, (int, np.integer)) or self.n < 1:
             raise SettingError("n", self.n, "an integer >= 1")
         if self.method == "fd" and (self.n < 2 or self.n % 2):
@@ -91,7 +104,8 @@ class RunConfig:
             r = self.D * self.dt0 / dx**2
             if r > 0.5 or self.dt_growth != 1.0:
                 raise SettingError(
-                    "dt0", self.dt0,
+                    "dt0",
+                    self.dt0,
                     f"explicit fd is stable only for r = D dt / dx^2 <= 1/2 with a fixed step: dt0 <= "
                     f"{0.5 * dx**2 / self.D if self.D > 0 else math.inf:.6g} and dt_growth = 1 for n={self.n} "
                     f"(got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
@@ -100,8 +114,11 @@ class RunConfig:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         self.case  # noqa: B018 -- dimensions that do not apply to the method must be neutral
         if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:
-            raise SettingError("transfer_method", self.transfer_method,
-                               "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)")
+            raise SettingError(
+                "transfer_method",
+                self.transfer_method,
+                "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)",
+            )
 
     def rng(self) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels and eta share positions and walks."""

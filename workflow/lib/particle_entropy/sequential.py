@@ -49,8 +49,9 @@ def _sequential(x, m, sigma, radius, beta, keys):
     return m
 
 
-def sequential_transfer(x: np.ndarray, m: np.ndarray, sigma: float, beta: float, truncation: float | None,
-                        rng: np.random.Generator) -> np.ndarray:
+def sequential_transfer(
+    x: np.ndarray, m: np.ndarray, sigma: float, beta: float, truncation: float | None, rng: np.random.Generator
+) -> np.ndarray:
     """One step of the authors' loop on sorted positions; partners ordered by random keys."""
     radius = (9.0 if truncation is None else float(truncation)) * sigma
     keys = rng.random(x.size)

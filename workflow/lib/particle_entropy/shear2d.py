@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import math
 import zlib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Callable
 
 import numpy as np
 import pandas as pd
@@ -99,8 +99,11 @@ class ShearConfig:
             raise SettingError("seed", self.seed, "an integer >= 0")
         if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
             # the minimum-image distance in x is only exact while the kernel fits in half the box
-            raise SettingError("length", self.length, "for mt > 2 sqrt(alpha_L) kernel_cutoff "
-                               f"= {2.0 * math.sqrt(self.alpha_L) * kernel_cutoff(self):.4g}")
+            raise SettingError(
+                "length",
+                self.length,
+                f"for mt > 2 sqrt(alpha_L) kernel_cutoff = {2.0 * math.sqrt(self.alpha_L) * kernel_cutoff(self):.4g}",
+            )
 
     @property
     def n_steps(self) -> int:
@@ -288,8 +291,11 @@ def wall_fraction(y: np.ndarray, weights: np.ndarray | None = None) -> float:
     return float(weights[near].sum() / weights.sum())
 
 
-def run_shear(cfg: ShearConfig, progress: Callable[[str], None] | None = None,
-              init: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+def run_shear(
+    cfg: ShearConfig,
+    progress: Callable[[str], None] | None = None,
+    init: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Run one case of Appendix B to t_final; returns (per-step table, final particle table).
 
     ``init`` = (x, y, mass) replaces the random initial condition (tests, constructed cases).
@@ -314,8 +320,17 @@ def run_shear(cfg: ShearConfig, progress: Callable[[str], None] | None = None,
             wf = wall_fraction(y, m) if total > 0 else math.nan
         else:
             mean_y, wf = float(y.mean()), wall_fraction(y)
-        rec.add(step=step, time=step * cfg.dt, mass_total=float(m.sum()), mass_min=float(m.min()),
-                wall_fraction=wf, mean_y=mean_y, substeps=substeps, max_offdiag_beta=c_max, n_pairs=n_pairs)
+        rec.add(
+            step=step,
+            time=step * cfg.dt,
+            mass_total=float(m.sum()),
+            mass_min=float(m.min()),
+            wall_fraction=wf,
+            mean_y=mean_y,
+            substeps=substeps,
+            max_offdiag_beta=c_max,
+            n_pairs=n_pairs,
+        )
 
     record(0)
     for step in range(1, cfg.n_steps + 1):

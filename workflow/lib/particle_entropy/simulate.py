@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Callable
 
 import numpy as np
 import pandas as pd
 
-from . import fd, measures as M, mtpt, pt
+from . import fd, mtpt, pt
+from . import measures as M
 from .records import Recorder
 from .runconfig import RunConfig
 from .timegrid import time_steps, times
@@ -94,7 +95,9 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
     return {"x": x, "c": c}
 
 
-def run_seeds(cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False) -> pd.DataFrame:
+def run_seeds(
+    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False
+) -> pd.DataFrame:
     """Run ``cfg`` for each seed and concatenate the per-step tables (or final states)."""
     parts = []
     for seed in seeds:

@@ -11,8 +11,8 @@ file names stay stable. No Snakemake needed: tested directly.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 from .case import CASE_DIR, Case, SettingError
 from .registry import PAPER
@@ -38,7 +38,7 @@ class Ensemble:
     realisations: int
 
     @classmethod
-    def from_wildcards(cls, w: Mapping) -> "Ensemble":
+    def from_wildcards(cls, w: Mapping) -> Ensemble:
         return cls(Case.from_wildcards(w), int(w["nreal"]))
 
     def summary_path(self) -> str:
@@ -64,8 +64,12 @@ def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
     if r == "ensemble":
         table = {int(e["n"]): int(e["count"]) for e in config["realisations"]}
         if n not in table:
-            raise SettingError("n", n, "a particle number listed in `realisations` (the section uses "
-                                        "realisations: ensemble); add {n: %d, count: ...} there" % n)
+            raise SettingError(
+                "n",
+                n,
+                "a particle number listed in `realisations` (the section uses "
+                f"realisations: ensemble); add {{n: {n}, count: ...}} there",
+            )
         r = table[n]
         if "max_realisations" in spec:
             r = min(r, int(spec["max_realisations"]))
@@ -107,8 +111,9 @@ def run_settings(case: Case, config: Mapping) -> dict:
     physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
     out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
     out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
-    out["dt0"] = float(first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"],
-                                  time.get("fixed_dt", PAPER["fixed_dt"])))
+    out["dt0"] = float(
+        first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"], time.get("fixed_dt", PAPER["fixed_dt"]))
+    )
     return out
 
 
@@ -137,8 +142,10 @@ def check_sweeps(config: Mapping) -> None:
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     t_final = float(config["physics"]["t_final"])
-    for key, times in (("comic_times", config.get("comic_times", [])),
-                       ("tradeoff.times", config.get("tradeoff", {}).get("times", []))):
+    for key, times in (
+        ("comic_times", config.get("comic_times", [])),
+        ("tradeoff.times", config.get("tradeoff", {}).get("times", [])),
+    ):
         for t in times:
             if not (math.isfinite(float(t)) and 0 <= float(t) <= t_final):
                 raise SettingError(key, t, f"a time in [0, physics.t_final = {t_final:g}]")

@@ -28,8 +28,7 @@ def time_steps(t_final: float, dt0: float, growth: float = 1.05) -> np.ndarray:
     n = max(n, 1)
     if n > MAX_STEPS:
         raise ValueError(
-            f"{n} time steps needed for t_final={t_final} with dt0={dt0}, growth={growth};"
-            f" at most {MAX_STEPS} allowed"
+            f"{n} time steps needed for t_final={t_final} with dt0={dt0}, growth={growth}; at most {MAX_STEPS} allowed"
         )
     dt = dt0 * growth ** np.arange(n, dtype=np.float64)
     t_before_last = float(np.cumsum(dt[:-1])[-1]) if n > 1 else 0.0  # same sums as times()

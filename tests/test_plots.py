@@ -1,0 +1,357 @@
+"""Figures draw exactly the cases they are given, in paper or automatic styles, and return the data they plot.
+
+Tables are synthetic (known values, the columns the workflow writes) except where a test runs
+tiny real simulations; assertions read the returned source data and the Line2D objects, not pixels.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+matplotlib.use("Agg")
+
+from particle_entropy import plots, plots_shear  # noqa: E402
+from particle_entropy.aggregate import METRICS  # noqa: E402
+from particle_entropy.case import CASE_COLUMNS, Case, rows_of  # noqa: E402
+from particle_entropy.runconfig import RunConfig  # noqa: E402
+from particle_entropy.simulate import run  # noqa: E402
+
+CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config.yaml").read_text())
+NS = (30, 100)
+T = np.array([0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0])
+KW = {"D": 1e-3, "t_final": 20.0}
+ADDED = Case("mtpt", "collision", eta=0.25, truncation=3)  # a model the paper does not draw
+
+
+def paper_cases(fig: str, ns=NS, extra: tuple[Case, ...] = ()) -> list[Case]:
+    """The cases of a config section (cases x N, config order), plus ``extra`` models at each N."""
+    section = CONFIG["tradeoff"] if fig == "tradeoff" else CONFIG["figures"][fig]
+    models = [Case.from_spec(spec, None, CONFIG["case_defaults"]) for spec in section["cases"]] + list(extra)
+    return [m.at(n) for m in models for n in ns]
+
+
+def _rng(case: Case) -> np.random.Generator:
+    return np.random.default_rng(zlib.crc32(repr(case).encode()))
+
+
+def _common(df: pd.DataFrame, case: Case) -> pd.DataFrame:
+    """Analytic columns (tables over time), dV, D and the case columns."""
+    domain = 12.0 if case.method == "fd" else 10.0
+    if "time" in df:
+        t = df["time"].to_numpy()
+        with np.errstate(divide="ignore"):
+            df["H_C_analytic"] = -math.log(domain / case.n) + 0.5 * np.log(4 * np.pi * 1e-3 * t) + 0.5
+        df["E_analytic"] = np.sqrt(4 * np.pi * np.e * 1e-3 * t)
+    df["dV"], df["D"] = domain / case.n, 1e-3
+    for col, value in case.columns().items():
+        df[col] = value
+    return df
+
+
+def summary(case: Case, realisations: int = 3) -> pd.DataFrame:
+    """A case summary with random positive ensemble means (known arrays) and stds."""
+    rng = _rng(case)
+    df = pd.DataFrame({"step": np.arange(T.size), "time": T, "n_realisations": realisations})
+    for m in METRICS:
+        df[f"{m}_mean"] = rng.uniform(0.1, 2.0, T.size)
+        df[f"{m}_std"] = rng.uniform(0.0, 0.1, T.size)
+    return _common(df, case)
+
+
+def run_table(case: Case) -> pd.DataFrame:
+    """A single-run table with random positive measures."""
+    rng = _rng(case)
+    df = pd.DataFrame({"step": np.arange(T.size), "time": T})
+    for m in METRICS:
+        df[m] = rng.uniform(0.1, 2.0, T.size)
+    return _common(df, case)
+
+
+def state(case: Case) -> pd.DataFrame:
+    x = np.linspace(-1.0, 1.0, case.n)
+    df = pd.DataFrame({"x": x, "c": np.exp(-(x**2) / 0.08) / np.sqrt(0.08 * np.pi), "mass": 1.0 / case.n})
+    return _common(df, case)
+
+
+def comic_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
+    rows = []
+    for c in cases:
+        rng = _rng(c)
+        for t in times:
+            mu, sd = rng.uniform(-10, -5), rng.uniform(0.1, 1.0)
+            rows.append(
+                {
+                    "label": c.label(n=False),
+                    **c.columns(),
+                    "time": t,
+                    "time_step": t - 0.1,
+                    "COMIC_mean": mu,
+                    "COMIC_std": sd,
+                    "COMIC_of_mean_SSE": mu + 0.5,
+                    "COMIC_of_mean_SSE_lo": -math.inf,
+                    "COMIC_of_mean_SSE_hi": mu + 1.0,
+                    "SSE_mean": 0.1,
+                    "SSE_std": 0.2,
+                    "n_realisations": 3,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def tradeoff_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
+    rows = []
+    for c in cases:
+        rng = _rng(c)
+        for t in times:
+            rows.append(
+                {
+                    "label": c.label(n=False),
+                    **c.columns(),
+                    "time": t,
+                    "wall_s": rng.uniform(0.01, 1),
+                    "wall_s_std": 0.001,
+                    "rmse": rng.uniform(0.01, 1),
+                    "rmse_std": 0.01,
+                    "COMIC_mean": rng.uniform(-10, -5),
+                    "COMIC_std": 0.5,
+                    "n_realisations": 2,
+                }
+            )
+    df = pd.DataFrame(rows)
+    keys = ["method", "kernel", "eta", "truncation", "dt_growth", "scheme", "time"]
+    df["is_comic_optimum"] = df["COMIC_mean"] == df.groupby(keys)["COMIC_mean"].transform("min")
+    return df
+
+
+def inputs(fig: str, cases: list[Case]) -> list[pd.DataFrame]:
+    """What plot_figure.py reads for ``fig``: one table per case, or one table for all cases."""
+    if fig == "fig9":
+        return [comic_table(cases)]
+    if fig == "tradeoff":
+        return [tradeoff_table(cases)]
+    make = {"fig1": run_table, "fig2": run_table, "fig7": state}.get(fig, summary)
+    return [make(c) for c in cases]
+
+
+def draw(fig: str, cases: list[Case], tables=None):
+    figure, data = plots.FIGURES[fig](inputs(fig, cases) if tables is None else tables, cases, **KW)
+    return figure, data
+
+
+def case_of(row) -> Case:
+    return Case.from_row(row)
+
+
+def hex_of(colour) -> str:
+    return matplotlib.colors.to_hex(colour)
+
+
+def line_styles(ax) -> dict[str, tuple]:
+    """(colour, marker, line style, marker face) of every labelled Line2D of an axes, by label."""
+    return {
+        ln.get_label(): (hex_of(ln.get_color()), ln.get_marker(), ln.get_linestyle(), str(ln.get_markerfacecolor()))
+        for ln in ax.get_lines()
+        if not ln.get_label().startswith("_")
+    }
+
+
+FIGURE_NAMES = list(plots.FIGURES)
+
+
+# ------------------------------------------------------------------ every figure
+@pytest.mark.parametrize("fig", FIGURE_NAMES)
+def test_every_figure_returns_its_cases_and_only_them(fig):
+    cases = paper_cases(fig)
+    tables = inputs(fig, cases)
+    if fig in ("fig9", "tradeoff"):  # rows of a model not in the section must not be drawn
+        tables = [pd.concat([tables[0], inputs(fig, [Case("mtpt", "sph", n, eta=0.3) for n in NS])[0]])]
+    figure, data = draw(fig, cases, tables)
+    assert list(data.columns) == list(plots.SOURCE_COLUMNS)
+    assert len(data) > 0 and set(data["figure"]) == {fig}
+    drawn = data[data["method"] != "analytic"]
+    assert {case_of(r) for _, r in drawn.drop_duplicates(list(CASE_COLUMNS)).iterrows()} == set(cases)
+    assert data.groupby(["panel", "series", "x_name", "y_name"]).ngroups == data.groupby(["panel", "series"]).ngroups
+
+
+@pytest.mark.parametrize("fig", [f for f in FIGURE_NAMES if f != "fig7"])
+def test_an_added_model_has_a_style_of_its_own_in_every_panel(fig):
+    extra = Case("fd", "explicit") if fig == "fig8" else Case("pt", "adaptive", dt_growth=1.01)
+    extra = ADDED if fig in ("fig5", "fig6", "fig9") else extra
+    figure, data = draw(fig, paper_cases(fig, extra=(extra,)))
+    added = data[
+        (data["method"] == extra.method)
+        & (data["kernel"] == extra.kernel)
+        & (data["eta"] == extra.eta)
+        & (data["dt_growth"] == extra.dt_growth)
+    ]
+    assert len(added) > 0
+    for ax in figure.axes:
+        styles = line_styles(ax)
+        mine = {label: st for label, st in styles.items() if label in set(added["series"])}
+        others = {st for label, st in styles.items() if label not in mine}
+        assert all(st not in others for st in mine.values()), (ax.get_title(), mine, others)
+
+
+def test_fig5_added_case_data_and_paper_colours():
+    cases = paper_cases("fig5", extra=(ADDED,))
+    tables = inputs("fig5", cases)
+    figure, data = draw("fig5", cases, tables)
+    for case, table in zip(cases, tables, strict=True):
+        rows = rows_of(data, case)
+        plotted = table[table["time"] > 0]
+        assert np.allclose(rows["y"], plotted["E_mean"]) and np.allclose(rows["x"], plotted["time"])
+        assert np.allclose(rows["y_std"], plotted["E_std"]) and (rows["n_realisations"] == 3).all()
+        assert set(rows["series"]) == {case.label()} and set(rows["y_name"]) == {"E"}
+    added = data[data["eta"] == 0.25]
+    assert set(added["truncation"]) == {3.0} and set(added["n"]) == set(NS)
+    for ax, n in zip(figure.axes, sorted(NS, reverse=True), strict=True):
+        styles = line_styles(ax)
+        colour = {(c.kernel, c.eta): styles[c.label()][0] for c in cases if c.n == n}
+        assert colour["collision", 1.0] == colour["collision", 0.1] == hex_of(plots.GREEN)
+        assert colour["sph", 1.0] == colour["sph", 0.1] == hex_of(plots.VERMILLION)
+        assert colour["collision", 0.25] not in map(hex_of, (plots.GREEN, plots.VERMILLION, plots.BLACK))
+
+
+def test_analytic_references_are_marked_as_such():
+    _, data = draw("fig1", paper_cases("fig1"))
+    ref = data[data["method"] == "analytic"]
+    assert {"H_C", "settling time"} <= set(ref["y_name"])
+    assert ref[["kernel", "scheme"]].isna().all().all() and ref["eta"].isna().all()
+    assert set(ref["n"].dropna()) == set(NS) and ref["n_realisations"].isna().all()
+
+
+def test_a_case_without_a_table_is_marked_no_data():
+    cases = paper_cases("fig5")
+    tables = [t for c, t in zip(cases, inputs("fig5", cases), strict=True) if c.kernel != "sph" or c.n != 30]
+    figure, data = draw("fig5", cases, tables)
+    assert not ((data["kernel"] == "sph") & (data["n"] == 30)).any()
+    texts = [t.get_text() for ax in figure.axes for t in ax.texts]
+    assert any(t.startswith("no data") and "SPH" in t for t in texts)
+    _, empty = draw("fig9", paper_cases("fig9"), [comic_table([])])
+    assert empty.empty and list(empty.columns) == list(plots.SOURCE_COLUMNS)
+
+
+# ------------------------------------------------------------------ styles
+def test_paper_style_goes_to_the_case_closest_to_the_paper():
+    base, truncated = Case("mtpt", "collision", eta=1.0), Case("mtpt", "collision", eta=1.0, truncation=3)
+    style = plots.styles("fig9", [truncated.at(30), base.at(30)])
+    assert style[base] == plots.PAPER_STYLES["fig9"][("mtpt", "collision", 1.0)]
+    assert style[truncated]["color"] not in (plots.GREEN, plots.VERMILLION, plots.BLUE)
+
+
+def test_automatic_styles_stay_distinct_and_off_the_paper_palette():
+    added = [
+        Case("mtpt", kernel, eta=eta, truncation=tr)
+        for kernel in ("collision", "sph")
+        for eta in (0.2, 0.3, 0.4)
+        for tr in (None, 3)
+    ]
+    style = plots.styles("fig5", paper_cases("fig5", extra=tuple(added)))
+    looks = [(s["color"], s.get("marker"), s.get("linestyle", "-"), bool(s.get("open"))) for s in style.values()]
+    assert len(set(looks)) == len(looks)
+    assert all(style[m]["color"] not in (plots.GREEN, plots.VERMILLION) for m in added)
+
+
+def test_scheme_variants_are_two_series_in_fig9_and_tradeoff():
+    symmetric = Case("mtpt", "collision", eta=1.0, truncation=3)
+    sequential = Case("mtpt", "collision", eta=1.0, truncation=3, scheme="sequential")
+    cases = [m.at(n) for m in (symmetric, sequential) for n in NS]
+    _, data = draw("fig9", cases)
+    assert data.groupby("panel")["scheme"].agg(set).to_dict() == {"a": {"symmetric"}, "b": {"sequential"}}
+    assert data.groupby("series")["scheme"].nunique().eq(1).all() and data["series"].nunique() == 4
+    figure, data = draw("tradeoff", cases)
+    assert data.groupby("panel")["series"].nunique().eq(2).all()
+    assert set(data["series"]) == {symmetric.label(n=False), sequential.label(n=False)}
+    styles = line_styles(figure.axes[0])
+    assert styles[symmetric.label(n=False)] != styles[sequential.label(n=False)]
+    variant = plots.tradeoff_styles(cases)
+    assert variant[symmetric]["linestyle"] == plots.VARIANT_LINES[("truncation",)]
+    assert variant[sequential]["linestyle"] == plots.VARIANT_LINES[("truncation", "scheme")]
+
+
+# ------------------------------------------------------------------ fig9, tradeoff, fig7, fig10
+def test_fig9_error_bars_are_comic_std_at_the_time_nearest_t_final():
+    cases = paper_cases("fig9", ns=(30, 100, 300), extra=(ADDED,))
+    comic = comic_table(cases)
+    figure, data = draw("fig9", cases, [comic])
+    assert [ax.get_title(loc="left")[:3] for ax in figure.axes if ax.get_visible()] == ["(a)", "(b)", "(c)", "(d)"]
+    mean = data[data["y_name"] == "COMIC"]
+    for case in cases:
+        row = rows_of(comic, case).query("time == 20.0").iloc[0]
+        got = rows_of(mean, case).iloc[0]
+        assert got["y"] == row["COMIC_mean"] and got["y_std"] == row["COMIC_std"]
+        assert got["y_hi"] == pytest.approx(row["COMIC_mean"] + row["COMIC_std"])
+        assert got["time"] == pytest.approx(19.9)
+    for _, g in mean.groupby("panel"):
+        assert g.loc[g["marked"], "y"].tolist() == [g["y"].min()]
+    of_mean = data[data["y_name"] == "COMIC of mean SSE"]
+    assert set(mean["series"]) == {m.label(n=False) for m in {c.model for c in cases}}
+    assert np.isneginf(of_mean["y_lo"]).all() and of_mean["y_std"].isna().all()
+
+
+def test_tradeoff_plots_rmse_against_wall_time_and_n_with_the_optimum_marked():
+    cases = paper_cases("tradeoff", ns=(100, 300))
+    table = tradeoff_table(cases)
+    _, data = draw("tradeoff", cases, [table])
+    assert set(data["panel"]) == set("abcd") and set(data["x_name"]) == {"wall_s", "N"}
+    merged = data.merge(table, on=[*CASE_COLUMNS, "time"], suffixes=("", "_table"))
+    assert len(merged) == len(data) and np.allclose(merged["y"], merged["rmse"])
+    assert (merged["marked"] == merged["is_comic_optimum"]).all()
+
+
+def test_fig7_plots_every_particle():
+    cases = paper_cases("fig7")
+    _, data = draw("fig7", cases)
+    for case in cases:
+        rows = rows_of(data, case)
+        assert len(rows) == case.n and set(rows["x_name"]) == {"x"} and set(rows["y_name"]) == {"c"}
+
+
+def test_fig1_and_fig6_from_tiny_real_runs():
+    cases = [Case(m, k, 30, dt_growth=1.3) for m, k in (("pt", "bins"), ("pt", "fixed"), ("mtpt", "collision"))]
+    runs = [run(RunConfig.for_case(c, t_final=2.0))[0] for c in cases]
+    figure, data = plots.fig1(runs, cases, D=1e-3, t_final=2.0)
+    h_c = data[(data["y_name"] == "H_C") & (data["method"] != "analytic")]
+    assert len(h_c) == sum(((r["time"] > 0) & np.isfinite(r["H_C"])).sum() for r in runs)
+    h_d = data[data["y_name"] == "H_D"]
+    assert np.allclose(h_d["y"], math.log(30)) and set(h_d["kernel"]) == {"bins"}
+
+
+def test_fig10_returns_the_particles_it_draws():
+    rng = np.random.default_rng(0)
+    states = [
+        pd.DataFrame(
+            {
+                "x": rng.uniform(90, 110, 200),
+                "y": rng.uniform(0, 1, 200),
+                "mass": np.where(np.arange(200) < 150, 1 / 150, 1e-9),
+                "case": case,
+                "seed": 0,
+            }
+        )
+        for case in ("mt", "rw_drift", "rw_nodrift")
+    ]
+    figure, data = plots_shear.fig10(states)
+    assert list(data.columns) == list(plots_shear.SOURCE_COLUMNS)
+    dots = data[data["panel"].isin(list("abc"))]
+    assert dots.groupby("panel")["case"].first().to_dict() == {"a": "rw_nodrift", "b": "rw_drift", "c": "mt"}
+    assert (dots.groupby("case").size() == 150).all() and (dots["mass"] > plots_shear.MASS_FLOOR).all()
+    hist = data[(data["panel"] == "f") & (data["y_name"] == "mass density")]
+    assert len(hist) == plots_shear.N_BINS and np.sum(hist["y"]) / plots_shear.N_BINS == pytest.approx(1.0)
+
+
+def test_save_figure_is_byte_stable(tmp_path):
+    outputs = []
+    for k in range(2):
+        figure, _ = draw("fig5", paper_cases("fig5"))
+        plots.save_figure(figure, tmp_path / f"{k}.png", tmp_path / f"{k}.pdf")
+        outputs.append([(tmp_path / f"{k}.{ext}").read_bytes() for ext in ("png", "pdf")])
+    assert outputs[0] == outputs[1]
