@@ -254,3 +254,10 @@ def test_fd_only_section_needs_no_realisations_entry():
     cfg["figures"]["fig8"].update(realisations="ensemble", n=[30, 40])  # no realisations entry for n = 40
     check_sweeps(cfg)
     assert [e.realisations for e in figure_ensembles(cfg, "fig8")] == [1, 1]
+
+
+def test_physics_settings_from_config_reach_the_run():
+    cfg = copy.deepcopy(TINY)
+    cfg["physics"].update(fixed_kernel_time=2.5, D=2e-3)
+    run = run_config(Case("pt", "fixed", 30), cfg)
+    assert (run.fixed_kernel_time, run.D, run.t_final) == (2.5, 2e-3, cfg["physics"]["t_final"])

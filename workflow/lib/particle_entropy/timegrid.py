@@ -1,4 +1,4 @@
-"""Time stepping of the paper's runs: dt0 = 0.01 growing geometrically to t_final."""
+"""Time stepping of the runs: a first step dt0 growing geometrically (or fixed) to t_final."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 MAX_STEPS = 10_000_000
 
 
-def time_steps(t_final: float, dt0: float, growth: float = 1.05) -> np.ndarray:
+def time_steps(t_final: float, dt0: float, growth: float) -> np.ndarray:
     """Step sizes dt_n = dt0 * growth**n, the last one shortened to end exactly at t_final.
 
     ``growth = 1`` gives a fixed step. A t_final shorter than dt0 gives one step of t_final.
