@@ -189,3 +189,25 @@ def test_markdown_counts_passes():
     assert sum("| pass |" in line for line in lines) == 3 and sum("| FAIL |" in line for line in lines) == 2
     all_pass = to_markdown(claims.assign(passed=True)).splitlines()
     assert "5 of 5 claims pass" in all_pass[2]
+
+
+def test_no_comic_models_give_no_comic_claims():
+    from particle_entropy.aggregate import comic_minima, comic_table
+
+    comic = comic_table([], [250.0])  # a config without fig8 and fig9
+    tol = {
+        "fd_optimum_nodes": [1000, 10000],
+        "collision_eta1_optimum": [1000, 10000],
+        "collision_eta05_optimum": [100, 1000],
+        "sph_flat_max_spread": 2.0,
+    }
+    assert comic_claims(comic_minima(comic), comic, tol) == []
+
+
+def test_single_run_claims_without_the_mtpt_case_skip_it():
+    from particle_entropy.runconfig import RunConfig
+    from particle_entropy.simulate import run
+
+    runs = [run(RunConfig(method="pt", kernel=k, n=n, t_final=2.0))[0] for n in (30, 60) for k in ("bins", "fixed")]
+    claims = single_run_claims(runs, {})
+    assert claims == []  # each N lacks the MTPT collision run its claims compare with: nothing judged, no crash

@@ -261,3 +261,10 @@ def test_physics_settings_from_config_reach_the_run():
     cfg["physics"].update(fixed_kernel_time=2.5, D=2e-3)
     run = run_config(Case("pt", "fixed", 30), cfg)
     assert (run.fixed_kernel_time, run.D, run.t_final) == (2.5, 2e-3, cfg["physics"]["t_final"])
+
+
+def test_a_case_listed_twice_is_one_ensemble():
+    cfg = copy.deepcopy(TINY)
+    cases = cfg["figures"]["fig9"]["cases"]
+    cases.append({**cases[0], "eta": 1.0, "scheme": "symmetric"})  # the first case again, written another way
+    assert len(figure_ensembles(cfg, "fig9")) == len(figure_ensembles(TINY, "fig9"))

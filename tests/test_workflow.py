@@ -418,3 +418,12 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
             assert "simulate_shear" not in rules and "plot_fig10" not in rules
         (lib / module).write_text(original)  # identical content again (a newer mtime): nothing to do
         assert plan()[0] == set(), module
+
+
+def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path):
+    cfg = load(TINY)
+    del cfg["shear"], cfg["tradeoff"]
+    path = tmp_path / "lean.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=True))
+    proc = snakemake(tmp_path, "-n", configfile=path)
+    assert "figures/fig9.png" in proc.stdout and "fig10" not in proc.stdout and "tradeoff" not in proc.stdout

@@ -3,42 +3,43 @@
 SHEAR_PARAMS = ["n", "length", "strip_lo", "strip_hi", "alpha_L", "alpha_T", "beta", "dt", "t_final"]
 
 
-rule simulate_shear:
-    output:
-        steps="results/shear/{case}/seed~{seed}/steps.parquet",
-        state="results/shear/{case}/seed~{seed}/state.parquet",
-    log:
-        "logs/simulate_shear/{case}/seed~{seed}.log",
-    benchmark:
-        "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
-    wildcard_constraints:
-        case="|".join(SHEAR_CASES),
-    conda:
-        "../../envs/particle-entropy.yaml"
-    resources:
-        mem_mb=2000,
-        runtime=10,
-    params:
-        **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
-        code=SHEAR_CODE,
-    script:
-        "../scripts/shear2d.py"
+if "shear" in config:  # Fig. 10 exists only with a shear section
 
+    rule simulate_shear:
+        output:
+            steps="results/shear/{case}/seed~{seed}/steps.parquet",
+            state="results/shear/{case}/seed~{seed}/state.parquet",
+        log:
+            "logs/simulate_shear/{case}/seed~{seed}.log",
+        benchmark:
+            "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
+        wildcard_constraints:
+            case="|".join(SHEAR_CASES),
+        conda:
+            "../../envs/particle-entropy.yaml"
+        resources:
+            mem_mb=2000,
+            runtime=10,
+        params:
+            **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
+            code=SHEAR_CODE,
+        script:
+            "../scripts/shear2d.py"
 
-rule plot_fig10:
-    input:
-        [f"results/shear/{case}/seed~{config['shear']['seed']}/state.parquet" for case in config["shear"]["cases"]],
-    output:
-        png=report("figures/fig10.png", caption="../report/fig10.rst", category="Figures"),
-        pdf="figures/fig10.pdf",
-        data=FIGURE_DATA_PATTERN.format(fig="fig10"),
-    log:
-        "logs/plot/fig10.log",
-    conda:
-        "../../envs/particle-entropy.yaml"
-    resources:
-        mem_mb=2000,
-    params:
-        code=SHEAR_PLOT_CODE,
-    script:
-        "../scripts/plot_fig10.py"
+    rule plot_fig10:
+        input:
+            [f"results/shear/{case}/seed~{config['shear']['seed']}/state.parquet" for case in config["shear"]["cases"]],
+        output:
+            png=report("figures/fig10.png", caption="../report/fig10.rst", category="Figures"),
+            pdf="figures/fig10.pdf",
+            data=FIGURE_DATA_PATTERN.format(fig="fig10"),
+        log:
+            "logs/plot/fig10.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        resources:
+            mem_mb=2000,
+        params:
+            code=SHEAR_PLOT_CODE,
+        script:
+            "../scripts/plot_fig10.py"

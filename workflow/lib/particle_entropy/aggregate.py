@@ -161,7 +161,23 @@ def comic_minima(comic: pd.DataFrame) -> pd.DataFrame:
     for model, rows_of_model in by_model(comic):
         for time, g in rows_of_model.groupby("time", sort=True):
             rows.append(_minimum(model, time, g.sort_values("n", ignore_index=True)))
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=MINIMA_COLUMNS)
+
+
+MINIMA_COLUMNS = [
+    "label",
+    *MODEL_COLUMNS,
+    "time",
+    "n_opt",
+    "COMIC_opt",
+    "COMIC_opt_std",
+    "n_opt_of_mean_SSE",
+    "n_below",
+    "COMIC_below",
+    "n_above",
+    "COMIC_above",
+    "interior",
+]
 
 
 def _minimum(model, time: float, g: pd.DataFrame) -> dict:

@@ -96,11 +96,10 @@ def single_run_claims(runs: list[pd.DataFrame], defaults: dict | None = None) ->
             )
         )
     ns = sorted({int(r["n"].iloc[0]) for r in runs})
+    mtpt = {n: df for n in ns for df in runs if case_of_table(df) == paper("mtpt", "collision", n)}
+    ns = sorted(mtpt)
     if len(ns) >= 2:
-        errs = {
-            n: abs(_near(_pick(runs, paper("mtpt", "collision", n)), 10.0).pipe(lambda r: r.E / r.E_analytic - 1))
-            for n in ns
-        }
+        errs = {n: abs(_near(mtpt[n], 10.0).pipe(lambda r: r.E / r.E_analytic - 1)) for n in ns}
         out.append(
             _claim(
                 "MTPT collision converges faster for larger N",

@@ -77,7 +77,7 @@ def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
 
 
 def spec_ensembles(spec: Mapping, config: Mapping) -> list[Ensemble]:
-    """Every case of a section (its cases x its n), with realisation counts; FD, being
+    """Every case of a section (its cases x its n), each once, with realisation counts; FD, being
     deterministic, runs once whatever the ensemble size."""
     defaults = config.get("case_defaults", {})
     out = []
@@ -85,7 +85,7 @@ def spec_ensembles(spec: Mapping, config: Mapping) -> list[Ensemble]:
         for n in spec["n"]:
             case = Case.from_spec(c, int(n), defaults)
             out.append(Ensemble(case, 1 if case.method == "fd" else realisations_for(spec, int(n), config)))
-    return out
+    return list(dict.fromkeys(out))  # a case listed twice (or written two ways) is drawn once
 
 
 def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
