@@ -69,12 +69,14 @@ class SettingError(ValueError):
         self.name, self.value, self.allowed = name, value, allowed
 
 
-def _number(name: str, value, lo: float, hi: float = math.inf, open_low: bool = False) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    v = float(value) if ok else math.nan
+def check_range(name, value, lo, hi, open_low=False) -> float:
+    """``value`` as a float; SettingError unless it is a finite number with lo <(=) value <= hi."""
+    is_number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    v = float(value) if is_number else math.nan
     if not math.isfinite(v) or (v <= lo if open_low else v < lo) or v > hi:
-        rng = f"{'>' if open_low else '>='} {lo:g}" + ("" if hi == math.inf else f" and <= {hi:g}")
-        raise SettingError(name, value, f"a finite number {rng}")
+        low = f"> {lo}" if open_low else f">= {lo}"
+        high = "finite" if hi == math.inf else f"<= {hi}"
+        raise SettingError(name, value, f"a number {low} and {high}")
     return v
 
 
@@ -114,10 +116,12 @@ class Case:
             if isinstance(self.n, bool) or not integral or self.n < 1:
                 raise SettingError("n", self.n, "an integer >= 1")
             object.__setattr__(self, "n", int(self.n))
-        object.__setattr__(self, "eta", _number("eta", self.eta, 0.0, 1.0))
+        object.__setattr__(self, "eta", check_range("eta", self.eta, 0.0, 1.0))
         if self.truncation is not None:
-            object.__setattr__(self, "truncation", _number("truncation", self.truncation, 0.0, open_low=True))
-        object.__setattr__(self, "dt_growth", _number("dt_growth", self.dt_growth, 1.0))
+            object.__setattr__(
+                self, "truncation", check_range("truncation", self.truncation, 0.0, math.inf, open_low=True)
+            )
+        object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, 1.0, math.inf))
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         for dim, methods in APPLIES.items():
