@@ -53,10 +53,10 @@ def run_states(n: int, seed: int = 0):
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
     ts = step_times(dts, cfg.t_final)
     rng = cfg.rng()
-    x, m = mtpt.initial_state(cfg, rng)
+    x, m, label = mtpt.initial_state(cfg, rng)
     early = (x, m)
     for k, dt in enumerate(dts[:-1], start=1):
-        x, m, *_ = mtpt.step(cfg, x, m, dt, ts[k], rng)
+        x, m, label, *_ = mtpt.step(cfg, x, m, label, dt, ts[k], rng)
     return {"early": early, "late": (x, m)}
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from .registry import KERNELS, METHODS, PAPER, SCHEMES
+from .registry import KERNELS, METHODS, PAPER, SCHEME_DOCS, SCHEME_LABELS, SCHEMES, TRUNCATED_SCHEMES
 
 # Case field -> (wildcard name, path segment); the path of a case is these segments in order.
 PATH_SEGMENTS = {
@@ -39,7 +39,7 @@ COLUMN_DOCS = {
     "eta": "fraction of D by mass transfer (PT, FD: 1)",
     "truncation": "transfer kernel cut at this many kernel widths; inf = whole Gaussian",
     "dt_growth": "time-step growth factor dt_{k+1} / dt_k (1: fixed step)",
-    "scheme": "symmetric (Eqs. 16-21) or sequential (the authors' pairwise loop)",
+    "scheme": "; ".join(f"{k}: {v}" for k, v in SCHEME_DOCS.items()),
 }
 KERNEL_NAMES = {
     "bins": "binned",
@@ -124,6 +124,8 @@ class Case:
         object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, 1.0, math.inf))
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
+        if self.scheme in TRUNCATED_SCHEMES and self.truncation is None:
+            raise SettingError("scheme", self.scheme, "needs a truncation (a number of kernel widths), not none")
         for dim, methods in APPLIES.items():
             if self.method not in methods and getattr(self, dim) != NEUTRAL[dim]:
                 raise SettingError(
@@ -235,7 +237,7 @@ class Case:
         if "dt_growth" in v:
             parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
         if "scheme" in v:
-            parts.append(f"{v['scheme']} loop")
+            parts.append(SCHEME_LABELS[v["scheme"]])
         if n and self.n is not None:
             parts.append(f"N={self.n:,}")
         return ", ".join(parts)

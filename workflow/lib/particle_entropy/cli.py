@@ -6,7 +6,17 @@ import argparse
 import math
 import sys
 
-from .registry import ALL_KERNELS, DEFAULT_KERNEL, KERNELS, METHODS, PAPER, SCHEMES, TRANSFER_METHODS
+from .registry import (
+    ALL_KERNELS,
+    DEFAULT_KERNEL,
+    KERNELS,
+    METHODS,
+    PAPER,
+    SCHEME_DOCS,
+    SCHEMES,
+    TIME_GRIDS,
+    TRANSFER_METHODS,
+)
 from .runconfig import RunConfig, SettingError
 
 
@@ -94,7 +104,14 @@ def build_parser() -> argparse.ArgumentParser:
         "--scheme",
         choices=SCHEMES,
         default=PAPER["scheme"],
-        help="mtpt: symmetric transfer matrix (Eqs. 16-21) or the authors' sequential pairwise loop",
+        help="mtpt: " + "; ".join(f"{k}: {v}" for k, v in SCHEME_DOCS.items()),
+    )
+    s.add_argument(
+        "--time-grid",
+        choices=TIME_GRIDS,
+        default=PAPER["time_grid"],
+        help="particles: exact = last step shortened to end at t-final; authors = whole steps while "
+        "t < t-final, as the authors' code (175 steps to t = 1021.1 for the defaults)",
     )
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
     s.add_argument("--state-out", default=None, help="optional Parquet path for the final state (x, mass, c)")
@@ -120,6 +137,7 @@ def config_from_args(a: argparse.Namespace) -> RunConfig:
         transfer_method=a.transfer_method,
         transfer_tolerance=a.transfer_tolerance,
         scheme=a.scheme,
+        time_grid=a.time_grid,
     ).resolved()
 
 

@@ -27,6 +27,14 @@ def beta_sph(eta: float, D: float, dt: float, h: float) -> float:
     return 2.0 * eta * D * dt / (h * h)
 
 
+def truncated_variance_fraction(k: float | None) -> float:
+    """Variance of a Gaussian cut at k widths over the whole one's: 1 - 2k phi(k) / (2 Phi(k) - 1)."""
+    if k is None:
+        return 1.0
+    phi = math.exp(-0.5 * k * k) / math.sqrt(2.0 * math.pi)
+    return 1.0 - 2.0 * k * phi / math.erf(k / math.sqrt(2.0))
+
+
 def gaussian_pdf(x: np.ndarray, var: float) -> np.ndarray:
     """Zero-mean Gaussian density with variance ``var``."""
     return np.exp(-0.5 * x * x / var) / math.sqrt(2.0 * math.pi * var)

@@ -9,19 +9,20 @@ import numpy as np
 
 from . import gauss
 from . import measures as M
-from .kernels import beta_sph, collision_sigma, h_sph
+from .kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 from .mass_transfer import mass_transfer
 from .runconfig import RunConfig
 from .sequential import sequential_transfer
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
-    """N - 1 zero-mass particles uniform on [-Omega/2, Omega/2] and one unit mass at x = 0, sorted."""
+    """N - 1 zero-mass particles uniform on [-Omega/2, Omega/2] and one unit mass at x = 0, stored
+    first: (positions sorted, masses, storage index of each), as sequential.py stores them."""
     x = np.concatenate([[0.0], rng.uniform(-cfg.omega / 2.0, cfg.omega / 2.0, cfg.n - 1)])
     m = np.zeros(cfg.n)
     m[0] = 1.0
     order = np.argsort(x, kind="stable")
-    return x[order], m[order]
+    return x[order], m[order], order
 
 
 def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
@@ -34,20 +35,35 @@ def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
     return h, beta_sph(cfg.eta, cfg.D, dt, h)
 
 
-def step(cfg: RunConfig, x, m, dt: float, t_end: float, rng: np.random.Generator):
-    """Random walk with (1 - eta) D, re-sort, then one mass transfer with eta D (Eq. 19)."""
+def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Generator, order_rng=None):
+    """Random walk with (1 - eta) D, re-sort, then one mass transfer with eta D (Eq. 19) by the
+    case's scheme -> (x, m, label, kernel width, beta, substeps). ``order_rng`` draws the
+    sequential loop's partner orders (default: ``rng``)."""
     d_walk = (1.0 - cfg.eta) * cfg.D
     if d_walk > 0:
         x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
         order = np.argsort(x, kind="stable")
-        x, m = x[order], m[order]
+        x, m, label = x[order], m[order], label[order]
     sigma, beta = kernel_for_step(cfg, dt, t_end)  # (0, 0) when eta D = 0
     if sigma == 0.0 or beta == 0.0:
-        return x, m, sigma, 0.0, 1
-    if cfg.scheme == "sequential":
-        return x, sequential_transfer(x, m, sigma, beta, cfg.truncation, rng), sigma, beta, 1
+        return x, m, label, sigma, 0.0, 1
+    if cfg.scheme.startswith("sequential"):
+        m = sequential_transfer(
+            x,
+            m,
+            sigma,
+            beta,
+            cfg.truncation,
+            order_rng if order_rng is not None else rng,
+            label=None if cfg.scheme == "sequential_sorted" else label,
+            symnorm=cfg.scheme == "sequential_symnorm",
+            clip=cfg.scheme != "sequential_noclip",
+        )
+        return x, m, label, sigma, beta, 1
+    if cfg.scheme == "compensated":  # widen the cut kernel so that its variance is the whole one's
+        sigma = sigma / math.sqrt(truncated_variance_fraction(cfg.truncation))
     res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method, cfg.transfer_tolerance)
-    return x, res.mass, sigma, beta, res.substeps
+    return x, res.mass, label, sigma, beta, res.substeps
 
 
 def measure(cfg: RunConfig, x, m, t: float) -> dict:

@@ -14,7 +14,26 @@ KERNELS = {
 }
 ALL_KERNELS = tuple(k for m in METHODS for k in KERNELS[m])
 DEFAULT_KERNEL = {m: KERNELS[m][0] for m in METHODS}  # bins, collision, implicit
-SCHEMES = ("symmetric", "sequential")  # Eqs. 16-21, or the authors' sequential pairwise loop
+# How the mass transfer is computed (sequential.py states the authors' loop fact by fact). The
+# variants after the first two change one detail each, for the controlled experiments of Fig. 9.
+SCHEME_DOCS = {
+    "symmetric": "the symmetric transfer matrix of Eqs. 16-21",
+    "sequential": "the authors' sequential pairwise loop",
+    "compensated": "Eqs. 16-21 with the truncated kernel widened to keep the whole Gaussian's variance",
+    "sequential_sorted": "the authors' loop visiting particles left to right, partners to the right",
+    "sequential_symnorm": "the authors' loop with the pair weight W_ij (1/r_i + 1/r_j)/2 of Eq. 18",
+    "sequential_noclip": "the authors' loop without clipping negative masses",
+}
+SCHEMES = tuple(SCHEME_DOCS)
+SCHEME_LABELS = {  # legend text of a non-default scheme
+    "sequential": "sequential loop",
+    "compensated": "compensated width",
+    "sequential_sorted": "sequential loop in position order",
+    "sequential_symnorm": "sequential loop, symmetric weights",
+    "sequential_noclip": "sequential loop, no clipping",
+}
+TRUNCATED_SCHEMES = ("compensated",)  # schemes that need a truncation
+TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or whole steps while t < t_final
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
 
@@ -36,6 +55,7 @@ PAPER = {
     "truncation": None,  # None: whole Gaussian; else kernel widths (3 = authors' code)
     "dt_growth": 1.05,  # dt_{n+1} = growth * dt_n
     "scheme": "symmetric",
+    "time_grid": "exact",
     "transfer_method": "auto",
     "transfer_tolerance": FGT_TOLERANCE,
     "shear_beta": 0.5,  # Appendix B mass-transfer coefficient (Eq. 16)

@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .case import Case, SettingError, check_range
-from .registry import DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, PAPER, TRANSFER_METHODS
+from .registry import DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, PAPER, TIME_GRIDS, TRANSFER_METHODS
 
 
 def first_step(method: str, dt_growth: float, dt0: float, fd_dt: float, fixed_dt: float) -> float:
@@ -36,7 +36,8 @@ class RunConfig:
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = PAPER["transfer_method"]
     transfer_tolerance: float = PAPER["transfer_tolerance"]  # FGT error <= this x sum of |weights| in reach
-    scheme: str = PAPER["scheme"]  # symmetric (Eqs. 16-21) or sequential (the authors' loop)
+    scheme: str = PAPER["scheme"]  # registry.SCHEMES: symmetric (Eqs. 16-21), sequential (the authors' loop), ...
+    time_grid: str = PAPER["time_grid"]  # exact (last step ends at t_final) or authors (whole steps past it)
 
     @classmethod
     def for_case(cls, case: Case, **settings) -> RunConfig:
@@ -87,6 +88,8 @@ class RunConfig:
         check_range("omega", self.omega, 0.0, math.inf, open_low=True)
         check_range("fd_length", self.fd_length, 0.0, math.inf, open_low=True)
         check_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
+        if self.time_grid not in TIME_GRIDS:
+            raise SettingError("time_grid", self.time_grid, f"one of {', '.join(TIME_GRIDS)}")
         if self.transfer_method not in TRANSFER_METHODS:
             raise SettingError("transfer_method", self.transfer_method, f"one of {', '.join(TRANSFER_METHODS)}")
         check_range("transfer_tolerance", self.transfer_tolerance, *FGT_TOLERANCE_RANGE)
@@ -108,11 +111,13 @@ class RunConfig:
                 "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)",
             )
 
-    def rng(self) -> np.random.Generator:
-        """Generator keyed by (seed, method, N): kernels and eta share positions and walks."""
+    def rng(self, stream: int = 0) -> np.random.Generator:
+        """Generator keyed by (seed, method, N): kernels, eta and schemes share positions and walks.
+        Stream 1 feeds the sequential loop's partner orders, so that they leave the walks alone."""
         key = zlib.crc32(f"{self.method}:{self.n}".encode())
-        return np.random.default_rng(np.random.SeedSequence(entropy=self.seed, spawn_key=(key,)))
+        spawn_key = (key,) if stream == 0 else (key, stream)
+        return np.random.default_rng(np.random.SeedSequence(entropy=self.seed, spawn_key=spawn_key))
 
     def case_columns(self) -> dict:
         """The case parameters written beside every row of a result table."""
-        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed)}
+        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed), "time_grid": self.time_grid}

@@ -1,58 +1,227 @@
-"""The authors' sequential pairwise mass transfer (reference MATLAB code), for comparison.
+"""The authors' sequential pairwise mass transfer, and variants of it that change one detail.
 
-Not the paper's equations: particle i in order exchanges with each partner j > i within the
-cut-off, partners in random order, dm = beta (m_i - m_j) W_ij / r_i with r_i the row sum of i
-alone, and masses clipped at zero after every exchange (so mass is not conserved exactly).
-The project's ../shared/docs/experiments.md states these facts about that code; here they are re-implemented from that
-description to measure how far the symmetric matrix of Eqs. 16-21 is from it.
+Facts about the authors' MATLAB script (repository dbenson5225/Particle_Entropy, file
+RW_entropy_ens_GSM_COMIC.m), checked line by line against that script and implemented here:
+
+1. Storage. Particles keep the order in which they were created: the unit mass at x = 0 first,
+   then N - 1 positions uniform on [-Omega/2, Omega/2]. Storage order is random in space and
+   never changes; random walks move particles, not their place in storage.
+2. Visits. Each step visits particles i = 1 ... N in storage order. Particle i exchanges with
+   every neighbour j within the cut-off that comes later in storage (j > i); these lie on both
+   sides of i.
+3. Partner order. The partners of i are taken in a random order, a fresh permutation for each i.
+4. Weights. The weight of pair (i, j) is W_ij / r_i, where W_ij = exp(-(x_i - x_j)^2 / (2 h^2))
+   (the kernel's prefactor cancels) and r_i sums W over all of i's neighbours within the cut-off,
+   i itself included. Positions do not change during the transfer, so r_i is fixed for the step.
+5. Cut-off. Neighbours are found by a range search of radius 3 h (|x_i - x_j| <= 3 h).
+6. Update. dm = beta (m_i - m_j) W_ij / r_i, then m_i <- max(0, m_i - dm) and
+   m_j <- max(0, m_j + dm). The clipping breaks mass conservation only when it acts, which
+   needs beta W_ij / r_i > 1. With beta = 1/2 it never acts, because W_ij <= r_i.
+7. Kernels. Collision: h = sqrt(4 eta D dt), beta = 1/2 (Eq. 17). SPH: h = 0.822 (2 D t)^(2/5)
+   (Omega/N)^(1/5), with D (not eta D) and t the time at the end of the step; beta =
+   2 eta D dt / h^2 (Eq. 20), used as it is even above 1 (no splitting).
+8. Random walk. When eta < 1, the same particles first take a random walk with (1 - eta) D,
+   then the transfer.
+9. Time loop. The clock advances by dt before the step, and the loop runs while t < t_final;
+   dt grows by 1.05 after each step. With dt0 = 0.01 and t_final = 1000 it ends after 175
+   steps at t = 1021.1 (timegrid.time_steps with grid "authors").
+
+Variants for the controlled experiments (registry.SCHEMES) each change one detail:
+- ``sorted``: visit particles left to right, partners to the right only (storage = position
+  order);
+- ``symnorm``: weight W_ij (1/r_i + 1/r_j) / 2, the pair weight of the symmetric matrix
+  (Eq. 18);
+- ``noclip``: no clipping.
+
+r_i is built during the sweep. When i is visited, every neighbour stored before i has already
+been visited and has added its W to i's sum, so each pair's kernel is evaluated once. The random
+permutations come from a SplitMix64 stream that is seeded for each step from the run's numpy
+Generator.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
+DEFAULT_CUTOFF = 9.0  # kernel widths searched when the kernel is not truncated (exp(-40.5) ~ 2.6e-18)
+
+
+@njit(cache=True, inline="always")
+def _splitmix(state):
+    """Next state and 64-bit output of SplitMix64."""
+    state = state + np.uint64(0x9E3779B97F4A7C15)
+    z = state
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return state, z ^ (z >> np.uint64(31))
+
+
+POLY_MAX_U = 4.6  # _kernel's polynomial covers exp(-u) for 0 <= u <= 4.6 (a cut-off of 3 widths: 4.5)
+
+
+@njit(cache=True, fastmath={"contract"})
+def _kernel(u, out, cnt, poly):
+    """out[k] = exp(-u[k]) for k < cnt. With ``poly`` (all u <= POLY_MAX_U) as (e^(-u/8))^8, the
+    inner factor a Taylor polynomial of degree 15 (relative error <= 2e-15, tested against
+    np.exp): arithmetic the compiler vectorises, unlike calls to exp."""
+    if not poly:
+        for k in range(cnt):
+            out[k] = np.exp(-u[k])
+        return
+    for k in range(cnt):
+        y = u[k] * 0.125
+        e = -1.0 / 1307674368000.0
+        e = e * y + 1.0 / 87178291200.0
+        e = e * y - 1.0 / 6227020800.0
+        e = e * y + 1.0 / 479001600.0
+        e = e * y - 1.0 / 39916800.0
+        e = e * y + 1.0 / 3628800.0
+        e = e * y - 1.0 / 362880.0
+        e = e * y + 1.0 / 40320.0
+        e = e * y - 1.0 / 5040.0
+        e = e * y + 1.0 / 720.0
+        e = e * y - 1.0 / 120.0
+        e = e * y + 1.0 / 24.0
+        e = e * y - 1.0 / 6.0
+        e = e * y + 0.5
+        e = e * y - 1.0
+        e = e * y + 1.0
+        e = e * e
+        e = e * e
+        out[k] = e * e
+
 
 @njit(cache=True)
-def _sequential(x, m, sigma, radius, beta, keys):
+def _row_sums(x, radius, inv2s2, poly):
+    """r_i = sum of W_ij over |x_i - x_j| <= radius, i included (x sorted)."""
+    n = x.shape[0]
+    r = np.empty(n)
+    u = np.empty(n)
+    w = np.empty(n)
+    for p in range(n):
+        lo = np.searchsorted(x, x[p] - radius, side="left")
+        hi = np.searchsorted(x, x[p] + radius, side="right")
+        for k in range(lo, hi):
+            d = x[p] - x[k]
+            u[k - lo] = d * d * inv2s2
+        _kernel(u, w, hi - lo, poly)
+        r[p] = w[: hi - lo].sum()
+    return r
+
+
+@njit(cache=True, fastmath={"contract"})
+def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
+    """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each."""
     n = x.shape[0]
     inv2s2 = 0.5 / (sigma * sigma)
-    lo = 0
-    hi = 0
-    order = np.empty(n, np.int64)
-    kk = np.empty(n)
+    poly = radius * radius * inv2s2 <= POLY_MAX_U
+    where = np.empty(n, np.int64)  # sorted index of the particle stored at i
+    for p in range(n):
+        where[label[p]] = p
+    r_full = _row_sums(x, radius, inv2s2, poly) if symnorm else np.zeros(0)
+    r_acc = np.zeros(n)  # W summed from the neighbours visited so far
+    # particles not yet visited, in position order, rebuilt every `chunk` visits so that windows
+    # hold few visited particles: their positions, sorted indices and labels
+    xs = x.copy()
+    ps = np.arange(n)
+    ls = label.copy()
+    left = n
+    chunk = max(64, n // 32)
+    part = np.empty(n, np.int64)
+    u = np.empty(n)
+    c = np.empty(n)
+    state = np.uint64(seed)
     for i in range(n):
-        while x[lo] < x[i] - radius:
-            lo += 1
-        if hi < i + 1:
-            hi = i + 1
-        while hi < n and x[hi] <= x[i] + radius:
-            hi += 1
-        r = 0.0
-        for j in range(lo, hi):
-            d = x[i] - x[j]
-            r += math.exp(-d * d * inv2s2)
-        cnt = hi - (i + 1)
-        for c in range(cnt):
-            order[c] = i + 1 + c
-            kk[c] = keys[i + 1 + c]
-        idx = np.argsort(kk[:cnt])
-        for c in range(cnt):
-            j = order[idx[c]]
-            d = x[i] - x[j]
-            v = math.exp(-d * d * inv2s2) / r
-            dm = beta * (m[i] - m[j]) * v
-            m[i] = max(0.0, m[i] - dm)
-            m[j] = max(0.0, m[j] + dm)
+        if i % chunk == 0 and i > 0:
+            k2 = 0
+            for k in range(left):
+                if ls[k] >= i:
+                    xs[k2] = xs[k]
+                    ps[k2] = ps[k]
+                    ls[k2] = ls[k]
+                    k2 += 1
+            left = k2
+        p = where[i]
+        xp = x[p]
+        lo = np.searchsorted(xs[:left], xp - radius, side="left")
+        hi = np.searchsorted(xs[:left], xp + radius, side="right")
+        cnt = 0
+        for k in range(lo, hi):  # partners: later in storage (branch-free compaction)
+            d = xp - xs[k]
+            part[cnt] = k
+            u[cnt] = d * d * inv2s2
+            cnt += ls[k] > i
+        if cnt == 0:
+            continue
+        _kernel(u, c, cnt, poly)
+        s = 0.0
+        for k in range(cnt):
+            q = ps[part[k]]
+            part[k] = q
+            s += c[k]
+            r_acc[q] += c[k]
+        inv_r = 1.0 / (r_full[p] if symnorm else r_acc[p] + 1.0 + s)
+        if symnorm:  # c = beta W_ij / r_i (symnorm: the mean of 1/r_i and 1/r_j)
+            for k in range(cnt):
+                c[k] *= beta * 0.5 * (inv_r + 1.0 / r_full[part[k]])
+        else:
+            b = beta * inv_r
+            for k in range(cnt):
+                c[k] *= b
+        mi = m[p]
+        z = np.uint64(0)
+        for k in range(cnt):
+            # Fisher-Yates as we go: the k-th partner is uniform among those left; 32 random
+            # bits a draw, two draws from each 64-bit output
+            if k % 2 == 0:
+                state, z = _splitmix(state)
+                bits = z >> np.uint64(32)
+            else:
+                bits = z & np.uint64(0xFFFFFFFF)
+            j = k + np.int64((bits * np.uint64(cnt - k)) >> np.uint64(32))
+            q = part[j]
+            cj = c[j]
+            part[j] = part[k]
+            c[j] = c[k]
+            mj = m[q]
+            dm = cj * (mi - mj)  # beta (m_i - m_j) W_ij / r_i
+            if clip:
+                mi = max(0.0, mi - dm)
+                m[q] = max(0.0, mj + dm)
+            else:
+                mi = mi - dm
+                m[q] = mj + dm
+        m[p] = mi
     return m
 
 
 def sequential_transfer(
-    x: np.ndarray, m: np.ndarray, sigma: float, beta: float, truncation: float | None, rng: np.random.Generator
+    x: np.ndarray,
+    m: np.ndarray,
+    sigma: float,
+    beta: float,
+    truncation: float | None,
+    rng: np.random.Generator,
+    label: np.ndarray | None = None,
+    symnorm: bool = False,
+    clip: bool = True,
 ) -> np.ndarray:
-    """One step of the authors' loop on sorted positions; partners ordered by random keys."""
-    radius = (9.0 if truncation is None else float(truncation)) * sigma
-    keys = rng.random(x.size)
-    return _sequential(np.ascontiguousarray(x), m.copy(), float(sigma), float(radius), float(beta), keys)
+    """One step of the authors' loop on sorted positions ``x``; ``label`` is the storage index of
+    each particle (None: storage order = position order, the ``sorted`` variant). ``rng`` seeds
+    the partner permutations of this step. The input masses are not changed."""
+    radius = (DEFAULT_CUTOFF if truncation is None else float(truncation)) * sigma
+    if label is None:
+        label = np.arange(x.size, dtype=np.int64)
+    seed = int(rng.integers(0, 2**63))
+    return _sweep(
+        np.ascontiguousarray(x, dtype=np.float64),
+        np.array(m, dtype=np.float64),
+        np.ascontiguousarray(label, dtype=np.int64),
+        float(sigma),
+        float(radius),
+        float(beta),
+        np.uint64(seed),
+        bool(symnorm),
+        bool(clip),
+    )

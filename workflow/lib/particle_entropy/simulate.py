@@ -26,12 +26,13 @@ def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
 def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
     """Simulate ``cfg`` (defaults resolved and checked) -> (per-step table, final state or None)."""
     cfg = cfg.resolved()
-    dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
+    grid = "exact" if cfg.method == "fd" else cfg.time_grid
+    dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid)
     runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
     warm_up(cfg.method)
     size = cfg.n + 1 if cfg.method == "fd" else cfg.n
     rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
-    state = runner(cfg, dts, times(dts, cfg.t_final), rec)
+    state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rec)
     table = rec.table()
     if not want_state:
         return table, None
@@ -68,12 +69,12 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
 
 
 def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
-    rng = cfg.rng()
-    x, m = mtpt.initial_state(cfg, rng)
+    rng, order_rng = cfg.rng(), cfg.rng(stream=1)
+    x, m, label = mtpt.initial_state(cfg, rng)
     _row(rec, cfg, 0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        x, m, h, beta, sub = mtpt.step(cfg, x, m, dt, t, rng)
+        x, m, label, h, beta, sub = mtpt.step(cfg, x, m, label, dt, t, rng, order_rng)
         _row(rec, cfg, k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
     dV = cfg.omega / cfg.n
     return {"x": x, "mass": m, "c": m / dV}

@@ -111,6 +111,7 @@ def run_settings(case: Case, config: Mapping) -> dict:
     physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
     out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
     out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
+    out["time_grid"] = time.get("grid", PAPER["time_grid"])
     out["dt0"] = float(
         first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"], time.get("fixed_dt", PAPER["fixed_dt"]))
     )

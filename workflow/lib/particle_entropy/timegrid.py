@@ -6,14 +6,21 @@ import math
 
 import numpy as np
 
+from .registry import TIME_GRIDS
+
 MAX_STEPS = 10_000_000
 
 
-def time_steps(t_final: float, dt0: float, growth: float) -> np.ndarray:
-    """Step sizes dt_n = dt0 * growth**n, the last one shortened to end exactly at t_final.
+def time_steps(t_final: float, dt0: float, growth: float, grid: str = "exact") -> np.ndarray:
+    """Step sizes dt_n = dt0 * growth**n up to t_final: ``exact`` shortens the last step to end at
+    t_final; ``authors`` keeps whole steps while t < t_final, as the authors' loop (which ends
+    past t_final: 175 steps, t = 1021.1 for the paper's settings).
 
-    ``growth = 1`` gives a fixed step. A t_final shorter than dt0 gives one step of t_final.
+    ``growth = 1`` gives a fixed step. A t_final shorter than dt0 gives one step of t_final
+    (exact) or of dt0 (authors).
     """
+    if grid not in TIME_GRIDS:
+        raise ValueError(f"time grid must be one of {', '.join(TIME_GRIDS)}, got {grid!r}")
     if not (t_final > 0 and math.isfinite(t_final)):
         raise ValueError(f"t_final must be positive and finite, got {t_final!r}")
     if not (dt0 > 0 and math.isfinite(dt0)):
@@ -31,12 +38,26 @@ def time_steps(t_final: float, dt0: float, growth: float) -> np.ndarray:
             f"{n} time steps needed for t_final={t_final} with dt0={dt0}, growth={growth}; at most {MAX_STEPS} allowed"
         )
     dt = dt0 * growth ** np.arange(n, dtype=np.float64)
+    if grid == "authors":
+        return _whole_steps(dt, t_final)
     t_before_last = float(np.cumsum(dt[:-1])[-1]) if n > 1 else 0.0  # same sums as times()
     if t_before_last >= t_final:  # round-off in n: the last step would vanish
         dt = dt[:-1]
         t_before_last = float(np.cumsum(dt[:-1])[-1]) if dt.size > 1 else 0.0
     dt[-1] = t_final - t_before_last  # exact end, no cancellation
     return dt
+
+
+def _whole_steps(dt: np.ndarray, t_final: float) -> np.ndarray:
+    """Steps taken while the clock, advanced step by step, is below t_final."""
+    t = np.cumsum(dt)
+    # n above may be one short or long by round-off: keep steps that start before t_final
+    start = t - dt
+    while start[-1] < t_final and t[-1] < t_final:
+        dt = np.append(dt, dt[-1] * (dt[-1] / dt[-2] if dt.size > 1 else 1.0))
+        t = np.cumsum(dt)
+        start = t - dt
+    return dt[start < t_final]
 
 
 def times(dt: np.ndarray, t_final: float | None = None) -> np.ndarray:
