@@ -1,20 +1,33 @@
 """Ensemble statistics, COMIC tables, minima and the trade-off table (aggregate.py): summaries of three
-short real MTPT runs against numpy, and tables of hand-built summaries against hand-found minima."""
+short real MTPT runs against numpy, and tables of hand-built summaries against hand-found minima; the
+per-realisation values behind the COMIC tables, and the bootstrap of the argmin over N against
+shares worked out by hand."""
 
 from __future__ import annotations
 
+import contextlib
 import math
+import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from particle_entropy.aggregate import (
+    ARGMIN_COLUMN_DOCS,
+    BOOTSTRAP_SEED,
     METRICS,
+    MINIMA_COLUMN_DOCS,
+    MINIMA_COLUMNS,
+    N_RESAMPLES,
+    REALISATION_COLUMN_DOCS,
+    argmin_bootstrap,
     at_times,
+    comic_argmin,
     comic_minima,
     comic_of_mean_sse,
     comic_table,
+    read_realisations,
     summarise_files,
     summarise_runs,
     tradeoff_table,
@@ -241,3 +254,208 @@ def test_tied_comic_marks_one_optimum_the_smallest_n_as_comic_minima_does():
     marked = tradeoff_table(summaries, [10.0]).query("is_comic_optimum")
     assert marked["n"].tolist() == [min(NS)]
     assert comic_minima(comic_table(summaries, [10.0]))["n_opt"].tolist() == [min(NS)]
+
+
+# --------------------------------------------------------------------------- per-realisation values
+def test_realisations_are_the_runs_at_the_nearest_step_and_average_to_the_summary(runs, tmp_path):
+    write_parquet(pd.concat(runs[:2], ignore_index=True), tmp_path / "seeds~3-4.parquet")
+    write_parquet(runs[2], tmp_path / "seeds~5-5.parquet")
+    paths = [str(tmp_path / "seeds~5-5.parquet"), str(tmp_path / "seeds~3-4.parquet")]
+    times = [0.7, 2.0]
+    table = read_realisations(paths + paths[:1], times)  # a block read twice: its seed counts once
+    assert list(table.columns) == list(REALISATION_COLUMN_DOCS)
+    assert len(table) == len(SEEDS) * len(times)
+    assert table["seed"].tolist() == [3, 4, 5, 3, 4, 5] and table["time"].tolist() == [0.7] * 3 + [2.0] * 3
+    t = runs[0]["time"].to_numpy()
+    for requested, step_time in zip(times, (t[np.argmin(np.abs(t - 0.7))], t[-1]), strict=True):
+        rows = table[table["time"] == requested]
+        assert (rows["time_step"] == step_time).all()
+        for seed, run_ in zip(SEEDS, runs, strict=True):
+            r = rows[rows["seed"] == seed].iloc[0]
+            want = run_[run_["time"] == step_time].iloc[0]
+            assert (r["SSE"], r["COMIC"], r["n_sse"], r["dV"]) == (
+                want["SSE"],
+                want["COMIC"],
+                want["n_sse"],
+                want["dV"],
+            )
+        # the per-seed values average to the ensemble mean of the COMIC table
+        comic = comic_table([summarise_runs(runs)], [requested]).iloc[0]
+        assert rows["COMIC"].mean() == pytest.approx(comic["COMIC_mean"], rel=1e-13)
+        assert rows["COMIC"].std(ddof=1) == pytest.approx(comic["COMIC_std"], rel=1e-10)
+        assert Case.from_row(rows.iloc[0]) == Case("mtpt", "collision", 50)
+
+
+# --------------------------------------------------------------------------- bootstrap of the argmin
+def _realisations(values: dict[Case, list[float]], time: float = 10.0, sse: dict | None = None) -> pd.DataFrame:
+    """A realisations table: per case (with N) its per-seed COMIC (and SSE; default e^COMIC),
+    n_sse = N, dV = 10 / N."""
+    rows = []
+    for case, comic in values.items():
+        for seed, c in enumerate(comic):
+            s = sse[case][seed] if sse else math.exp(c)
+            rows.append(
+                {
+                    "label": case.label(n=False),
+                    **case.columns(),
+                    "time": time,
+                    "time_step": time,
+                    "seed": seed,
+                    "SSE": s,
+                    "COMIC": c,
+                    "n_sse": case.n,
+                    "dV": 10.0 / case.n,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def _shares(argmin: pd.DataFrame, convention: str = "mean_COMIC") -> dict[int, float]:
+    rows = argmin[argmin["convention"] == convention]
+    return dict(zip(rows["n"], rows["share"], strict=True))
+
+
+@contextlib.contextmanager
+def _no_warnings():
+    """A context in which any warning is an error."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        yield
+
+
+MODEL = Case("mtpt", "collision")
+NOISE = np.random.default_rng(7).normal(size=(4, 30))  # 30 realisations of 4 N, standard normal
+
+
+def test_a_clearly_lower_n_is_the_argmin_of_nearly_every_resample():
+    # N = 1000 sits 3 nats below its neighbours, each realisation spread by 0.5 nats
+    centre = {300: 1.0, 1000: -2.0, 3000: 1.0, 10000: 2.0}
+    values = {MODEL.at(n): list(c + 0.5 * NOISE[k]) for k, (n, c) in enumerate(centre.items())}
+    argmin = comic_argmin(_realisations(values))
+    assert list(argmin.columns) == list(ARGMIN_COLUMN_DOCS)
+    assert len(argmin) == 2 * 4 and set(argmin["convention"]) == {"mean_COMIC", "COMIC_of_mean_SSE"}
+    assert (argmin["n_resamples"] == N_RESAMPLES).all() and N_RESAMPLES == 2000
+    assert (argmin["n_realisations"] == 30).all()
+    for convention in ("mean_COMIC", "COMIC_of_mean_SSE"):
+        shares = _shares(argmin, convention)
+        assert shares[1000] > 0.99 and sum(shares.values()) == pytest.approx(1.0, abs=1e-12)
+        rows = argmin[argmin["convention"] == convention]
+        assert (rows["ci_lo"] == 1000).all() and (rows["ci_hi"] == 1000).all()
+
+
+def test_two_n_with_the_same_distribution_share_the_argmin_and_the_interval():
+    same = list(NOISE[0])
+    values = {MODEL.at(100): same, MODEL.at(300): same, MODEL.at(1000): list(5.0 + NOISE[1])}
+    argmin = comic_argmin(_realisations(values))
+    shares = _shares(argmin)
+    assert 0.42 < shares[100] < 0.58 and 0.42 < shares[300] < 0.58  # 1/2 each, +- 5 binomial sd
+    assert shares[1000] == 0.0
+    rows = argmin[argmin["convention"] == "mean_COMIC"]
+    assert (rows["ci_lo"] == 100).all() and (rows["ci_hi"] == 300).all()
+
+
+def test_a_single_realisation_is_held_fixed():
+    # N = 300 has one realisation, 0.5; N = 100 has two, -1 and 1. A resample of N = 100 has mean
+    # -1, 0 or 1 with probabilities 1/4, 1/2, 1/4: N = 300 is the argmin only at mean 1 (1/4).
+    values = {MODEL.at(100): [-1.0, 1.0], MODEL.at(300): [0.5]}
+    with _no_warnings():
+        argmin = comic_argmin(_realisations(values))
+    shares = _shares(argmin)
+    assert shares[300] == pytest.approx(0.25, abs=0.04) and shares[100] == pytest.approx(0.75, abs=0.04)
+    assert argmin.set_index(["convention", "n"]).loc[("mean_COMIC", 300), "n_realisations"] == 1
+
+
+def test_fd_single_realisations_give_the_point_estimate_with_share_one():
+    fd = Case("fd", "implicit")
+    # COMIC = 2 ln(SSE / N) - ln(10 / N) with the same SSE at every N: largest N is smallest
+    ns = (30, 100, 300, 1000)
+    comic = {fd.at(n): [2 * math.log(0.01 / n) - math.log(10.0 / n)] for n in ns}
+    sse = {fd.at(n): [0.01] for n in ns}
+    with _no_warnings():
+        argmin = comic_argmin(_realisations(comic, sse=sse))
+    assert (argmin["n_resamples"] == 0).all()
+    for convention in ("mean_COMIC", "COMIC_of_mean_SSE"):
+        assert _shares(argmin, convention) == {30: 0.0, 100: 0.0, 300: 0.0, 1000: 1.0}
+        rows = argmin[argmin["convention"] == convention]
+        assert (rows["ci_lo"] == 1000).all() and (rows["ci_hi"] == 1000).all()
+
+
+def test_identical_realisations_give_a_degenerate_distribution_without_warnings():
+    values = {MODEL.at(100): [1.0, 1.0, 1.0], MODEL.at(300): [0.0, 0.0, 0.0], MODEL.at(1000): [2.0, 2.0]}
+    with _no_warnings():
+        argmin = comic_argmin(_realisations(values))
+    for convention in ("mean_COMIC", "COMIC_of_mean_SSE"):
+        assert _shares(argmin, convention) == {100: 0.0, 300: 1.0, 1000: 0.0}
+        rows = argmin[argmin["convention"] == convention]
+        assert (rows["ci_lo"] == 300).all() and (rows["ci_hi"] == 300).all() and (rows["n_resamples"] == 2000).all()
+
+
+def test_the_two_conventions_resample_what_they_minimise():
+    # n_sse = 1 and dV = 1 in both N, so COMIC = 2 ln SSE. N = 100: SSE 1 always. N = 300: SSE
+    # 0.01 three times and 10 once. Mean of COMIC at 300 is < 0 unless a resample draws 10 three
+    # or four times, P = 4 (1/4)^3 (3/4) + (1/4)^4 = 0.0508; the COMIC of the mean SSE is < 0
+    # only if it never draws 10, P = (3/4)^4 = 0.3164.
+    sse = {MODEL.at(100): [1.0] * 4, MODEL.at(300): [0.01, 0.01, 0.01, 10.0]}
+    comic = {c: [2 * math.log(s) for s in v] for c, v in sse.items()}
+    table = _realisations(comic, sse=sse).assign(n_sse=1, dV=1.0)
+    argmin = comic_argmin(table)
+    assert _shares(argmin, "mean_COMIC")[300] == pytest.approx(1 - 0.0508, abs=0.025)
+    assert _shares(argmin, "COMIC_of_mean_SSE")[300] == pytest.approx(0.3164, abs=0.05)
+
+
+def test_the_bootstrap_is_byte_identical_between_calls(tmp_path):
+    values = {MODEL.at(n): list(0.3 * NOISE[k]) for k, n in enumerate((100, 300, 1000, 3000))}
+    table = _realisations(values)
+    a, b = comic_argmin(table), comic_argmin(table.copy())
+    pd.testing.assert_frame_equal(a, b, check_exact=True)
+    write_parquet(a, tmp_path / "a.parquet")
+    write_parquet(b, tmp_path / "b.parquet")
+    assert (tmp_path / "a.parquet").read_bytes() == (tmp_path / "b.parquet").read_bytes()
+    assert 0.0 < _shares(a)[100] < 1.0  # the shares are not trivially 0 or 1: the resamples matter
+    other = comic_argmin(table, seed=BOOTSTRAP_SEED + 1)
+    assert not other["share"].equals(a["share"])  # a different seed gives different resamples
+
+
+def test_argmin_bootstrap_interval_is_the_percentile_interval_widened_to_grid_points():
+    # index 0 when both draws are 0 (P = 1/4), else index 1: both tails hold mass, so [0, 1]
+    samples = [np.array([0.0, 1.0]), np.array([0.45, 0.45])]
+    shares, lo, hi, drawn = argmin_bootstrap(samples)
+    assert drawn == N_RESAMPLES and shares[0] == pytest.approx(0.25, abs=0.04)
+    assert (lo, hi) == (0, 1)
+    # index 0 only when all four draws are 0, P = 1/256, below the 2.5th percentile: index 1 alone
+    samples = [np.array([0.0, 1.0, 1.0, 1.0]), np.array([0.2, 0.2])]
+    shares, lo, hi, _ = argmin_bootstrap(samples)
+    assert 0.0 < shares[0] < 0.025 and (lo, hi) == (1, 1)
+
+
+def test_minima_carry_the_bootstrap_interval_and_share():
+    variant = VARIANTS[1]
+    summaries = _summaries(variant)
+    comic = comic_table(summaries, [5.0, 10.0, 20.0])
+    # realisations scattered +-0.01 around each summary's COMIC and SSE means
+    rows = []
+    for s in summaries:
+        case = Case.from_row(s.iloc[0])
+        for time, k in ((5.0, 1), (10.0, 2), (20.0, 3)):
+            c, e = s["COMIC_mean"][k], s["SSE_mean"][k]
+            for seed, d in enumerate((-0.01, 0.01, 0.0)):
+                rows.append(
+                    {"label": case.label(n=False), **case.columns(), "time": time, "time_step": s["time"][k]}
+                    | {"seed": seed, "SSE": e * (1 + d), "COMIC": c + d, "n_sse": case.n, "dV": 10.0 / case.n}
+                )
+    argmin = comic_argmin(pd.DataFrame(rows))
+    minima = comic_minima(comic, argmin)
+    assert list(minima.columns) == MINIMA_COLUMNS == list(MINIMA_COLUMN_DOCS)
+    assert len(minima) == 6 and (minima["n_resamples"] == N_RESAMPLES).all()
+    for prefix in ("n_opt", "n_opt_of_mean_SSE"):
+        assert (minima[f"{prefix}_ci_lo"] == minima[prefix]).all()
+        assert (minima[f"{prefix}_ci_hi"] == minima[prefix]).all()
+        assert (minima[f"{prefix}_share"] == 1.0).all()
+    assert (minima["n_opt_of_mean_SSE"] == 30).all()  # 2 ln(SSE / n) - ln(10 / n) = 2 ln 0.1k + ln(n / 10)
+    # without a bootstrap table: the same minima, bootstrap columns missing
+    bare = comic_minima(comic)
+    pd.testing.assert_frame_equal(bare[MINIMA_COLUMNS[:13]], minima[MINIMA_COLUMNS[:13]])
+    assert (bare["n_opt_ci_lo"] == -1).all() and bare["n_opt_share"].isna().all() and (bare["n_resamples"] == 0).all()
+    # a bootstrap missing one N of the COMIC table is refused
+    with pytest.raises(ValueError, match="same ensembles"):
+        comic_minima(comic, argmin[argmin["n"] != 300])

@@ -1,6 +1,6 @@
 """The paper's claims judged on hand-built tables (claims.py): COMIC optima inside or outside their
-ranges, variants judged as their own models, SPH flatness, the adaptive-PT and eta claims, and the
-markdown summary line."""
+ranges, variants judged as their own models and named by scheme with their bootstrap intervals, SPH
+flatness from the error bars, the adaptive-PT and eta claims, and the markdown summary line."""
 
 from __future__ import annotations
 
@@ -11,28 +11,40 @@ import pandas as pd
 import pytest
 
 from particle_entropy.case import Case
-from particle_entropy.claims import comic_claims, ensemble_claims, single_run_claims, to_markdown
+from particle_entropy.claims import comic_claims, ensemble_claims, flatness, single_run_claims, to_markdown
 
 TOL = {
     "fd_optimum_nodes": [1000, 10000],
     "collision_eta1_optimum": [1000, 10000],
     "collision_eta05_optimum": [100, 1000],
-    "sph_flat_max_spread": 2.0,
+    "sph_flat_min_n": 100,
     "adaptive_pt_hc_tolerance": 0.05,
 }
 TIMES = (250.0, 500.0, 1000.0)
 
 
-def _minima(rows: list[tuple[Case, float, int, int]]) -> pd.DataFrame:
-    """(model, time, n_opt, n_opt_of_mean_SSE) -> a minima table."""
+def _minima(rows: list[tuple[Case, float, int, int]], **bootstrap) -> pd.DataFrame:
+    """(model, time, n_opt, n_opt_of_mean_SSE) -> a minima table; ``bootstrap``: its interval
+    columns (default: no resampling, share 1)."""
     return pd.DataFrame(
-        [{"label": m.label(), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k} for m, t, n, k in rows]
+        [
+            {"label": m.label(), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k}
+            | {"n_opt_share": 1.0, "n_opt_of_mean_SSE_share": 1.0, "n_resamples": 0}
+            | bootstrap
+            for m, t, n, k in rows
+        ]
     )
 
 
-def _comic(rows: list[tuple[Case, float, float]]) -> pd.DataFrame:
-    """(case with N, time, mean COMIC) -> a COMIC table."""
-    return pd.DataFrame([{"label": c.label(n=False), **c.columns(), "time": t, "COMIC_mean": v} for c, t, v in rows])
+def _comic(rows: list[tuple]) -> pd.DataFrame:
+    """(case with N, time, mean COMIC[, std of COMIC]) -> a COMIC table (std 0.5 unless given)."""
+    return pd.DataFrame(
+        [
+            {"label": r[0].label(n=False), **r[0].columns(), "time": r[1], "COMIC_mean": r[2]}
+            | {"COMIC_std": r[3] if len(r) > 3 else 0.5}
+            for r in rows
+        ]
+    )
 
 
 EMPTY_COMIC = _comic([(Case("fd", "implicit", 30), 1000.0, 0.0)])  # no SPH rows: no flatness claim
@@ -94,7 +106,9 @@ def test_truncated_variant_gets_its_own_claim_rows():
     assert len(variant) == len(paper) == 2
     assert all(COLL1_T3.label() in k for k in variant)
     assert all(paper.values()) and not any(variant.values())
-    assert {c["reproduced"] for c in claims if "truncation 3" in c["claim"]} == {"300"}
+    assert {c["reproduced"] for c in claims if "truncation 3" in c["claim"]} == {
+        "the equations give 300 (one realisation per N: nothing to resample)"
+    }
 
 
 def test_sequential_variant_gets_its_own_claim_rows():
@@ -106,19 +120,82 @@ def test_sequential_variant_gets_its_own_claim_rows():
     assert [v for k, v in by.items() if "sequential" not in k] == [True, True]
 
 
+def test_fig9_rows_name_the_scheme_and_give_the_bootstrap_interval():
+    seq = Case("mtpt", "collision", truncation=3, scheme="sequential")
+    boot = {"n_opt_ci_lo": 1000, "n_opt_ci_hi": 3000, "n_opt_share": 0.81, "n_resamples": 2000}
+    boot |= {"n_opt_of_mean_SSE_ci_lo": 300, "n_opt_of_mean_SSE_ci_hi": 3000, "n_opt_of_mean_SSE_share": 0.404}
+    claims = comic_claims(_minima([(COLL1, 1000.0, 3000, 1000), (seq, 1000.0, 3000, 1000)], **boot), EMPTY_COMIC, TOL)
+    assert len(claims) == 4
+    for c in claims:
+        scheme = "sequential" if "sequential" in c["claim"] else "symmetric"
+        words = "sequential scheme, the authors' MATLAB loop" if scheme == "sequential" else "Eqs. 16-21"
+        assert words in c["claim"], c["claim"]
+        assert c["reproduced"].startswith("the loop gives" if scheme == "sequential" else "the equations give")
+        if "mean of COMIC" in c["claim"]:
+            assert c["reproduced"].endswith("3000 (95% CI 1000-3000; argmin in 81% of 2000 resamples)")
+        else:
+            assert c["reproduced"].endswith("1000 (95% CI 300-3000; argmin in 40% of 2000 resamples)")
+        assert c["passed"] is True  # judged by the optimum alone, though the interval reaches below 1000
+    assert sum(c["claim"].startswith(COLL1.label() + ": COMIC minimum") for c in claims) == 2
+    assert sum(c["claim"].startswith(seq.label() + ": COMIC minimum") for c in claims) == 2
+    md = to_markdown(pd.DataFrame(claims))
+    assert all(line.count(" | ") == 4 for line in md.splitlines() if line.startswith("| MTPT"))  # five cells
+
+
+def test_an_optimum_outside_its_range_fails_though_its_interval_reaches_in():
+    boot = {"n_opt_ci_lo": 3000, "n_opt_ci_hi": 30000, "n_opt_share": 0.6, "n_resamples": 2000}
+    claims = comic_claims(_minima([(COLL05, 1000.0, 10000, 300)], **boot), EMPTY_COMIC, TOL)
+    by = _by_claim(claims)
+    assert by[next(k for k in by if "mean of COMIC" in k)] is False  # 10000 outside [100, 1000]
+    assert by[next(k for k in by if "mean SSE" in k)] is True
+
+
 # --------------------------------------------------------------------------- SPH flatness
-def test_sph_flatness_passes_flat_and_fails_spread():
-    flat, steep = Case("mtpt", "sph"), Case("mtpt", "sph", truncation=3)
-    rows = []
-    for n, a, b in [(30, -20.0, 0.0), (100, 1.0, 1.0), (300, 1.5, 3.5), (1000, 0.8, -0.2)]:
-        rows += [(flat.at(n), 1000.0, a), (steep.at(n), 1000.0, b)]  # N = 30 is outside the judged range
-        rows += [(flat.at(n), 250.0, 10.0 * n), (steep.at(n), 250.0, 0.0)]  # earlier time: not judged
-    minima = _minima([(Case("fd", "implicit"), 1000.0, 3000, 3000)])
-    by = _by_claim(comic_claims(minima, _comic(rows), TOL))
-    sph = {k: v for k, v in by.items() if "flat" in k}
-    assert len(sph) == 2
-    assert by[next(k for k in sph if "truncation" not in k)] is True  # spread 0.7 <= 2
-    assert by[next(k for k in sph if "truncation 3" in k)] is False  # spread 3.7 > 2
+SPH, SPH_T3 = Case("mtpt", "sph"), Case("mtpt", "sph", truncation=3)
+FD_MINIMA = _minima([(Case("fd", "implicit"), 1000.0, 3000, 3000)])
+
+
+def _sph_claims(points: dict[Case, list[tuple[int, float, float]]]) -> dict[str, dict]:
+    """SPH claims of COMIC rows (N, mean, std) per model at t = 1000, plus a decoy at t = 250."""
+    rows = [(m.at(n), 1000.0, v, s) for m, pts in points.items() for n, v, s in pts]
+    rows += [(m.at(n), 250.0, 100.0 * n, 0.0) for m, pts in points.items() for n, _, _ in pts]  # not judged
+    claims = comic_claims(FD_MINIMA, _comic(rows), TOL)
+    return {c["claim"]: c for c in claims if "flat" in c["claim"]}
+
+
+def test_sph_flat_when_every_n_above_100_overlaps_the_minimum_and_not_when_one_is_3_std_away():
+    # flat: N_opt = 300 (0.5 +- 0.5); |1.0 - 0.5| / sqrt(0.5) = 0.71 at 100, |1.2 - 0.5| / sqrt(0.5) = 0.99 at 1000
+    flat = [(30, 20.0, 1.0), (100, 1.0, 0.5), (300, 0.5, 0.5), (1000, 1.2, 0.5)]
+    # steep: N_opt = 300 (0.5 +- 0.3); N = 1000 lies 3 combined std, 3 sqrt(0.18), above it
+    steep = [(30, 20.0, 1.0), (100, 0.6, 0.3), (300, 0.5, 0.3), (1000, 0.5 + 3 * math.sqrt(0.18), 0.3)]
+    claims = _sph_claims({SPH: flat, SPH_T3: steep})
+    assert len(claims) == 2
+    f = next(c for k, c in claims.items() if "truncation" not in k)
+    s = next(c for k, c in claims.items() if "truncation 3" in k)
+    assert f["passed"] is True and s["passed"] is False
+    assert "0.99 combined std, at N=1000" in f["reproduced"] and "N_opt=300" in f["reproduced"]
+    assert "3.00 combined std, at N=1000" in s["reproduced"]
+    assert "N >= 100" in f["claim"] and "symmetric scheme" in f["claim"]
+
+
+def test_sph_flatness_ignores_n_below_the_threshold_but_not_a_lower_minimum_there():
+    # N = 30 far above the rest: ignored (the paper: worse for N < 100)
+    assert next(iter(_sph_claims({SPH: [(30, 9.0, 0.1), (100, 0.1, 0.1), (300, 0.0, 0.1)]}).values()))["passed"]
+    # N = 30 far below the rest: the N >= 100 are outside the bars of that minimum
+    low = next(iter(_sph_claims({SPH: [(30, -9.0, 0.1), (100, 0.1, 0.1), (300, 0.0, 0.1)]}).values()))
+    assert low["passed"] is False and "N_opt=30" in low["reproduced"]
+
+
+def test_sph_flatness_without_error_bars():
+    # one realisation (std 0): equal means are flat (ratio 0), any difference is not (ratio inf)
+    assert flatness(_comic([(SPH.at(n), 1000.0, 1.0, 0.0) for n in (100, 300)]), 100) == {
+        "flat": True,
+        "n_opt": 100,
+        "ratio": 0.0,
+        "n_worst": 100,
+    }
+    uneven = flatness(_comic([(SPH.at(100), 1000.0, 1.0, 0.0), (SPH.at(300), 1000.0, 1.1, 0.0)]), 100)
+    assert uneven["flat"] is False and uneven["ratio"] == math.inf and uneven["n_worst"] == 300
 
 
 # --------------------------------------------------------------------------- ensemble claims
@@ -199,7 +276,7 @@ def test_no_comic_models_give_no_comic_claims():
         "fd_optimum_nodes": [1000, 10000],
         "collision_eta1_optimum": [1000, 10000],
         "collision_eta05_optimum": [100, 1000],
-        "sph_flat_max_spread": 2.0,
+        "sph_flat_min_n": 100,
     }
     assert comic_claims(comic_minima(comic), comic, tol) == []
 
@@ -211,3 +288,11 @@ def test_single_run_claims_without_the_mtpt_case_skip_it():
     runs = [run(RunConfig(method="pt", kernel=k, n=n, t_final=2.0))[0] for n in (30, 60) for k in ("bins", "fixed")]
     claims = single_run_claims(runs, {})
     assert claims == []  # each N lacks the MTPT collision run its claims compare with: nothing judged, no crash
+
+
+def test_markdown_escapes_bars_inside_cells():
+    claims = pd.DataFrame(
+        [{"claim": "c", "paper": "|d ln E| > 0", "reproduced": "|dH_C| 0.1", "tolerance": "t", "passed": True}]
+    )
+    row = to_markdown(claims).splitlines()[-1]
+    assert row == r"| c | \|d ln E\| > 0 | \|dH_C\| 0.1 | t | pass |"

@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.kernels import beta_sph, collision_sigma, gaussian_pdf, h_de, h_sph
+from particle_entropy.kernels import (
+    beta_sph,
+    collision_sigma,
+    gaussian_pdf,
+    h_de,
+    h_sph,
+    truncated_variance_fraction,
+)
 
 
 def test_h_de_eq23():
@@ -69,3 +76,15 @@ def test_gaussian_pdf_moments(var):
     assert g.sum() * dx == pytest.approx(1.0, rel=1e-12)
     assert (g * x * x).sum() * dx == pytest.approx(var, rel=1e-12)
     assert gaussian_pdf(np.array([0.0]), var)[0] == pytest.approx(1 / math.sqrt(2 * math.pi * var), rel=1e-14)
+
+
+@pytest.mark.parametrize("k", [1.0, 2.0, 3.0, 4.5])
+def test_truncated_variance_fraction_equals_the_truncated_normal_variance(k):
+    from scipy.stats import truncnorm
+
+    assert truncated_variance_fraction(k) == pytest.approx(truncnorm.var(-k, k), rel=1e-12)
+
+
+def test_truncated_variance_fraction_at_three_widths_and_whole():
+    assert truncated_variance_fraction(3.0) == pytest.approx(0.9733, abs=5e-5)  # the 2.7 % the issue names
+    assert truncated_variance_fraction(None) == 1.0

@@ -224,3 +224,25 @@ def test_positivity_guard_counts_only_mass_holders():
     res = mass_transfer(x, m, 0.01, 1.5)
     assert res.substeps >= 2 and res.mass.min() >= 0.0
     assert res.mass.sum() == pytest.approx(2.0, rel=1e-13)
+
+
+def _variance_added(scheme_sigma, truncation, beta=0.5, sigma=0.05):
+    """Variance a transfer step adds to a smooth Gaussian of masses on a dense even grid."""
+    x = np.linspace(-3.0, 3.0, 6001)
+    m = np.exp(-0.5 * (x / 0.5) ** 2)
+    m /= m.sum()
+    out = mass_transfer(x, m, scheme_sigma(sigma), beta, truncation, "direct").mass
+    var = lambda w: np.sum(w * x * x) / w.sum() - (np.sum(w * x) / w.sum()) ** 2
+    return (var(out) - var(m)) / (beta * sigma**2)
+
+
+def test_truncation_loses_the_cut_variance_and_widening_restores_it():
+    # a step of Eq. 19 adds beta x (kernel variance); a kernel cut at 3 widths has 0.9733 of it
+    from particle_entropy.kernels import truncated_variance_fraction as f
+
+    whole = _variance_added(lambda s: s, None)
+    cut = _variance_added(lambda s: s, 3.0)
+    widened = _variance_added(lambda s: s / math.sqrt(f(3.0)), 3.0)
+    assert whole == pytest.approx(1.0, abs=2e-3)
+    assert cut == pytest.approx(f(3.0), abs=2e-3) and cut < 0.98
+    assert widened == pytest.approx(1.0, abs=2e-3)

@@ -99,3 +99,30 @@ def test_max_steps_boundary():
     assert MAX_STEPS >= 175
     dt = time_steps(1000.0, 1e-3, 1.0)  # 1e6 steps is allowed
     assert len(dt) == 1_000_000
+
+
+def test_authors_grid_runs_whole_steps_past_t_final():
+    # the authors' loop: t += dt; step; dt *= 1.05 while t < 1000, written out as a plain loop
+    t, dt, ends = 0.0, 0.01, []
+    while t < 1000.0:
+        t += dt
+        ends.append(t)
+        dt *= 1.05
+    assert len(ends) == 175 and round(ends[-1], 1) == 1021.1
+    steps = time_steps(1000.0, 0.01, 1.05, grid="authors")
+    assert steps.size == 175
+    np.testing.assert_allclose(np.cumsum(steps), ends, rtol=1e-12)
+    assert times(steps)[-1] == pytest.approx(1021.1, abs=0.05)
+
+
+@pytest.mark.parametrize(("t_final", "dt0", "growth"), [(10.0, 1.0, 1.0), (10.0, 0.3, 1.0), (7.0, 0.01, 1.2)])
+def test_authors_grid_last_step_starts_before_t_final_and_ends_at_or_after_it(t_final, dt0, growth):
+    steps = time_steps(t_final, dt0, growth, grid="authors")
+    ends = np.cumsum(steps)
+    assert ends[-1] >= t_final - 1e-12 and ends[-1] - steps[-1] < t_final
+    np.testing.assert_allclose(steps, dt0 * growth ** np.arange(steps.size), rtol=1e-12)  # no step shortened
+
+
+def test_unknown_grid_is_refused():
+    with pytest.raises(ValueError, match="exact, authors"):
+        time_steps(10.0, 1.0, 1.0, grid="matlab")

@@ -20,13 +20,23 @@ rule summarise_case:
         Path(log[0]).write_text(f"summarised {count} realisations\n")
 
 
+def runs_of(*sections):
+    """The run tables behind the ensembles of these sections (per-realisation values), each once."""
+    return list(dict.fromkeys(p for s in sections for e in ensembles(s) for p in case_run_paths(e, config)))
+
+
 rule comic_tables:
-    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models."""
+    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
+    per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each
+    N is the argmin, and the minima with their bootstrap intervals."""
     input:
-        summaries_of("fig8", "fig9"),
+        summaries=summaries_of("fig8", "fig9"),
+        runs=runs_of("fig8", "fig9"),
     output:
         comic="results/tables/comic.parquet",
         minima="results/tables/comic_minima.parquet",
+        realisations="results/tables/comic_realisations.parquet",
+        argmin="results/tables/comic_argmin.parquet",
     log:
         "logs/comic_tables.log",
     conda:
@@ -39,12 +49,15 @@ rule comic_tables:
 
 
 rule comic_tables_fig9:
-    """Fig. 9's own COMIC table, so that its target pulls no FD run."""
+    """Fig. 9's own COMIC tables, so that its target pulls no FD run."""
     input:
-        summaries_of("fig9"),
+        summaries=summaries_of("fig9"),
+        runs=runs_of("fig9"),
     output:
         comic="results/tables/fig9/comic.parquet",
         minima="results/tables/fig9/comic_minima.parquet",
+        realisations="results/tables/fig9/comic_realisations.parquet",
+        argmin="results/tables/fig9/comic_argmin.parquet",
     log:
         "logs/comic_tables_fig9.log",
     conda:

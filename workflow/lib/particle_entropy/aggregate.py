@@ -1,11 +1,17 @@
-"""Ensemble statistics over realisations, COMIC tables and their minima (Figs. 3-6, 8, 9)."""
+"""Ensemble statistics over realisations, COMIC tables and their minima (Figs. 3-6, 8, 9), and a
+bootstrap over realisations of where each COMIC minimum lies."""
 
 from __future__ import annotations
 
+import inspect
+import math
+from collections.abc import Callable
+
 import numpy as np
 import pandas as pd
+from scipy import stats
 
-from .case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table
+from .case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
 from .measures import comic
 
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
@@ -155,29 +161,45 @@ def comic_of_mean_sse(sse_mean: float, sse_std: float, n: int, dV: float) -> dic
     }
 
 
-def comic_minima(comic: pd.DataFrame) -> pd.DataFrame:
-    """For each model and time: the N minimising mean COMIC, its COMIC, and its neighbours' values."""
+def comic_minima(comic: pd.DataFrame, argmin: pd.DataFrame | None = None) -> pd.DataFrame:
+    """For each model and time: the N minimising mean COMIC, its COMIC, its neighbours' values,
+    the N minimising the COMIC of the mean SSE, and (from ``argmin``, the table of
+    ``comic_argmin``) the bootstrap interval and share of both optima (MINIMA_COLUMN_DOCS).
+    Without ``argmin`` the bootstrap columns hold their missing values (-1, nan, 0 resamples)."""
     rows = []
     for model, rows_of_model in by_model(comic):
         for time, g in rows_of_model.groupby("time", sort=True):
-            rows.append(_minimum(model, time, g.sort_values("n", ignore_index=True)))
+            row = _minimum(model, time, g.sort_values("n", ignore_index=True))
+            rows.append({**row, **_bootstrap_columns(model, time, row, g, argmin)})
     return pd.DataFrame(rows, columns=MINIMA_COLUMNS)
 
 
-MINIMA_COLUMNS = [
-    "label",
-    *MODEL_COLUMNS,
-    "time",
-    "n_opt",
-    "COMIC_opt",
-    "COMIC_opt_std",
-    "n_opt_of_mean_SSE",
-    "n_below",
-    "COMIC_below",
-    "n_above",
-    "COMIC_above",
-    "interior",
-]
+MINIMA_COLUMN_DOCS = {
+    "label": "legend label of the model (Case.label)",
+    **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},
+    "time": "requested time [T] (the COMIC table's rows are at the nearest recorded step)",
+    "n_opt": "N minimising the ensemble mean of per-realisation COMIC (smallest N among ties)",
+    "COMIC_opt": "mean COMIC at n_opt",
+    "COMIC_opt_std": "ensemble standard deviation of COMIC at n_opt (ddof = 1; 0 for one realisation)",
+    "n_opt_of_mean_SSE": "N minimising the COMIC of the ensemble-mean SSE, 2 ln(mean SSE / n) - ln dV "
+    "(the authors' Fig. 9 convention)",
+    "n_below": "the next smaller N of the grid (-1: n_opt is the smallest)",
+    "COMIC_below": "mean COMIC at n_below (nan if none)",
+    "n_above": "the next larger N of the grid (-1: n_opt is the largest)",
+    "COMIC_above": "mean COMIC at n_above (nan if none)",
+    "interior": "n_opt has a neighbour on both sides, so the minimum is bracketed",
+    "n_opt_ci_lo": "lower end of the 95 % bootstrap percentile interval of the argmin N of mean COMIC, "
+    "widened outward to a grid N (aggregate.argmin_bootstrap; -1: no bootstrap table)",
+    "n_opt_ci_hi": "upper end of that interval, a grid N (-1: no bootstrap table)",
+    "n_opt_share": "fraction of bootstrap resamples whose argmin of mean COMIC is n_opt (1 when nothing "
+    "is resampled; nan: no bootstrap table)",
+    "n_opt_of_mean_SSE_ci_lo": "the same interval for the argmin of the COMIC of the mean SSE: lower end",
+    "n_opt_of_mean_SSE_ci_hi": "its upper end",
+    "n_opt_of_mean_SSE_share": "fraction of resamples whose argmin of the COMIC of the mean SSE is n_opt_of_mean_SSE",
+    "n_resamples": "bootstrap resamples drawn (aggregate.N_RESAMPLES; 0: every N has one realisation, "
+    "e.g. FD, so the optimum is certain and its share 1)",
+}
+MINIMA_COLUMNS = list(MINIMA_COLUMN_DOCS)
 
 
 def _minimum(model, time: float, g: pd.DataFrame) -> dict:
@@ -199,3 +221,203 @@ def _minimum(model, time: float, g: pd.DataFrame) -> dict:
         "COMIC_above": above["COMIC_mean"] if above is not None else np.nan,
         "interior": below is not None and above is not None,
     }
+
+
+# --------------------------------------------------------------------------- per-realisation values
+REALISATION_COLUMN_DOCS = {
+    "label": "legend label of the model (Case.label without N)",
+    **{c: f"case column (case.COLUMN_DOCS): {c}" for c in CASE_COLUMNS},
+    "time": "requested time [T]",
+    "time_step": "time of the recorded step nearest to it [T] (the rule of at_times)",
+    "seed": "seed of the realisation",
+    "SSE": "sum of squared errors of this realisation, Eq. 44",
+    "COMIC": "2 ln(SSE / n_sse) - ln dV of this realisation, Eq. 43",
+    "n_sse": "number of points in SSE",
+    "dV": "sampling volume [L]",
+}
+REALISATION_COLUMNS = list(REALISATION_COLUMN_DOCS)
+RUN_COLUMNS = ["step", "time", "seed", "SSE", "COMIC", "n_sse", "dV", *CASE_COLUMNS]  # what they are read from
+
+
+def read_realisations(paths: list[str], times: list[float]) -> pd.DataFrame:
+    """``realisations_table`` of the run tables at ``paths`` (blocks of seeds, any cases)."""
+    return realisations_table([pd.read_parquet(p, columns=RUN_COLUMNS) for p in paths], times)
+
+
+def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
+    """Per-realisation SSE and COMIC of every case in the run tables ``runs`` (each one case,
+    one or more seeds) at the recorded step nearest to each of ``times``: one row per case,
+    time and seed (REALISATION_COLUMN_DOCS). A seed read twice counts once."""
+    parts = []
+    for run in runs:
+        case = case_of_table(run)
+        for seed, g in run.groupby("seed", sort=True):
+            rows = at_times(g.sort_values("step"), times)
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "label": case.label(n=False),
+                        **{c: [v] * len(rows) for c, v in case.columns().items()},
+                        "time": rows["time_requested"].to_numpy(dtype=np.float64),
+                        "time_step": rows["time"].to_numpy(dtype=np.float64),
+                        "seed": int(seed),
+                        "SSE": rows["SSE"].to_numpy(dtype=np.float64),
+                        "COMIC": rows["COMIC"].to_numpy(dtype=np.float64),
+                        "n_sse": rows["n_sse"].to_numpy(dtype=np.int64),
+                        "dV": rows["dV"].to_numpy(dtype=np.float64),
+                    }
+                )
+            )
+    if not parts:
+        return pd.DataFrame(columns=REALISATION_COLUMNS)
+    df = pd.concat(parts, ignore_index=True).drop_duplicates([*CASE_COLUMNS, "time", "seed"])
+    parts = [g.sort_values(["time", "n", "seed"]) for _, g in by_model(df)]
+    return pd.concat(parts, ignore_index=True)[REALISATION_COLUMNS]
+
+
+# --------------------------------------------------------------------------- bootstrap of the argmin
+N_RESAMPLES = 2000  # bootstrap resamples of every argmin distribution
+BOOTSTRAP_SEED = 2020  # fixed: the same realisations give byte-identical tables
+CONFIDENCE = 0.95
+# convention -> (its column prefix in the minima table, what is minimised over N)
+CONVENTIONS = {
+    "mean_COMIC": ("n_opt", "mean over realisations of per-realisation COMIC"),
+    "COMIC_of_mean_SSE": ("n_opt_of_mean_SSE", "COMIC of the mean SSE over realisations"),
+}
+ARGMIN_COLUMN_DOCS = {
+    "label": "legend label of the model (Case.label)",
+    **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},
+    "time": "requested time [T]",
+    "convention": "what is minimised over N: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
+    "n": "particles (FD: intervals): one N of the model's grid",
+    "share": "fraction of bootstrap resamples whose argmin over N is this N (shares of a model, "
+    "time and convention sum to 1; with no resampling, 1 at the point estimate)",
+    "n_realisations": "realisations of this N that were resampled (1: held fixed)",
+    "n_resamples": "bootstrap resamples drawn (0: every N has one realisation, nothing to resample)",
+    "ci_lo": "lower end of the 95 % interval of the argmin N of this model, time and convention (argmin_bootstrap)",
+    "ci_hi": "its upper end",
+}
+ARGMIN_COLUMNS = list(ARGMIN_COLUMN_DOCS)
+_RNG = "rng" if "rng" in inspect.signature(stats.bootstrap).parameters else "random_state"  # scipy < 1.15
+
+
+def argmin_bootstrap(
+    samples: list[np.ndarray],
+    value: Callable[[np.ndarray], np.ndarray] = lambda means: means,
+    n_resamples: int = N_RESAMPLES,
+    seed: int = BOOTSTRAP_SEED,
+) -> tuple[np.ndarray, int, int, int]:
+    """Where the minimum over N lies, resampled: ``samples[i]`` are the realisations of the i-th
+    N, ``value`` maps the stacked sample means (shape (N count, resamples)) to the statistic
+    minimised over axis 0. Returns (share of resamples whose argmin is each i, interval low
+    index, high index, resamples drawn).
+
+    Each N is resampled on its own (scipy.stats.bootstrap, paired=False: realisations with
+    replacement, the same count), the argmin recomputed per resample. The interval is the 95 %
+    percentile interval of the bootstrap argmin index (2.5 and 97.5 percentiles, linear
+    interpolation) widened outward to grid points: low = floor, high = ceil. Being a set of
+    grid points bounded by order statistics, it is the same whether the argmin is counted in
+    index, N or log N. An N with a single realisation cannot be resampled meaningfully (every
+    resample would repeat it): it is held fixed at its value; when every N has one realisation
+    (FD, deterministic) nothing is resampled, the share is 1 at the point estimate and the
+    interval that point. Every call draws from its own Generator seeded with ``seed``, so equal
+    inputs give equal results and two conventions of one model see the same resamples."""
+    samples = [np.asarray(s, dtype=np.float64) for s in samples]
+    if not samples or any(len(s) == 0 for s in samples):
+        raise ValueError("every N needs at least one realisation")
+    means = np.array([s.mean() for s in samples])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        point = int(np.argmin(value(means[:, None])[:, 0]))
+    free = [i for i, s in enumerate(samples) if len(s) > 1]
+    shares = np.zeros(len(samples))
+    if not free:
+        shares[point] = 1.0
+        return shares, point, point, 0
+
+    def statistic(*resampled, axis=-1):
+        batch = resampled[0].shape[:-1]  # scipy passes (resamples, realisations) per N
+        stacked = np.empty((len(means), *batch))
+        stacked[:] = means.reshape(-1, *[1] * len(batch))  # single realisations: fixed
+        for i, r in zip(free, resampled):
+            stacked[i] = r.mean(axis=axis)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
+            return np.argmin(value(stacked), axis=0).astype(np.float64)  # float: scipy casts its levels
+
+    res = stats.bootstrap(
+        [samples[i] for i in free],
+        statistic,
+        n_resamples=n_resamples,
+        vectorized=True,
+        paired=False,
+        confidence_level=CONFIDENCE,
+        method="percentile",
+        **{_RNG: np.random.default_rng(seed)},
+    )
+    dist = np.asarray(res.bootstrap_distribution).astype(np.int64)
+    shares = np.bincount(dist, minlength=len(samples)) / len(dist)
+    lo, hi = res.confidence_interval.low, res.confidence_interval.high
+    return shares, int(math.floor(lo)), int(math.ceil(hi)), len(dist)
+
+
+def comic_argmin(
+    realisations: pd.DataFrame, n_resamples: int = N_RESAMPLES, seed: int = BOOTSTRAP_SEED
+) -> pd.DataFrame:
+    """How often each N is the COMIC argmin over bootstrap resamples of the realisations, per
+    model, time and convention (mean of per-realisation COMIC; COMIC of the mean SSE, Eq. 43):
+    one row per model, time, convention and N (ARGMIN_COLUMN_DOCS), from the table of
+    ``realisations_table``. Methods: ``argmin_bootstrap``."""
+    rows = []
+    for model, of_model in by_model(realisations):
+        for time, g in of_model.groupby("time", sort=True):
+            per_n = [s for _, s in g.groupby("n", sort=True)]
+            ns = [int(s["n"].iloc[0]) for s in per_n]
+            n_sse = np.array([float(s["n_sse"].iloc[0]) for s in per_n])[:, None]
+            dV = np.array([float(s["dV"].iloc[0]) for s in per_n])[:, None]
+            of_sse = lambda means, n_sse=n_sse, dV=dV: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)
+            for convention, column, value in (
+                ("mean_COMIC", "COMIC", lambda means: means),
+                ("COMIC_of_mean_SSE", "SSE", of_sse),
+            ):
+                samples = [s[column].to_numpy() for s in per_n]
+                shares, lo, hi, drawn = argmin_bootstrap(samples, value, n_resamples, seed)
+                for n, sample, share in zip(ns, samples, shares):
+                    rows.append(
+                        {
+                            "label": model.label(),
+                            **model.columns(),
+                            "time": time,
+                            "convention": convention,
+                            "n": n,
+                            "share": float(share),
+                            "n_realisations": len(sample),
+                            "n_resamples": drawn,
+                            "ci_lo": ns[lo],
+                            "ci_hi": ns[hi],
+                        }
+                    )
+    return pd.DataFrame(rows, columns=ARGMIN_COLUMNS)
+
+
+def _bootstrap_columns(model, time: float, minimum: dict, g: pd.DataFrame, argmin: pd.DataFrame | None) -> dict:
+    """The minima table's bootstrap columns of one model and time, from the ``comic_argmin`` table."""
+    out = {"n_resamples": 0}
+    for convention, (prefix, _) in CONVENTIONS.items():
+        out.update({f"{prefix}_ci_lo": -1, f"{prefix}_ci_hi": -1, f"{prefix}_share": np.nan})
+        if argmin is None:
+            continue
+        rows = rows_of(argmin[(argmin["convention"] == convention) & (argmin["time"] == time)], model)
+        if sorted(rows["n"]) != sorted(g["n"]):
+            raise ValueError(
+                f"{model.label()}, t = {time:g}: the bootstrap has N = {sorted(rows['n'].tolist())}, "
+                f"the COMIC table N = {sorted(g['n'].tolist())}; they must come from the same ensembles"
+            )
+        at_opt = rows[rows["n"] == minimum[prefix]].iloc[0]
+        out.update(
+            {
+                f"{prefix}_ci_lo": int(at_opt["ci_lo"]),
+                f"{prefix}_ci_hi": int(at_opt["ci_hi"]),
+                f"{prefix}_share": float(at_opt["share"]),
+                "n_resamples": int(at_opt["n_resamples"]),
+            }
+        )
+    return out

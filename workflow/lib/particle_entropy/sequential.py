@@ -44,6 +44,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .gauss import _exp_neg
+
 DEFAULT_CUTOFF = 9.0  # kernel widths searched when the kernel is not truncated (exp(-40.5) ~ 2.6e-18)
 
 
@@ -57,43 +59,15 @@ def _splitmix(state):
     return state, z ^ (z >> np.uint64(31))
 
 
-POLY_MAX_U = 4.6  # _kernel's polynomial covers exp(-u) for 0 <= u <= 4.6 (a cut-off of 3 widths: 4.5)
-
-
 @njit(cache=True, fastmath={"contract"})
-def _kernel(u, out, cnt, poly):
-    """out[k] = exp(-u[k]) for k < cnt. With ``poly`` (all u <= POLY_MAX_U) as (e^(-u/8))^8, the
-    inner factor a Taylor polynomial of degree 15 (relative error <= 2e-15, tested against
-    np.exp): arithmetic the compiler vectorises, unlike calls to exp."""
-    if not poly:
-        for k in range(cnt):
-            out[k] = np.exp(-u[k])
-        return
+def _kernel(u, out, cnt):
+    """out[k] = exp(-u[k]) for k < cnt, by gauss._exp_neg (arithmetic that vectorises)."""
     for k in range(cnt):
-        y = u[k] * 0.125
-        e = -1.0 / 1307674368000.0
-        e = e * y + 1.0 / 87178291200.0
-        e = e * y - 1.0 / 6227020800.0
-        e = e * y + 1.0 / 479001600.0
-        e = e * y - 1.0 / 39916800.0
-        e = e * y + 1.0 / 3628800.0
-        e = e * y - 1.0 / 362880.0
-        e = e * y + 1.0 / 40320.0
-        e = e * y - 1.0 / 5040.0
-        e = e * y + 1.0 / 720.0
-        e = e * y - 1.0 / 120.0
-        e = e * y + 1.0 / 24.0
-        e = e * y - 1.0 / 6.0
-        e = e * y + 0.5
-        e = e * y - 1.0
-        e = e * y + 1.0
-        e = e * e
-        e = e * e
-        out[k] = e * e
+        out[k] = _exp_neg(u[k])
 
 
 @njit(cache=True)
-def _row_sums(x, radius, inv2s2, poly):
+def _row_sums(x, radius, inv2s2):
     """r_i = sum of W_ij over |x_i - x_j| <= radius, i included (x sorted)."""
     n = x.shape[0]
     r = np.empty(n)
@@ -105,7 +79,7 @@ def _row_sums(x, radius, inv2s2, poly):
         for k in range(lo, hi):
             d = x[p] - x[k]
             u[k - lo] = d * d * inv2s2
-        _kernel(u, w, hi - lo, poly)
+        _kernel(u, w, hi - lo)
         r[p] = w[: hi - lo].sum()
     return r
 
@@ -115,11 +89,10 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each."""
     n = x.shape[0]
     inv2s2 = 0.5 / (sigma * sigma)
-    poly = radius * radius * inv2s2 <= POLY_MAX_U
     where = np.empty(n, np.int64)  # sorted index of the particle stored at i
     for p in range(n):
         where[label[p]] = p
-    r_full = _row_sums(x, radius, inv2s2, poly) if symnorm else np.zeros(0)
+    r_full = _row_sums(x, radius, inv2s2) if symnorm else np.zeros(0)
     r_acc = np.zeros(n)  # W summed from the neighbours visited so far
     # particles not yet visited, in position order, rebuilt every `chunk` visits so that windows
     # hold few visited particles: their positions, sorted indices and labels
@@ -154,7 +127,7 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
             cnt += ls[k] > i
         if cnt == 0:
             continue
-        _kernel(u, c, cnt, poly)
+        _kernel(u, c, cnt)
         s = 0.0
         for k in range(cnt):
             q = ps[part[k]]
