@@ -13,6 +13,7 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/shear.smk"
+include: "workflow/rules/mechanism.smk"
 
 
 rule all:

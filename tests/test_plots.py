@@ -106,6 +106,35 @@ def comic_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def argmin_and_minima(comic: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Synthetic bootstrap tables for a COMIC table: per model and time, the N of least mean COMIC
+    is the argmin of 70 % of resamples and the next N of 30 % (the last N: the one before)."""
+    shares, minima = [], []
+    model_cols = ["method", "kernel", "eta", "truncation", "dt_growth", "scheme"]
+    for key, g in comic.groupby([*model_cols, "time"]):
+        g = g.sort_values("n").reset_index(drop=True)
+        k = int(np.argmin(g["COMIC_mean"].to_numpy()))
+        other = k + 1 if k + 1 < len(g) else k - 1
+        model = dict(zip([*model_cols, "time"], key, strict=True))
+        for j, row in g.iterrows():
+            share = 0.7 if j == k else (0.3 if j == other else 0.0)
+            shares.append(
+                {**model, "convention": "mean_COMIC", "n": int(row["n"]), "share": share, "n_realisations": 3}
+            )
+        lo, hi = sorted((int(g["n"][k]), int(g["n"][other])))
+        minima.append(
+            {
+                **model,
+                "n_opt": int(g["n"][k]),
+                "n_opt_ci_lo": lo,
+                "n_opt_ci_hi": hi,
+                "n_opt_share": 0.7,
+                "n_resamples": 2000,
+            }
+        )
+    return pd.DataFrame(shares), pd.DataFrame(minima)
+
+
 def tradeoff_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
     rows = []
     for c in cases:
@@ -134,7 +163,9 @@ def tradeoff_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
 def inputs(fig: str, cases: list[Case]) -> list[pd.DataFrame]:
     """What plot_figure.py reads for ``fig``: one table per case, or one table for all cases."""
     if fig == "fig9":
-        return [comic_table(cases)]
+        comic = comic_table(cases)
+        argmin, minima = argmin_and_minima(comic)
+        return [comic, minima, argmin]
     if fig == "tradeoff":
         return [tradeoff_table(cases)]
     make = {"fig1": run_table, "fig2": run_table, "fig7": state}.get(fig, summary)
@@ -260,13 +291,17 @@ def test_automatic_styles_stay_distinct_and_off_the_paper_palette():
     assert all(style[m]["color"] not in (plots.GREEN, plots.VERMILLION) for m in added)
 
 
-def test_scheme_variants_are_two_series_in_fig9_and_tradeoff():
+def test_scheme_variants_are_side_by_side_in_fig9_and_apart_in_tradeoff():
     symmetric = Case("mtpt", "collision", eta=1.0, truncation=3)
     sequential = Case("mtpt", "collision", eta=1.0, truncation=3, scheme="sequential")
     cases = [m.at(n) for m in (symmetric, sequential) for n in NS]
     _, data = draw("fig9", cases)
-    assert data.groupby("panel")["scheme"].agg(set).to_dict() == {"a": {"symmetric"}, "b": {"sequential"}}
-    assert data.groupby("series")["scheme"].nunique().eq(1).all() and data["series"].nunique() == 4
+    # one panel of COMIC (a) and one of argmin shares (b), both schemes in each
+    assert data.groupby("panel")["scheme"].agg(set).to_dict() == {
+        "a": {"symmetric", "sequential"},
+        "b": {"symmetric", "sequential"},
+    }
+    assert data.groupby("series")["scheme"].nunique().eq(1).all() and data["series"].nunique() == 6
     figure, data = draw("tradeoff", cases)
     assert data.groupby("panel")["series"].nunique().eq(2).all()
     assert set(data["series"]) == {symmetric.label(n=False), sequential.label(n=False)}
@@ -281,8 +316,12 @@ def test_scheme_variants_are_two_series_in_fig9_and_tradeoff():
 def test_fig9_error_bars_are_comic_std_at_the_time_nearest_t_final():
     cases = paper_cases("fig9", ns=(30, 100, 300), extra=(ADDED,))
     comic = comic_table(cases)
-    figure, data = draw("fig9", cases, [comic])
-    assert [ax.get_title(loc="left")[:3] for ax in figure.axes if ax.get_visible()] == ["(a)", "(b)", "(c)", "(d)"]
+    argmin, minima = argmin_and_minima(comic)
+    figure, data = draw("fig9", cases, [comic, minima, argmin])
+    # three families: the paper's three, the added collision eta = 0.25 model its own panel; each
+    # COMIC panel has its argmin panel below
+    titles = sorted(ax.get_title(loc="left")[:3] for ax in figure.axes if ax.get_visible())
+    assert titles == [f"({c})" for c in "abcdefgh"]
     mean = data[data["y_name"] == "COMIC"]
     for case in cases:
         row = rows_of(comic, case).query("time == 20.0").iloc[0]
@@ -293,8 +332,23 @@ def test_fig9_error_bars_are_comic_std_at_the_time_nearest_t_final():
     for _, g in mean.groupby("panel"):
         assert g.loc[g["marked"], "y"].tolist() == [g["y"].min()]
     of_mean = data[data["y_name"] == "COMIC of mean SSE"]
-    assert set(mean["series"]) == {m.label(n=False) for m in {c.model for c in cases}}
+    assert set(mean["series"]) == {f"{m.label(n=False)}: mean COMIC" for m in {c.model for c in cases}}
     assert np.isneginf(of_mean["y_lo"]).all() and of_mean["y_std"].isna().all()
+
+
+def test_fig9_draws_the_argmin_shares_and_names_each_minimum_with_its_interval():
+    cases = paper_cases("fig9", ns=(30, 100, 300))
+    comic = comic_table(cases)
+    argmin, minima = argmin_and_minima(comic)
+    figure, data = draw("fig9", cases, [comic, minima, argmin])
+    bars = data[data["y_name"] == "share of resamples with this argmin"]
+    expected = argmin[argmin["time"] == 20.0]
+    merged = bars.merge(expected, on=["method", "kernel", "eta", "truncation", "dt_growth", "scheme", "n"])
+    assert len(merged) == len(bars) == len(expected) and np.allclose(merged["y"], merged["share"])
+    texts = [t.get_text() for ax in figure.axes for t in ax.texts]
+    for _, m in minima[minima["time"] == 20.0].iterrows():
+        lo, hi = int(m["n_opt_ci_lo"]), int(m["n_opt_ci_hi"])
+        assert f"N_opt {int(m['n_opt']):,}, 95% CI {lo:,}–{hi:,} (70%)" in texts
 
 
 def test_tradeoff_plots_rmse_against_wall_time_and_n_with_the_optimum_marked():

@@ -22,6 +22,7 @@ from particle_entropy.sweeps import (  # noqa: E402
     case_run_paths,
     check_sweeps,
     figure_ensembles,
+    mechanism_ensembles,
     run_path,
     run_settings,
     spec_ensembles,
@@ -60,9 +61,11 @@ def all_targets():
 
 
 def ensembles(section):
-    """The ensembles of a figure (fig1 ... fig9) or of `tradeoff`."""
+    """The ensembles of a figure (fig1 ... fig9), of `tradeoff` or of `mechanism`."""
     if section == "tradeoff":
         return spec_ensembles(config["tradeoff"], config) if "tradeoff" in config else []
+    if section == "mechanism":
+        return mechanism_ensembles(config)
     return figure_ensembles(config, section) if section in config["figures"] else []
 
 
@@ -71,8 +74,8 @@ def section_inputs(section):
     table or case summaries (sweeps.FIGURE_READS)."""
     reads = FIGURE_READS.get(section, "summaries")
     base = config["base_seed"]
-    if reads == "comic":
-        return [f"results/tables/{section}/comic.parquet"]
+    if reads == "comic":  # the COMIC table, its minima and the bootstrap argmin shares
+        return [f"results/tables/{section}/{t}.parquet" for t in ("comic", "comic_minima", "comic_argmin")]
     if reads == "tradeoff":
         return ["results/tables/tradeoff.parquet"]
     if reads in ("runs", "snapshots"):
@@ -92,6 +95,12 @@ def summary_runs(wildcards):
 
 def summaries_of(*sections):
     return [e.summary_path() for s in sections for e in ensembles(s)]
+
+
+def fd_report_times(count=20):
+    """Times of the FD domain experiment: count even steps to t_final, on the FD time grid."""
+    t_final, dt = float(config["physics"]["t_final"]), float(config["time"]["fd_dt"])
+    return [round(k * t_final / count / dt) * dt for k in range(1, count + 1)]
 
 
 def sim_mem_mb(wildcards):
@@ -121,3 +130,5 @@ CLAIMS_CODE = code_version("claims", "io", files=[SCRIPTS / "paper_claims.py"])
 PLOT_CODE = code_version("plots", "io", files=[SCRIPTS / "plot_figure.py"])
 SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
 SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])
+MECHANISM_PLOT_CODE = code_version("plots_mechanism", "io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
+FD_DOMAIN_CODE = code_version("fd_domain", "io", files=[SCRIPTS / "fd_domain.py"])

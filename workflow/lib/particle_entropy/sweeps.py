@@ -51,11 +51,20 @@ def run_path(case: Case, first: int, last: int | None = None, kind: str = "runs"
 
 
 def case_sections(config: Mapping) -> dict[str, Mapping]:
-    """Every config section that lists cases, by name: each figure, and `tradeoff`."""
+    """Every config section that lists cases, by name: each figure, `tradeoff`, and each sweep of
+    `mechanism` (the controlled experiments behind figures/fig9_mechanism.png)."""
     out = {f"figures.{fig}": spec for fig, spec in config.get("figures", {}).items()}
     if "tradeoff" in config:
         out["tradeoff"] = config["tradeoff"]
+    for i, spec in enumerate(config.get("mechanism", {}).get("sweeps", [])):
+        out[f"mechanism.sweeps[{i}]"] = spec
     return out
+
+
+def mechanism_ensembles(config: Mapping) -> list[Ensemble]:
+    """Every ensemble of the mechanism sweeps, each once (cases shared with Fig. 9 share its runs)."""
+    sweeps = config.get("mechanism", {}).get("sweeps", [])
+    return list(dict.fromkeys(e for spec in sweeps for e in spec_ensembles(spec, config)))
 
 
 def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:

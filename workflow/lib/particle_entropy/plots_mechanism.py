@@ -1,0 +1,258 @@
+"""figures/fig9_mechanism.png: why Fig. 9's minima differ between the paper's equations and the
+authors' algorithm, and why Fig. 8's fine grids turn up late; controlled experiments drawn.
+
+(a) mean COMIC +-1 std against N for the mechanism sweeps (same seeds, one change at a time);
+(b) SSE/N +-1 standard error against N, with the floor a kernel cut at k widths predicts: it
+    diffuses with D times the cut Gaussian's variance fraction (kernels.truncated_variance_fraction);
+(c) each variant's COMIC minus the equations' COMIC, realisation by realisation (same seeds),
+    mean +-1 standard error: a difference outside its error bar is an effect, not noise;
+(d) Fig. 8's ln(SSE/N) against time on the paper's FD domain and on a longer one (same dx).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from .case import Case, rows_of
+from .kernels import truncated_variance_fraction
+from .plots import GREY, Series, _look, _models, _n_ticks, _nearest, _no_data, draw, source_table, styles
+
+FIGURE = "fig9_mechanism"
+
+
+def truncation_floor(D: float, t: float, fraction: float, omega: float) -> float:
+    """SSE/N between N(0, 2Dt) and N(0, 2 fraction D t) sampled at uniform random points of a
+    domain Omega: (1/Omega) int (g - g')^2 dx, by the Gaussian product integral."""
+    a, b = 2.0 * D * t, 2.0 * fraction * D * t
+    cross = 1.0 / math.sqrt(2.0 * math.pi * (a + b))
+    return (1.0 / math.sqrt(4.0 * math.pi * a) + 1.0 / math.sqrt(4.0 * math.pi * b) - 2.0 * cross) / omega
+
+
+def _label(model: Case, equations: Case | None) -> str:
+    """A model by what it changes from the paper's equations."""
+    text = ", ".join(model.label(n=False).split(", ")[2:])
+    if model == equations:
+        return "paper's equations (whole Gaussian)" + (f", {text}" if text else "")
+    return text or model.label(n=False)
+
+
+def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final) -> list[Series]:
+    """Panel (a): mean COMIC +-1 std of every model; panel (b): SSE/N +-1 standard error."""
+    out = []
+    for model in models:
+        g = pd.concat([rows_of(comic, c) for c in cases if c.model == model])
+        if g.empty:
+            continue
+        g = _nearest(g, t_final).sort_values("n")
+        n = g["n"].to_numpy(float)
+        r = g["n_realisations"].to_numpy(int)
+        common = dict(
+            case=model,
+            x_name="N",
+            x=n,
+            n=n.astype(int),
+            time=g["time_step"].to_numpy(float),
+            n_realisations=r,
+            style=style[model],
+        )
+        mu = g["COMIC_mean"].to_numpy(float)
+        out.append(
+            Series(
+                "a",
+                f"{model.label(n=False)}: mean COMIC",
+                legend=_label(model, equations),
+                y_name="COMIC",
+                y=mu,
+                y_std=g["COMIC_std"].to_numpy(float),
+                kind="errorbar",
+                marked=mu == mu.min(),
+                **common,
+            )
+        )
+        sse = g["SSE_mean"].to_numpy(float) / n
+        se = g["SSE_std"].to_numpy(float) / n / np.sqrt(np.maximum(r, 1))
+        out.append(
+            Series(
+                "b",
+                f"{model.label(n=False)}: SSE/N",
+                legend=_label(model, equations),
+                y_name="SSE/N",
+                y=sse,
+                y_lo=sse - se,
+                y_hi=sse + se,
+                kind="errorbar",
+                **common,
+            )
+        )
+    return out
+
+
+def _paired_series(realisations: pd.DataFrame, models, style, equations, t_final) -> list[Series]:
+    """Panel (c): COMIC(model) - COMIC(equations) per seed and N, mean +-1 standard error."""
+    if equations is None or realisations.empty:
+        return []
+    at = _nearest(realisations, t_final)
+    base = rows_of(at, equations).set_index(["n", "seed"])["COMIC"]
+    out = []
+    for model in models:
+        if model == equations:
+            continue
+        mine = rows_of(at, model).set_index(["n", "seed"])["COMIC"]
+        diff = (mine - base).dropna()
+        if diff.empty:
+            continue
+        g = diff.groupby(level="n")
+        mean, std, count = g.mean(), g.std(ddof=1).fillna(0.0), g.size()
+        se = (std / np.sqrt(count)).to_numpy(float)
+        n = mean.index.to_numpy(float)
+        y = mean.to_numpy(float)
+        out.append(
+            Series(
+                "c",
+                f"{model.label(n=False)}: COMIC minus the equations' (same seeds)",
+                legend=_label(model, equations),
+                case=model,
+                x_name="N",
+                x=n,
+                n=n.astype(int),
+                y_name="paired COMIC difference",
+                y=y,
+                y_lo=y - se,
+                y_hi=y + se,
+                kind="errorbar",
+                n_realisations=count.to_numpy(int),
+                time=float(at["time"].iloc[0]),
+                style=style[model],
+            )
+        )
+    return out
+
+
+def _fd_series(fd: pd.DataFrame) -> list[Series]:
+    """Panel (d): ln(SSE/n) of each FD grid (n = the paper's grid label, dx = L_paper / n) against
+    time, on each domain length: solid the paper's, dashed the longer one."""
+    if fd.empty:
+        return []
+    lengths = sorted(fd["fd_length"].unique())
+    colours = ["#0072B2", "#009E73", "#D55E00", "#CC79A7", "#E69F00", "#56B4E9"]
+    out = []
+    for j, n in enumerate(sorted(fd["n"].unique())):
+        for k, length in enumerate(lengths):
+            g = fd[(fd["n"] == n) & (fd["fd_length"] == length)].sort_values("time")
+            line = "-" if k == 0 else ("--" if k == 1 else ":")
+            out.append(
+                Series(
+                    "d",
+                    f"FD N = {int(n):,}, domain length {length:g}",
+                    case=Case("fd", "implicit", int(n)),
+                    x_name="time",
+                    x=g["time"].to_numpy(float),
+                    y_name="ln(SSE/N)",
+                    y=np.log(g["SSE"].to_numpy(float) / n),
+                    n_realisations=1,
+                    time=g["time"].to_numpy(float),
+                    style={"color": colours[j % len(colours)], "linestyle": line, "marker": None},
+                )
+            )
+    return out
+
+
+def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float):
+    """The four panels (module docstring) -> (Figure, source data)."""
+    models = _models(cases)
+    style = styles("fig9", cases)
+    # the reference of panel (c): the first model with the paper's symmetric matrix and whole kernel
+    equations = next((m for m in models if m.scheme == "symmetric" and m.truncation is None), None)
+    fig = Figure(figsize=(12.5, 10.0), layout="constrained")
+    axes = list(fig.subplots(2, 2).ravel())
+    out = []
+    if comic.empty:
+        for ax in axes[:3]:
+            _no_data(ax, "mechanism COMIC table")
+    else:
+        main = _comic_series(comic, models, cases, style, equations, t_final)
+        paired = _paired_series(realisations, models, style, equations, t_final)
+        for s in main + paired:
+            draw(axes["abc".index(s.panel)], s)
+        out += main + paired
+        ns = np.concatenate([s.x for s in main]) if main else []
+        time = main[0].time[0] if main else t_final
+        _look(
+            axes[0],
+            "a",
+            f"COMIC at t = {time:g}, same seeds, one change at a time",
+            r"COMIC $= 2\ln(SSE/N) - \ln\Delta V$ (mean ± 1 std)",
+            xlabel="number of particles $N$",
+            legend=None,
+        )
+        _look(
+            axes[1],
+            "b",
+            "SSE/N: a cut kernel's error stops falling",
+            "SSE/N (mean ± 1 s.e.)",
+            xlabel="number of particles $N$",
+            logy=True,
+            legend=None,
+        )
+        cut = sorted({m.truncation for m in models if m.truncation is not None})
+        for k in cut:
+            fraction = truncated_variance_fraction(k)
+            floor = truncation_floor(D, time, fraction, omega)
+            axes[1].axhline(
+                floor,
+                color=GREY,
+                linestyle="--",
+                linewidth=1.0,
+                label=f"floor of D × {fraction:.4f} (cut at {k:g} widths)",
+            )
+            out.append(
+                Series(
+                    "b",
+                    f"predicted floor, kernel cut at {k:g} widths",
+                    None,
+                    x_name="N",
+                    x=np.array([min(ns), max(ns)], float),
+                    y_name="SSE/N",
+                    y=np.array([floor, floor]),
+                    time=time,
+                    style={"color": GREY, "linestyle": "--"},
+                )
+            )
+        _look(
+            axes[2],
+            "c",
+            "the same seeds: each change's own effect",
+            "COMIC − COMIC of the equations (mean ± 1 s.e.)",
+            xlabel="number of particles $N$",
+            legend=None,
+        )
+        axes[2].axhline(0.0, color="black", linewidth=0.8)
+        for ax in axes[:3]:
+            if len(ns):
+                _n_ticks(ax, ns)
+            ax.legend(loc="best", fontsize=7)
+    fd_series = _fd_series(fd)
+    for s in fd_series:
+        draw(axes[3], s)
+    out += fd_series
+    if fd_series:
+        _look(
+            axes[3],
+            "d",
+            "Fig. 8: FD error against time; zero ends at the domain edge",
+            r"$\ln(SSE/N)$, N = the paper's grid",
+            xlabel="time",
+            logx=False,
+            legend=None,
+        )
+        axes[3].plot([], [], color="0.3", linestyle="-", label=f"domain length {sorted(fd['fd_length'].unique())[0]:g}")
+        for k, length in enumerate(sorted(fd["fd_length"].unique())[1:], start=1):
+            axes[3].plot([], [], color="0.3", linestyle="--" if k == 1 else ":", label=f"domain length {length:g}")
+        axes[3].legend(loc="best", fontsize=7, ncol=2)
+    else:
+        _no_data(axes[3], "FD domain experiment")
+    return fig, source_table(FIGURE, out)

@@ -1,0 +1,67 @@
+# figures/fig9_mechanism.png: the controlled experiments behind Fig. 9's minima and Fig. 8's late
+# error (config `mechanism`). Its own target: `snakemake -j2 figures/fig9_mechanism.png`.
+
+if "mechanism" in config:
+
+    rule comic_tables_mechanism:
+        """COMIC tables of the mechanism sweeps (the same tables as Fig. 9's)."""
+        input:
+            summaries=summaries_of("mechanism"),
+            runs=runs_of("mechanism"),
+        output:
+            comic="results/tables/mechanism/comic.parquet",
+            minima="results/tables/mechanism/comic_minima.parquet",
+            realisations="results/tables/mechanism/comic_realisations.parquet",
+            argmin="results/tables/mechanism/comic_argmin.parquet",
+        log:
+            "logs/comic_tables_mechanism.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        params:
+            times=config["comic_times"],
+            code=COMIC_CODE,
+        script:
+            "../scripts/comic_tables.py"
+
+    rule fd_domain:
+        """Fig. 8's FD grids on the paper's domain and on longer ones, at the same dx."""
+        output:
+            "results/tables/mechanism/fd_domain.parquet",
+        log:
+            "logs/fd_domain.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        params:
+            n=config["mechanism"].get("fd_domain", {}).get("n", []),
+            lengths=config["mechanism"].get("fd_domain", {}).get("lengths", []),
+            fd_dt=config["time"]["fd_dt"],
+            times=fd_report_times(),
+            D=config["physics"]["D"],
+            ref_length=config["physics"]["fd_length"],
+            code=FD_DOMAIN_CODE,
+        script:
+            "../scripts/fd_domain.py"
+
+    rule plot_fig9_mechanism:
+        input:
+            comic="results/tables/mechanism/comic.parquet",
+            realisations="results/tables/mechanism/comic_realisations.parquet",
+            fd="results/tables/mechanism/fd_domain.parquet" if "fd_domain" in config["mechanism"] else [],
+        output:
+            png=report("figures/fig9_mechanism.png", caption="../report/fig9_mechanism.rst", category="Mechanism"),
+            pdf="figures/fig9_mechanism.pdf",
+            data=FIGURE_DATA_PATTERN.format(fig="fig9_mechanism"),
+        log:
+            "logs/plot/fig9_mechanism.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        resources:
+            mem_mb=1000,
+        params:
+            cases=section_cases("mechanism"),
+            D=config["physics"]["D"],
+            t_final=config["physics"]["t_final"],
+            omega=config["physics"]["omega"],
+            code=MECHANISM_PLOT_CODE,
+        script:
+            "../scripts/plot_fig9_mechanism.py"

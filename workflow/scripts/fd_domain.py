@@ -1,0 +1,15 @@
+"""Fig. 8's late error: implicit FD on the paper's domain and on longer ones at the same dx."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+from particle_entropy.fd_domain import comic_optimum, domain_experiment  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
+
+par = snakemake.params  # noqa: F821
+table = domain_experiment(
+    n_list=par.n, fd_lengths=par.lengths, fd_dts=(par.fd_dt,), times=par.times, D=par.D, ref_length=par.ref_length
+)
+write_parquet(table, snakemake.output[0])  # noqa: F821
+print(comic_optimum(table).to_string(), file=sys.stderr)

@@ -1,0 +1,31 @@
+"""Draw figures/fig9_mechanism.png from the mechanism COMIC tables and the FD domain experiment."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+
+import pandas as pd  # noqa: E402
+
+from particle_entropy.case import Case  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.plots import save_figure  # noqa: E402
+from particle_entropy.plots_mechanism import fig9_mechanism  # noqa: E402
+
+inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
+cases = [Case.from_wildcards(c) for c in par.cases]
+figure, data = fig9_mechanism(
+    pd.read_parquet(inp.comic),
+    pd.read_parquet(inp.realisations),
+    pd.read_parquet(inp.fd) if inp.fd else pd.DataFrame(),
+    cases,
+    D=float(par.D),
+    t_final=float(par.t_final),
+    omega=float(par.omega),
+)
+save_figure(figure, out.png, out.pdf)
+write_parquet(data, out.data)
+print(f"drew fig9_mechanism: {len(cases)} cases, {len(data)} plotted points", file=sys.stderr)
