@@ -111,16 +111,14 @@ def test_fd_gets_one_realisation():
 
 def test_shipped_fig9_expands_to_the_realisations_table():
     ens = figure_ensembles(SHIPPED, "fig9")
-    # config.yaml: 3 cases x 7 N; counts 80, 80, 60, 50, 20, 6, 4 for N = 30 ... 30000
+    # config.yaml: 6 cases (3 models x 2 schemes) x 7 N; counts 80, 80, 60, 50, 20, 6, 4 for N = 30 ... 30000
     counts = {30: 80, 100: 80, 300: 60, 1000: 50, 3000: 20, 10000: 6, 30000: 4}
-    assert len(ens) == 21
+    assert len(ens) == 42
     for e in ens:
         assert e.realisations == counts[e.case.n]
-    assert {e.case.model for e in ens} == {
-        Case("mtpt", "collision"),
-        Case("mtpt", "sph"),
-        Case("mtpt", "collision", eta=0.5),
-    }
+    paper = [Case("mtpt", "collision"), Case("mtpt", "sph"), Case("mtpt", "collision", eta=0.5)]
+    authors = [Case(m.method, m.kernel, eta=m.eta, truncation=3, scheme="sequential") for m in paper]
+    assert {e.case.model for e in ens} == {*paper, *authors}
 
 
 def test_shipped_fig3_is_capped_at_20():
@@ -147,8 +145,35 @@ def test_spec_ensembles_take_case_defaults_where_they_apply():
 
 
 def test_case_sections_of_the_shipped_config():
-    assert list(case_sections(SHIPPED)) == [f"figures.fig{k}" for k in range(1, 10)] + ["tradeoff"]
+    assert list(case_sections(SHIPPED)) == [f"figures.fig{k}" for k in range(1, 10)] + ["tradeoff"] + [
+        f"mechanism.sweeps[{i}]" for i in range(3)
+    ]
     assert "tradeoff" not in case_sections({"figures": {}})
+
+
+def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
+    from particle_entropy.sweeps import mechanism_ensembles
+
+    mech = set(mechanism_ensembles(SHIPPED))
+    fig9 = set(figure_ensembles(SHIPPED, "fig9"))
+    shared = mech & fig9
+    # from N = 3,000 the same ensembles (same summaries); below, the mechanism's 20 seeds are the
+    # first blocks of Fig. 9's larger ensemble: no run of the equations or the authors' loop is extra
+    assert {(e.case.scheme, e.case.n) for e in shared} == {
+        (s, n) for s in ("symmetric", "sequential") for n in (3000, 10000, 30000)
+    }
+    fig9_runs = {p for e in fig9 for p in case_run_paths(e, SHIPPED)}
+    for e in mech:
+        if e.case.model in {f.case.model for f in fig9} and e.case.n <= 30000:
+            assert set(case_run_paths(e, SHIPPED)) <= fig9_runs, e
+    assert {e.case.n for e in mech - fig9} >= {100000, 300000}
+
+
+def test_check_sweeps_refuses_a_bad_mechanism_case():
+    config = copy.deepcopy(TINY)
+    config["mechanism"]["sweeps"][0]["cases"].append({"method": "mtpt", "kernel": "collision", "scheme": "compensated"})
+    msg = _refused(config)
+    assert "mechanism.sweeps[0].cases[4].scheme" in msg and "needs a truncation" in msg
 
 
 # --------------------------------------------------------------------------- run settings

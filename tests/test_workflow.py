@@ -362,6 +362,29 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
         assert claims["claim"].str.startswith(m.label() + ": COMIC minimum").sum() == 2, m.label()
 
 
+def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run):
+    cfg = load(TINY)
+    proc = snakemake(tiny_run, "-n", "figures/fig9_mechanism.png", configfile=TINY)
+    planned = [e for e in re.findall(r"wildcards: (.*)", proc.stdout) if "scheme=" in e]
+    # the equations and the sequential loop are Fig. 9's cases: already run, never planned again
+    assert planned and not any("trunc=none" in e and "scheme=symmetric" in e for e in planned)
+    assert not any("scheme=sequential," in e or e.endswith("scheme=sequential") for e in planned)
+    snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+    assert (tiny_run / "figures/fig9_mechanism.png").stat().st_size > 5000
+    data = pd.read_parquet(tiny_run / "results/figures/fig9_mechanism.parquet")
+    assert set(data["panel"]) == set("abcd")
+    # (c): each variant minus the equations at the same seeds, from the per-seed table
+    real = pd.read_parquet(tiny_run / "results/tables/mechanism/comic_realisations.parquet")
+    real = real[real["time"] == real["time"].max()]
+    base = Case.from_spec({"method": "mtpt", "kernel": "collision", "eta": 1}, None, cfg["case_defaults"])
+    cut = replace(base, truncation=3.0)
+    diff = rows_of(real, cut).set_index(["n", "seed"])["COMIC"] - rows_of(real, base).set_index(["n", "seed"])["COMIC"]
+    drawn = rows_of(data[data["panel"] == "c"], cut).sort_values("x")
+    np.testing.assert_allclose(drawn["y"].to_numpy(), diff.groupby(level="n").mean().to_numpy())
+    fd = data[data["panel"] == "d"]
+    assert fd["series"].str.contains("domain length 24").any() and fd["series"].str.contains("domain length 12").any()
+
+
 def test_sequential_scheme_runs_the_authors_loop(tiny_run):
     runs = list(
         (tiny_run / "results/runs/mtpt/collision").glob("n~100/eta~1/trunc~3/growth~*/scheme~sequential/*.parquet")
