@@ -107,7 +107,7 @@ def test_truncated_variant_gets_its_own_claim_rows():
     assert all(COLL1_T3.label() in k for k in variant)
     assert all(paper.values()) and not any(variant.values())
     assert {c["reproduced"] for c in claims if "truncation 3" in c["claim"]} == {
-        "the equations give 300 (one realisation per N: nothing to resample)"
+        "this variant gives 300 (one realisation per N: nothing to resample)"  # a cut kernel is not the equations
     }
 
 
@@ -128,9 +128,11 @@ def test_fig9_rows_name_the_scheme_and_give_the_bootstrap_interval():
     assert len(claims) == 4
     for c in claims:
         scheme = "sequential" if "sequential" in c["claim"] else "symmetric"
-        words = "sequential scheme, the authors' MATLAB loop" if scheme == "sequential" else "Eqs. 16-21"
+        words = "the authors' sequential loop, kernel cut at 3 widths" if scheme == "sequential" else "Eqs. 16-21"
         assert words in c["claim"], c["claim"]
-        assert c["reproduced"].startswith("the loop gives" if scheme == "sequential" else "the equations give")
+        assert c["reproduced"].startswith(
+            "the authors' algorithm gives" if scheme == "sequential" else "the equations give"
+        )
         if "mean of COMIC" in c["claim"]:
             assert c["reproduced"].endswith("3000 (95% CI 1000-3000; argmin in 81% of 2000 resamples)")
         else:
@@ -175,7 +177,7 @@ def test_sph_flat_when_every_n_above_100_overlaps_the_minimum_and_not_when_one_i
     assert f["passed"] is True and s["passed"] is False
     assert "0.99 combined std, at N=1000" in f["reproduced"] and "N_opt=300" in f["reproduced"]
     assert "3.00 combined std, at N=1000" in s["reproduced"]
-    assert "N >= 100" in f["claim"] and "symmetric scheme" in f["claim"]
+    assert "N >= 100" in f["claim"] and "the paper's Eqs. 16-21, whole Gaussian" in f["claim"]
 
 
 def test_sph_flatness_ignores_n_below_the_threshold_but_not_a_lower_minimum_there():

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from .case import Case, by_model, case_of_table
+from .registry import SCHEME_DOCS
 
 
 def _near(df: pd.DataFrame, t: float) -> pd.Series:
@@ -152,17 +153,16 @@ def ensemble_claims(summaries: list[pd.DataFrame], tol_hc: float, defaults: dict
     return out
 
 
-# How each scheme's Fig. 9 rows are worded: the paper's figure came from the authors' MATLAB
-# loop; the symmetric scheme is what the paper's equations give. Other schemes: their name.
-SCHEME_WORDS = {
-    "symmetric": "symmetric scheme, the paper's Eqs. 16-21",
-    "sequential": "sequential scheme, the authors' MATLAB loop",
-}
-FIG9_SOURCE = {"symmetric": "the equations give", "sequential": "the loop gives"}
-
-
-def _scheme_words(scheme: str) -> str:
-    return SCHEME_WORDS.get(scheme, f"{scheme} scheme")
+def _model_words(model: Case) -> tuple[str, str]:
+    """How a Fig. 9 row names its model, and the verb phrase of its result: the paper's figure
+    came from the authors' loop (kernel cut at 3 widths); the paper's equations are the symmetric
+    matrix with the whole Gaussian (Eqs. 16-21); other models by their scheme (registry.SCHEME_DOCS)."""
+    cut = f", kernel cut at {model.truncation:g} widths" if model.truncation is not None else ""
+    if model.scheme == "symmetric" and model.truncation is None:
+        return "the paper's Eqs. 16-21, whole Gaussian", "the equations give"
+    if model.scheme == "sequential":
+        return f"the authors' sequential loop{cut}", "the authors' algorithm gives"
+    return f"{SCHEME_DOCS[model.scheme]}{cut}", "this variant gives"
 
 
 def _optimum_text(row: pd.Series, prefix: str) -> str:
@@ -235,9 +235,9 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
                 n_opt = int(row[col])
                 out.append(
                     _claim(
-                        f"{model.label()}: COMIC minimum at t = {row['time']:g} ({how}; {_scheme_words(model.scheme)})",
+                        f"{model.label()}: COMIC minimum at t = {row['time']:g} ({how}; {_model_words(model)[0]})",
                         f"{paper}, the authors' code",
-                        f"{FIG9_SOURCE.get(model.scheme, 'this scheme gives')} {_optimum_text(row, col)}",
+                        f"{_model_words(model)[1]} {_optimum_text(row, col)}",
                         f"N_opt in [{lo}, {hi}]",
                         lo <= n_opt <= hi,
                     )
@@ -248,7 +248,7 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
         f = flatness(sph, min_n)
         out.append(
             _claim(
-                f"{model.label()}: COMIC roughly flat for N >= {min_n} ({_scheme_words(model.scheme)})",
+                f"{model.label()}: COMIC roughly flat for N >= {min_n} ({_model_words(model)[0]})",
                 "flat, worse only for N < 100",
                 f"largest distance from the minimum {f['ratio']:.2f} combined std, at N={f['n_worst']} "
                 f"(N_opt={f['n_opt']}, t = {sph['time'].iloc[0]:g})",
