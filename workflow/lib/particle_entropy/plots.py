@@ -57,7 +57,7 @@ PNG_META = {"Software": None}
 PDF_META = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
 
 SOURCE_COLUMNS = {
-    "figure": "figure name: fig1 ... fig9 or tradeoff",
+    "figure": "figure name: fig1 ... fig9, tradeoff or fig9_mechanism",
     "panel": "panel letter as printed ('' for a one-panel figure)",
     "series": "name of the series, unique within a panel: its legend label, except in fig7 (whose legend adds "
     "a line of statistics) and fig9 (the model's label, which is the panel title, then the quantity)",

@@ -34,7 +34,9 @@ Variants for the controlled experiments (registry.SCHEMES) each change one detai
 - ``noclip``: no clipping.
 
 r_i is built during the sweep. When i is visited, every neighbour stored before i has already
-been visited and has added its W to i's sum, so each pair's kernel is evaluated once. The random
+been visited and has added its W to i's sum, so each pair's kernel is evaluated once. A visited
+particle never changes again within the step, so the sweep keeps the unvisited ones in compact
+arrays in position order, and each window holds almost only partners. The random
 permutations come from a SplitMix64 stream that is seeded for each step from the run's numpy
 Generator.
 """
@@ -92,13 +94,16 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     where = np.empty(n, np.int64)  # sorted index of the particle stored at i
     for p in range(n):
         where[label[p]] = p
-    r_full = _row_sums(x, radius, inv2s2) if symnorm else np.zeros(0)
-    r_acc = np.zeros(n)  # W summed from the neighbours visited so far
-    # particles not yet visited, in position order, rebuilt every `chunk` visits so that windows
-    # hold few visited particles: their positions, sorted indices and labels
+    r_full = _row_sums(x, radius, inv2s2) if symnorm else np.zeros(n)
+    # The particles not yet visited, in position order: positions, sorted indices, labels, masses,
+    # row sums so far (and whole row sums). Only they exchange mass from here on: a visited
+    # particle is final, written back when the arrays are compacted every `chunk` visits.
     xs = x.copy()
     ps = np.arange(n)
     ls = label.copy()
+    ms = m.copy()
+    rs = np.zeros(n)
+    rf = r_full.copy()
     left = n
     chunk = max(64, n // 32)
     part = np.empty(n, np.int64)
@@ -113,12 +118,19 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
                     xs[k2] = xs[k]
                     ps[k2] = ps[k]
                     ls[k2] = ls[k]
+                    ms[k2] = ms[k]
+                    rs[k2] = rs[k]
+                    rf[k2] = rf[k]
                     k2 += 1
+                else:
+                    m[ps[k]] = ms[k]
             left = k2
-        p = where[i]
-        xp = x[p]
+        xp = x[where[i]]
         lo = np.searchsorted(xs[:left], xp - radius, side="left")
         hi = np.searchsorted(xs[:left], xp + radius, side="right")
+        me = np.searchsorted(xs[:left], xp, side="left")  # i itself
+        while ls[me] != i:
+            me += 1
         cnt = 0
         for k in range(lo, hi):  # partners: later in storage (branch-free compaction)
             d = xp - xs[k]
@@ -130,19 +142,17 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
         _kernel(u, c, cnt)
         s = 0.0
         for k in range(cnt):
-            q = ps[part[k]]
-            part[k] = q
             s += c[k]
-            r_acc[q] += c[k]
-        inv_r = 1.0 / (r_full[p] if symnorm else r_acc[p] + 1.0 + s)
+            rs[part[k]] += c[k]
+        inv_r = 1.0 / (rf[me] if symnorm else rs[me] + 1.0 + s)
         if symnorm:  # c = beta W_ij / r_i (symnorm: the mean of 1/r_i and 1/r_j)
             for k in range(cnt):
-                c[k] *= beta * 0.5 * (inv_r + 1.0 / r_full[part[k]])
+                c[k] *= beta * 0.5 * (inv_r + 1.0 / rf[part[k]])
         else:
             b = beta * inv_r
             for k in range(cnt):
                 c[k] *= b
-        mi = m[p]
+        mi = ms[me]
         z = np.uint64(0)
         for k in range(cnt):
             # Fisher-Yates as we go: the k-th partner is uniform among those left; 32 random
@@ -157,15 +167,17 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
             cj = c[j]
             part[j] = part[k]
             c[j] = c[k]
-            mj = m[q]
+            mj = ms[q]
             dm = cj * (mi - mj)  # beta (m_i - m_j) W_ij / r_i
             if clip:
                 mi = max(0.0, mi - dm)
-                m[q] = max(0.0, mj + dm)
+                ms[q] = max(0.0, mj + dm)
             else:
                 mi = mi - dm
-                m[q] = mj + dm
-        m[p] = mi
+                ms[q] = mj + dm
+        ms[me] = mi
+    for k in range(left):
+        m[ps[k]] = ms[k]
     return m
 
 
