@@ -25,6 +25,15 @@ RW_entropy_ens_GSM_COMIC.m), checked line by line against that script and implem
 9. Time loop. The clock advances by dt before the step, and the loop runs while t < t_final;
    dt grows by 1.05 after each step. With dt0 = 0.01 and t_final = 1000 it ends after 175
    steps at t = 1021.1 (timegrid.time_steps with grid "authors").
+10. Details kept as the paper has them (each a small difference): the script's SPH constant is
+   0.822 where Eq. 26 has 0.82 (0.24 % in h, 0.5 % in beta), and both kernels' lines are in the
+   script, the SPH ones overriding the collision ones (one is commented in or out by hand).
+11. Error and COMIC. The script's SSE is sum_i (g_i - m_i/dV)^2 / N with g the Gaussian at the
+   particles normalised so that sum_i g_i dV = 1 (measures.sse over N, the same). Its Fig. 9
+   is the COMIC of the ensemble-mean SSE at the last step, 2 ln(mean SSE/N) - ln(Omega/N), with
+   error bars ln(mean +- std) - ln(mean) of the SSE: not doubled, so on the COMIC scale they are
+   half the +-1 std of the SSE (aggregate.comic_of_mean_sse draws them doubled); its variance is
+   a running estimate, not the sample variance.
 
 Variants for the controlled experiments (registry.SCHEMES) each change one detail:
 - ``sorted``: visit particles left to right, partners to the right only (storage = position
