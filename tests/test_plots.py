@@ -329,8 +329,9 @@ def test_fig9_error_bars_are_comic_std_at_the_time_nearest_t_final():
         assert got["y"] == row["COMIC_mean"] and got["y_std"] == row["COMIC_std"]
         assert got["y_hi"] == pytest.approx(row["COMIC_mean"] + row["COMIC_std"])
         assert got["time"] == pytest.approx(19.9)
-    for _, g in mean.groupby("panel"):
+    for _, g in mean.groupby(["panel", "series"]):  # each model's own minimum, several models a panel
         assert g.loc[g["marked"], "y"].tolist() == [g["y"].min()]
+    assert mean.groupby("panel")["series"].nunique().max() == 2  # the equations beside the authors' loop
     of_mean = data[data["y_name"] == "COMIC of mean SSE"]
     assert set(mean["series"]) == {f"{m.label(n=False)}: mean COMIC" for m in {c.model for c in cases}}
     assert np.isneginf(of_mean["y_lo"]).all() and of_mean["y_std"].isna().all()
