@@ -22,6 +22,7 @@ from particle_entropy.sweeps import (  # noqa: E402
     case_run_paths,
     check_sweeps,
     figure_ensembles,
+    lattice_cases,
     mechanism_ensembles,
     run_path,
     run_settings,
@@ -132,3 +133,4 @@ SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
 SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])
 MECHANISM_PLOT_CODE = code_version("plots_mechanism", "io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
 FD_DOMAIN_CODE = code_version("fd_domain", "io", files=[SCRIPTS / "fd_domain.py"])
+LATTICE_CODE = code_version("lattice", "io", files=[SCRIPTS / "mechanism_floors.py"])

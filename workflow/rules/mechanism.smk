@@ -47,6 +47,7 @@ if "mechanism" in config:
             comic="results/tables/mechanism/comic.parquet",
             realisations="results/tables/mechanism/comic_realisations.parquet",
             fd="results/tables/mechanism/fd_domain.parquet" if "fd_domain" in config["mechanism"] else [],
+            floors="results/tables/mechanism/floors.parquet" if "lattice" in config["mechanism"] else [],
         output:
             png=report("figures/fig9_mechanism.png", caption="../report/fig9_mechanism.rst", category="Mechanism"),
             pdf="figures/fig9_mechanism.pdf",
@@ -65,3 +66,18 @@ if "mechanism" in config:
             code=MECHANISM_PLOT_CODE,
         script:
             "../scripts/plot_fig9_mechanism.py"
+
+    rule mechanism_floors:
+        """The mechanism models on evenly spaced particles: SSE floors without sampling noise."""
+        output:
+            "results/tables/mechanism/floors.parquet",
+        log:
+            "logs/mechanism_floors.log",
+        conda:
+            "../../envs/particle-entropy.yaml"
+        params:
+            runs=[{"case": c.wildcards(), "settings": run_settings(c, config)} for c in lattice_cases(config)],
+            times=config["comic_times"],
+            code=LATTICE_CODE,
+        script:
+            "../scripts/mechanism_floors.py"

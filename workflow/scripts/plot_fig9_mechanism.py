@@ -25,6 +25,7 @@ figure, data = fig9_mechanism(
     D=float(par.D),
     t_final=float(par.t_final),
     omega=float(par.omega),
+    floors=pd.read_parquet(inp.floors) if inp.floors else None,
 )
 save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)

@@ -2,8 +2,10 @@
 authors' algorithm, and why Fig. 8's fine grids turn up late; controlled experiments drawn.
 
 (a) mean COMIC +-1 std against N for the mechanism sweeps (same seeds, one change at a time);
-(b) SSE/N +-1 standard error against N, with the floor a kernel cut at k widths predicts: it
-    diffuses with D times the cut Gaussian's variance fraction (kernels.truncated_variance_fraction);
+(b) SSE/N +-1 standard error against N, with each model's noise-free floor f (its run on evenly
+    spaced particles, lattice.py) and the N* = a / f where the sampling error a / N meets it,
+    COMIC's minimum for SSE/N = a/N + f; grey, the floor the cut kernel's variance deficit alone
+    would give (D times kernels.truncated_variance_fraction);
 (c) each variant's COMIC minus the equations' COMIC, realisation by realisation (same seeds),
     mean +-1 standard error: a difference outside its error bar is an effect, not noise;
 (d) Fig. 8's ln(SSE/N) against time on the paper's FD domain and on a longer one (same dx).
@@ -91,6 +93,47 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
     return out
 
 
+def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, style, t_final, ns) -> list[Series]:
+    """Panel (b): each model's lattice floor f as a line across the N drawn, labelled with
+    N* = a / f, a the median of (SSE/N - f) N over its N <= 3000 (where sampling error dominates)."""
+    if floors.empty or not len(ns):
+        return []
+    at = _nearest(floors, t_final)
+    out = []
+    lattice_models = list(dict.fromkeys(Case.from_row(r).model for _, r in at.iterrows()))
+    for model in lattice_models:
+        f = float(rows_of(at, model)["SSE_over_N"].iloc[0])
+        text = f"{_label(model, None)}: floor {f:.2g}"
+        if model in models and not comic.empty:
+            g = _nearest(pd.concat([rows_of(comic, c) for c in cases if c.model == model]), t_final)
+            small = g[g["n"] <= 3000]
+            if len(small):
+                a = float(np.median((small["SSE_mean"] / small["n"] - f) * small["n"]))
+                text += f", N* = a/floor ≈ {a / f:,.0f}"
+        st = style.get(model, {"color": GREY})
+        out.append(
+            Series(
+                "b",
+                f"{model.label(n=False)}: lattice floor",
+                legend=text,
+                case=model,
+                x_name="N",
+                x=np.array([min(ns), max(ns)], float),
+                y_name="SSE/N",
+                y=np.array([f, f]),
+                time=float(at["time_step"].iloc[0]),
+                n_realisations=1,
+                style={
+                    "color": st.get("color", GREY),
+                    "linestyle": (0, (5, 3)) if model in models else "-.",
+                    "linewidth": 1.0,
+                    "marker": None,
+                },
+            )
+        )
+    return out
+
+
 def _paired_series(realisations: pd.DataFrame, models, style, equations, t_final) -> list[Series]:
     """Panel (c): COMIC(model) - COMIC(equations) per seed and N, mean +-1 standard error."""
     if equations is None or realisations.empty:
@@ -161,7 +204,7 @@ def _fd_series(fd: pd.DataFrame) -> list[Series]:
     return out
 
 
-def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float):
+def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float, floors=None):
     """The four panels (module docstring) -> (Figure, source data)."""
     models = _models(cases)
     style = styles("fig9", cases)

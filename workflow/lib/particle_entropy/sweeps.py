@@ -67,6 +67,40 @@ def mechanism_ensembles(config: Mapping) -> list[Ensemble]:
     return list(dict.fromkeys(e for spec in sweeps for e in spec_ensembles(spec, config)))
 
 
+def lattice_cases(config: Mapping) -> list[Case]:
+    """The cases of the noise-free floors (lattice.py): every mechanism model and the extra
+    `mechanism.lattice.cases`, at N = `mechanism.lattice.n`, each once."""
+    mech = config.get("mechanism", {})
+    if "lattice" not in mech:
+        return []
+    n = int(mech["lattice"]["n"])
+    models = [e.case.model for e in mechanism_ensembles(config)]
+    defaults = config.get("case_defaults", {})
+    models += [Case.from_spec(c, None, defaults) for c in mech["lattice"].get("cases", [])]
+    return [m.at(n) for m in dict.fromkeys(models)]
+
+
+def check_lattice(config: Mapping) -> None:
+    """A lattice run needs an odd N and mtpt cases at eta = 1 (random walks leave the lattice)."""
+    mech = config.get("mechanism", {})
+    if "lattice" not in mech:
+        return
+    n = mech["lattice"]["n"]
+    if int(n) % 2 == 0:
+        raise SettingError("mechanism.lattice.n", n, "an odd integer >= 3, so that a particle sits at x = 0")
+    for i, spec in enumerate(mech["lattice"].get("cases", [])):
+        try:
+            case = Case.from_spec(spec, int(n), config.get("case_defaults", {}))
+            run_config(case, config)
+        except SettingError as e:
+            raise SettingError(f"mechanism.lattice.cases[{i}].{e.name}", e.value, e.allowed) from None
+    for case in lattice_cases(config):
+        if case.method != "mtpt" or case.eta != 1.0:
+            raise SettingError(
+                "mechanism.lattice", case.label(), "mtpt cases at eta = 1 only (random walks would leave the lattice)"
+            )
+
+
 def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
     """Realisations of one N in a section: an integer, or the `realisations` table (capped)."""
     r = spec.get("realisations", 1)
@@ -151,6 +185,7 @@ def check_sweeps(config: Mapping) -> None:
                 realisations_for(spec, int(n), config)
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
+    check_lattice(config)
     t_final = float(config["physics"]["t_final"])
     for key, times in (
         ("comic_times", config.get("comic_times", [])),

@@ -1,0 +1,20 @@
+"""Noise-free SSE floors: each mechanism model run on evenly spaced particles."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+import pandas as pd  # noqa: E402
+
+from particle_entropy.case import Case  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.lattice import lattice_run  # noqa: E402
+from particle_entropy.runconfig import RunConfig  # noqa: E402
+
+par = snakemake.params  # noqa: F821
+rows = []
+for run in par.runs:
+    case = Case.from_wildcards(run["case"])
+    rows += lattice_run(RunConfig.for_case(case, **run["settings"]), [float(t) for t in par.times])
+    print(f"{case.label()}: SSE/N {rows[-1]['SSE_over_N']:.4g} at t = {rows[-1]['time_step']:g}", file=sys.stderr)
+write_parquet(pd.DataFrame(rows), snakemake.output[0])  # noqa: F821
