@@ -293,3 +293,17 @@ def test_a_case_listed_twice_is_one_ensemble():
     cases = cfg["figures"]["fig9"]["cases"]
     cases.append({**cases[0], "eta": 1.0, "scheme": "symmetric"})  # the first case again, written another way
     assert len(figure_ensembles(cfg, "fig9")) == len(figure_ensembles(TINY, "fig9"))
+
+
+def test_lattice_cases_and_their_checks():
+    from particle_entropy.sweeps import lattice_cases
+
+    cases = lattice_cases(SHIPPED)
+    assert {c.n for c in cases} == {3001} and all(c.eta == 1.0 and c.method == "mtpt" for c in cases)
+    assert any(c.dt_growth == 1.01 for c in cases) and len(cases) == len(set(cases))
+    config = copy.deepcopy(TINY)
+    config["mechanism"]["lattice"]["n"] = 60
+    assert "mechanism.lattice.n" in _refused(config)
+    config = copy.deepcopy(TINY)
+    config["mechanism"]["lattice"]["cases"].append({"method": "mtpt", "kernel": "collision", "eta": 0.5})
+    assert "eta = 1 only" in _refused(config)
