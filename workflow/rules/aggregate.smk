@@ -20,11 +20,6 @@ rule summarise_case:
         Path(log[0]).write_text(f"summarised {count} realisations\n")
 
 
-def runs_of(*sections):
-    """The run tables behind the ensembles of these sections (per-realisation values), each once."""
-    return list(dict.fromkeys(p for s in sections for e in ensembles(s) for p in case_run_paths(e, config)))
-
-
 rule comic_tables:
     """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
     per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each

@@ -104,6 +104,11 @@ def fd_report_times(count=20):
     return [round(k * t_final / count / dt) * dt for k in range(1, count + 1)]
 
 
+def runs_of(*sections):
+    """The run tables behind the ensembles of these sections (per-realisation values), each once."""
+    return list(dict.fromkeys(p for s in sections for e in ensembles(s) for p in case_run_paths(e, config)))
+
+
 def sim_mem_mb(wildcards):
     return 300 + int(wildcards.n) // 20
 

@@ -95,7 +95,8 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
 
 def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, style, t_final, ns) -> list[Series]:
     """Panel (b): each model's lattice floor f as a line across the N drawn, labelled with
-    N* = a / f, a the median of (SSE/N - f) N over its N <= 3000 (where sampling error dominates)."""
+    N* = a / f, a the median of (SSE/N - f) N over its N from 1,000 to 10,000 (where the sampling
+    error behaves as a / N; below, the kernel is not resolved and it falls faster)."""
     if floors.empty or not len(ns):
         return []
     at = _nearest(floors, t_final)
@@ -106,7 +107,7 @@ def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, styl
         text = f"{_label(model, None)}: floor {f:.2g}"
         if model in models and not comic.empty:
             g = _nearest(pd.concat([rows_of(comic, c) for c in cases if c.model == model]), t_final)
-            small = g[g["n"] <= 3000]
+            small = g[(g["n"] >= 1000) & (g["n"] <= 10000)]
             if len(small):
                 a = float(np.median((small["SSE_mean"] / small["n"] - f) * small["n"]))
                 text += f", N* = a/floor ≈ {a / f:,.0f}"
