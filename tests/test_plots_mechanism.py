@@ -89,3 +89,38 @@ def test_sse_panel_uses_standard_errors_and_the_fd_panel_ln_sse_over_n():
     assert set(d["series"]) == {"FD N = 100, domain length 12", "FD N = 100, domain length 24"}
     short = d[d["series"].str.endswith("12")]
     np.testing.assert_allclose(short["y"], np.log(2e-3 * short["x"].to_numpy() / 100))
+
+
+def test_floors_are_drawn_with_n_star_where_sampling_error_meets_them():
+    rows, floors = [], []
+    for model, f in ((EQUATIONS, 1e-6), (CUT, 8e-6)):
+        for n in (1000, 3000):
+            # SSE/N = a / N + f with a = 0.04: the figure's N* must be a / f
+            rows.append(
+                {
+                    **model.at(n).columns(),
+                    "time": 20.0,
+                    "time_step": 19.9,
+                    "COMIC_mean": -10.0,
+                    "COMIC_std": 0.1,
+                    "SSE_mean": (0.04 / n + f) * n,
+                    "SSE_std": 0.0,
+                    "n_realisations": 5,
+                }
+            )
+        floors.append({**model.at(3001).columns(), "time": 20.0, "time_step": 19.9, "SSE_over_N": f})
+    cases = [m.at(n) for m in (EQUATIONS, CUT) for n in (1000, 3000)]
+    figure, data = fig9_mechanism(
+        pd.DataFrame(rows),
+        pd.DataFrame(),
+        pd.DataFrame(),
+        cases,
+        D=1e-3,
+        t_final=20.0,
+        omega=10.0,
+        floors=pd.DataFrame(floors),
+    )
+    lines = data[data["series"].str.endswith("lattice floor")]
+    assert sorted(lines.groupby("series")["y"].first()) == [1e-6, 8e-6]
+    texts = [t.get_text() for t in figure.axes[1].get_legend().get_texts()]
+    assert any("N* = a/floor ≈ 40,000" in t for t in texts) and any("N* = a/floor ≈ 5,000" in t for t in texts)
