@@ -21,9 +21,29 @@ from matplotlib.figure import Figure
 
 from .case import Case, rows_of
 from .kernels import truncated_variance_fraction
-from .plots import GREY, Series, _look, _models, _n_ticks, _nearest, _no_data, draw, source_table, styles
+from .plots import (
+    BLACK,
+    BLUE,
+    GREEN,
+    GREY,
+    ORANGE,
+    PURPLE,
+    SKY,
+    VERMILLION,
+    Series,
+    _look,
+    _models,
+    _n_ticks,
+    _nearest,
+    _no_data,
+    draw,
+    source_table,
+    styles,
+)
 
 FIGURE = "fig9_mechanism"
+# one distinct colour per model, in config order (the equations first: the paper's green)
+PALETTE = (GREEN, ORANGE, SKY, PURPLE, VERMILLION, BLACK, BLUE)
 
 
 def truncation_floor(D: float, t: float, fraction: float, omega: float) -> float:
@@ -81,7 +101,7 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
             Series(
                 "b",
                 f"{model.label(n=False)}: SSE/N",
-                legend=_label(model, equations),
+                legend="_" + _label(model, equations),  # named in panel (a)
                 y_name="SSE/N",
                 y=sse,
                 y_lo=sse - se,
@@ -93,7 +113,7 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
     return out
 
 
-def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, style, t_final, ns) -> list[Series]:
+def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, style, equations, t_final, ns):
     """Panel (b): each model's lattice floor f as a line across the N drawn, labelled with
     N* = a / f, a the median of (SSE/N - f) N over its N from 1,000 to 10,000 (where the sampling
     error behaves as a / N; below, the kernel is not resolved and it falls faster)."""
@@ -104,7 +124,7 @@ def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, styl
     lattice_models = list(dict.fromkeys(Case.from_row(r).model for _, r in at.iterrows()))
     for model in lattice_models:
         f = float(rows_of(at, model)["SSE_over_N"].iloc[0])
-        text = f"{_label(model, None)}: floor {f:.2g}"
+        text = f"{_label(model, equations)}: floor {f:.2g}"
         if model in models and not comic.empty:
             g = _nearest(pd.concat([rows_of(comic, c) for c in cases if c.model == model]), t_final)
             small = g[(g["n"] >= 1000) & (g["n"] <= 10000)]
@@ -208,7 +228,7 @@ def _fd_series(fd: pd.DataFrame) -> list[Series]:
 def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float, floors=None):
     """The four panels (module docstring) -> (Figure, source data)."""
     models = _models(cases)
-    style = styles("fig9", cases)
+    style = {m: {**st, "color": PALETTE[k % len(PALETTE)]} for k, (m, st) in enumerate(styles("fig9", cases).items())}
     # the reference of panel (c): the first model with the paper's symmetric matrix and whole kernel
     equations = next((m for m in models if m.scheme == "symmetric" and m.truncation is None), None)
     fig = Figure(figsize=(12.5, 10.0), layout="constrained")
@@ -243,7 +263,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
             legend=None,
         )
         floor_lines = _floor_series(
-            floors if floors is not None else pd.DataFrame(), comic, models, cases, style, t_final, ns
+            floors if floors is not None else pd.DataFrame(), comic, models, cases, style, equations, t_final, ns
         )
         for s in floor_lines:
             draw(axes[1], s)
@@ -285,7 +305,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
             if len(ns):
                 _n_ticks(ax, ns)
             if ax.get_legend_handles_labels()[0]:
-                ax.legend(loc="best", fontsize=7)
+                ax.legend(loc="lower left" if ax is axes[1] else "best", fontsize=6.5 if ax is axes[1] else 7)
     fd_series = _fd_series(fd)
     for s in fd_series:
         draw(axes[3], s)
