@@ -1,6 +1,7 @@
 """Benchmark whole runs: wall time, time per step and peak memory of one simulation.
 
     python benchmarks/bench_run.py --method mtpt --kernel collision --n 30000
+    python benchmarks/bench_run.py --n 10000 30000 --truncation 3 --scheme sequential   # the authors' loop
 
 Runs in a fresh process per configuration so that peak RSS belongs to that run alone.
 """
@@ -46,9 +47,13 @@ def main() -> None:
     p.add_argument("--n", type=int, nargs="+", default=[30000])
     p.add_argument("--eta", type=float, default=1.0)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--truncation", type=float, default=None, help="kernel widths (default: whole Gaussian)")
+    p.add_argument("--scheme", default="symmetric")
     a = p.parse_args()
     for n in a.n:
         cfg = {"method": a.method, "kernel": a.kernel, "n": n, "eta": a.eta, "seed": a.seed}
+        if a.method == "mtpt":
+            cfg.update(truncation=a.truncation, scheme=a.scheme)
         t0 = time.perf_counter()
         out = subprocess.run([sys.executable, "-c", CHILD, json.dumps(cfg)], capture_output=True, text=True, check=True)
         res = json.loads(out.stdout.strip().splitlines()[-1])
