@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import stat
 import subprocess
 import sys
 
@@ -129,4 +131,38 @@ def test_good_run_writes_table_and_state(tmp_path):
     assert np.all(np.diff(st["x"].to_numpy()) >= 0)
     assert st["mass"].sum() == pytest.approx(1.0, abs=1e-12)
     # no temporary files left beside the outputs (atomic writes)
-    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["run.parquet", "state.parquet"]
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == [
+        "run.parquet",
+        "run.parquet.sha256",
+        "state.parquet",
+        "state.parquet.sha256",
+    ]
+
+
+def _small_run(*out_args):
+    return _cli("simulate", "--method", "mtpt", "--n", "20", "--t-final", "1", "--quiet", *out_args)
+
+
+def test_out_and_state_out_on_one_path_are_refused_before_the_run(tmp_path):
+    same = tmp_path / "x.parquet"
+    res = _small_run("--out", str(same), "--state-out", str(tmp_path / "." / "x.parquet"))
+    assert res.returncode == 2 and "--state-out" in res.stderr and "also --out" in res.stderr
+    assert "Traceback" not in res.stderr and list(tmp_path.iterdir()) == []
+
+
+def test_a_device_or_directory_out_is_refused_and_left_alone(tmp_path):
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)  # a non-regular file anyone can make (a character device needs root)
+    res = _small_run("--out", str(fifo))
+    assert res.returncode == 2 and "--out" in res.stderr and "not a regular file" in res.stderr
+    assert stat.S_ISFIFO(fifo.stat().st_mode)  # still the pipe
+    res = _small_run("--out", str(tmp_path))
+    assert res.returncode == 2 and "is a directory" in res.stderr
+
+
+def test_an_out_inside_a_file_is_refused_before_the_run(tmp_path):
+    blocker = tmp_path / "notes.txt"
+    blocker.write_text("a file where a folder would be")
+    res = _small_run("--out", str(blocker / "run.parquet"))
+    assert res.returncode == 2 and "cannot write" in res.stderr and "notes.txt" in res.stderr
+    assert blocker.read_text() == "a file where a folder would be"

@@ -17,6 +17,7 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 from particle_entropy.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
+from particle_entropy.records import TIMING_COLUMNS
 from particle_entropy.sweeps import FIGURE_READS, Ensemble, case_run_paths, figure_ensembles, run_path, spec_ensembles
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -451,3 +452,22 @@ def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path):
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
     proc = snakemake(tmp_path, "-n", configfile=path)
     assert "figures/fig9.png" in proc.stdout and "fig10" not in proc.stdout and "tradeoff" not in proc.stdout
+
+
+# --- corrupt tables are found before use and rebuilt ------------------------------------------
+
+
+def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
+    cfg = load(TINY)
+    run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]  # a table Fig. 9 reads
+    good = run.read_bytes()
+    before = pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS))
+    summaries = sorted((tiny_run / "results/tables/cases").rglob("*.parquet"))
+    run.write_bytes(good[:100])  # truncate -s 100
+    proc = snakemake(tiny_run, configfile=TINY)
+    assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
+    pd.testing.assert_frame_equal(pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS)), before)  # rebuilt
+    assert (run.parent / (run.name + ".corrupt")).exists()
+    assert all(s.exists() for s in summaries)  # no good table was lost on the way
+    again = snakemake(tiny_run, "-n", configfile=TINY)
+    assert "Nothing to be done" in again.stdout + again.stderr

@@ -10,6 +10,7 @@ validate(config, str(Path(workflow.basedir) / "workflow" / "schemas" / "config.s
 from particle_entropy.aggregate import summarise_files  # noqa: E402
 from particle_entropy.case import Case  # noqa: E402
 from particle_entropy.codeversion import code_version  # noqa: E402
+from particle_entropy.io import CORRUPT_SUFFIX, corrupt_tables, set_aside  # noqa: E402
 from particle_entropy.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES  # noqa: E402
 from particle_entropy.sweeps import (  # noqa: E402
     CASE_DIR,
@@ -30,6 +31,20 @@ from particle_entropy.sweeps import (  # noqa: E402
 )
 
 check_sweeps(config)
+
+
+def set_aside_corrupt_tables(root="results"):
+    """Tables whose bytes no longer match their checksum (truncated, a flipped bit, empty) are
+    moved to <name>.corrupt before the DAG is built. The default target rebuilds every table set
+    aside and not yet rebuilt, so a dry run in between loses nothing."""
+    for path, problem in corrupt_tables(root).items():
+        moved = set_aside(path)
+        print(f"corrupt table {path}: {problem}; moved to {moved.name}, it will be rebuilt", file=sys.stderr)
+    aside = Path(root).rglob("*.parquet" + CORRUPT_SUFFIX) if Path(root).exists() else []
+    return sorted(str(p)[: -len(CORRUPT_SUFFIX)] for p in aside if not Path(str(p)[: -len(CORRUPT_SUFFIX)]).exists())
+
+
+CORRUPT = set_aside_corrupt_tables()
 FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 
@@ -53,12 +68,16 @@ def all_targets():
     figs = [f"figures/{f}.{ext}" for f in FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
     if "tradeoff" in config:
         figs += ["figures/tradeoff.png", "figures/tradeoff.pdf", "results/tables/tradeoff.parquet"]
-    return figs + [
-        "results/tables/comic.parquet",
-        "results/tables/comic_minima.parquet",
-        "results/tables/paper_claims.parquet",
-        "results/paper_claims.md",
-    ]
+    return (
+        CORRUPT
+        + figs
+        + [
+            "results/tables/comic.parquet",
+            "results/tables/comic_minima.parquet",
+            "results/tables/paper_claims.parquet",
+            "results/paper_claims.md",
+        ]
+    )
 
 
 def ensembles(section):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 
 from .registry import (
@@ -148,6 +149,16 @@ def main(argv=None) -> int:
         cfg = config_from_args(a)
     except SettingError as e:
         parser.error(f"--{e.name.replace('_', '-')}: {e}")
+    from .io import OutputError, check_output_path
+
+    if a.state_out is not None and os.path.abspath(a.state_out) == os.path.abspath(a.out):
+        parser.error(f"--state-out: {a.state_out!r} is also --out; the final state would replace the per-step table")
+    for flag, target in (("--out", a.out), ("--state-out", a.state_out)):
+        if target is not None:
+            try:
+                check_output_path(target)
+            except OutputError as e:
+                parser.error(f"{flag}: {e}")
     from .io import write_parquet
     from .simulate import run
 
