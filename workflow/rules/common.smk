@@ -40,7 +40,7 @@ def set_aside_corrupt_tables(root="results"):
     for path, problem in corrupt_tables(root).items():
         moved = set_aside(path)
         print(f"corrupt table {path}: {problem}; moved to {moved.name}, it will be rebuilt", file=sys.stderr)
-    aside = Path(root).rglob("*.parquet" + CORRUPT_SUFFIX) if Path(root).exists() else []
+    aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
     return sorted(str(p)[: -len(CORRUPT_SUFFIX)] for p in aside if not Path(str(p)[: -len(CORRUPT_SUFFIX)]).exists())
 
 
