@@ -1,7 +1,9 @@
 # Config validation, the cases of every config section, target helpers and code versions.
+import re
 import sys
 from pathlib import Path
 
+from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
@@ -39,9 +41,16 @@ def set_aside_corrupt_tables(root="results"):
     aside and not yet rebuilt, so a dry run in between loses nothing."""
     for path, problem in corrupt_tables(root).items():
         moved = set_aside(path)
-        print(f"corrupt table {path}: {problem}; moved to {moved.name}, it will be rebuilt", file=sys.stderr)
+        print(
+            f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it", file=sys.stderr
+        )
     aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
-    return sorted(str(p)[: -len(CORRUPT_SUFFIX)] for p in aside if not Path(str(p)[: -len(CORRUPT_SUFFIX)]).exists())
+    missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
+    missing = [m for m in missing if not Path(m).exists()]
+    # runs and case summaries are intermediate: name them as targets; every other table is a
+    # target or an output of a job that a target reruns. A path of an older layout is left.
+    rebuildable = [re.compile(regex_from_filepattern(p)) for p in (RUN_PATTERN, SUMMARY_PATTERN)]
+    return sorted(m for m in missing if any(r.match(m) for r in rebuildable))
 
 
 CORRUPT = set_aside_corrupt_tables()
