@@ -53,7 +53,9 @@ def set_aside_corrupt_tables(root="results"):
     return sorted(m for m in missing if any(r.match(m) for r in rebuildable))
 
 
-CORRUPT = set_aside_corrupt_tables()
+# Only the main Snakemake process checks: a job re-parsing this file on a cluster node must not
+# judge tables that other jobs are writing at that moment.
+CORRUPT = set_aside_corrupt_tables() if workflow.is_main_process else []
 FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 
