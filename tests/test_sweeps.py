@@ -307,3 +307,25 @@ def test_lattice_cases_and_their_checks():
     config = copy.deepcopy(TINY)
     config["mechanism"]["lattice"]["cases"].append({"method": "mtpt", "kernel": "collision", "eta": 0.5})
     assert "eta = 1 only" in _refused(config)
+
+
+@pytest.mark.parametrize(
+    ("path", "value"),
+    [
+        (("physics", "D"), float("nan")),
+        (("physics", "t_final"), float("inf")),
+        (("time", "dt0"), float("nan")),
+        (("physics", "omega"), -float("inf")),
+        (("comic_times", 1), float("nan")),
+        (("shear", "dt"), float("inf")),
+    ],
+)
+def test_check_sweeps_refuses_nan_and_infinity_anywhere(path, value):
+    config = copy.deepcopy(TINY)
+    node = config
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    msg = _refused(config)
+    where = path[0] + "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in path[1:])
+    assert msg.startswith(f"{where}=") and "finite" in msg

@@ -101,6 +101,17 @@ def test_kernel_method_mismatch_is_refused(tmp_path):
     assert "figures.fig1.cases[0].kernel='sph'" in proc.stdout + proc.stderr
 
 
+def test_nan_in_the_yaml_is_refused_before_any_job(tmp_path):
+    text = (ROOT / "config.yaml").read_text().replace("D: 1.0e-3", "D: .nan", 1)
+    assert "D: .nan" in text
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    assert proc.returncode != 0
+    assert "physics.D=nan is not allowed: a finite number" in proc.stdout + proc.stderr
+    assert not (tmp_path / "results").exists()
+
+
 # --- dry runs on the full config -------------------------------------------------------------
 
 

@@ -166,10 +166,25 @@ def run_config(case: Case, config: Mapping, seed: int = 0) -> RunConfig:
     return RunConfig.for_case(case, seed=seed, **run_settings(case, config)).resolved()
 
 
+def check_finite(value, where: str = "") -> None:
+    """Every number of the config must be finite: YAML's .nan and .inf pass the schema's
+    `number` but no setting means them. SettingError names the key path."""
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            check_finite(v, f"{where}.{k}" if where else str(k))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            check_finite(v, f"{where}[{i}]")
+    elif isinstance(value, float) and not math.isfinite(value):
+        raise SettingError(where, value, "a finite number (YAML .nan and .inf are not settings)")
+
+
 def check_sweeps(config: Mapping) -> None:
-    """Checks the JSON schema cannot express, before any job runs: every case of every section
-    must build a valid run (kernel for its method, dimensions that apply, FD grids, explicit
-    FD stability, an ensemble size for each N). The message names the section, key and value."""
+    """Checks the JSON schema cannot express, before any job runs: every number finite, every
+    case of every section must build a valid run (kernel for its method, dimensions that apply,
+    FD grids, explicit FD stability, an ensemble size for each N). The message names the
+    section, key and value."""
+    check_finite(config)
     for name, spec in case_sections(config).items():
         for i, c in enumerate(spec["cases"]):
             where = f"{name}.cases[{i}]"
