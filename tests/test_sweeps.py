@@ -329,3 +329,17 @@ def test_check_sweeps_refuses_nan_and_infinity_anywhere(path, value):
     msg = _refused(config)
     where = path[0] + "".join(f"[{k}]" if isinstance(k, int) else f".{k}" for k in path[1:])
     assert msg.startswith(f"{where}=") and "finite" in msg
+
+
+def test_check_sweeps_refuses_a_realisations_entry_given_twice():
+    config = copy.deepcopy(TINY)
+    config["realisations"].append({"n": config["realisations"][0]["n"], "count": 99})
+    last = len(config["realisations"]) - 1
+    assert f"realisations[{last}].n" in _refused(config) and "also at realisations[0]" in _refused(config)
+
+
+def test_check_sweeps_refuses_a_claims_range_written_high_to_low():
+    config = copy.deepcopy(TINY)
+    config["claims"]["collision_eta1_optimum"] = [10000, 1000]
+    msg = _refused(config)
+    assert msg.startswith("claims.collision_eta1_optimum=[10000, 1000]") and "low <= high" in msg

@@ -185,6 +185,15 @@ def check_sweeps(config: Mapping) -> None:
     FD grids, explicit FD stability, an ensemble size for each N). The message names the
     section, key and value."""
     check_finite(config)
+    seen: dict[int, int] = {}
+    for i, entry in enumerate(config.get("realisations", [])):
+        n = int(entry["n"])
+        if n in seen:
+            raise SettingError(f"realisations[{i}].n", n, f"each N once (also at realisations[{seen[n]}])")
+        seen[n] = i
+    for key, value in config.get("claims", {}).items():
+        if isinstance(value, (list, tuple)) and len(value) == 2 and value[0] > value[1]:
+            raise SettingError(f"claims.{key}", list(value), "a range [low, high] with low <= high")
     for name, spec in case_sections(config).items():
         for i, c in enumerate(spec["cases"]):
             where = f"{name}.cases[{i}]"
