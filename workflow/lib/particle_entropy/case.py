@@ -226,18 +226,24 @@ class Case:
                 out[dim] = getattr(self, dim)
         return out
 
-    def label(self, n: bool = True) -> str:
-        """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
-        parts = [f"{self.method.upper()} {KERNEL_NAMES[self.kernel]}"]
-        if self.method == "mtpt":
-            parts.append(f"η={self.eta:g}")
-        v = self.variant()
+    def variant_parts(self) -> list[str]:
+        """Legend words for the dimensions that differ from the paper's defaults, e.g.
+        ['truncation 3', 'sequential loop']."""
+        v, parts = self.variant(), []
         if "truncation" in v:
             parts.append(f"truncation {v['truncation']:g}")
         if "dt_growth" in v:
             parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
         if "scheme" in v:
             parts.append(SCHEME_LABELS[v["scheme"]])
+        return parts
+
+    def label(self, n: bool = True) -> str:
+        """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
+        parts = [f"{self.method.upper()} {KERNEL_NAMES[self.kernel]}"]
+        if self.method == "mtpt":
+            parts.append(f"η={self.eta:g}")
+        parts += self.variant_parts()
         if n and self.n is not None:
             parts.append(f"N={self.n:,}")
         return ", ".join(parts)

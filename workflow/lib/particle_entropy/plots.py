@@ -780,8 +780,7 @@ def _family(case: Case) -> tuple:
 
 def _scheme_text(model: Case) -> str:
     """How a model differs from the paper's equations, for a Fig. 9 legend."""
-    parts = model.label(n=False).split(", ")[2:]  # after 'MTPT collision', 'η=1'
-    return ", ".join(parts) if parts else "paper's equations (whole Gaussian)"
+    return ", ".join(model.variant_parts()) or "paper's equations (whole Gaussian)"
 
 
 def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: float) -> list[Series]:

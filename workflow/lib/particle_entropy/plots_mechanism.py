@@ -56,7 +56,7 @@ def truncation_floor(D: float, t: float, fraction: float, omega: float) -> float
 
 def _label(model: Case, equations: Case | None) -> str:
     """A model by what it changes from the paper's equations."""
-    text = ", ".join(model.label(n=False).split(", ")[2:])
+    text = ", ".join(model.variant_parts())
     if model == equations:
         return "paper's equations (whole Gaussian)" + (f", {text}" if text else "")
     return text or model.label(n=False)
