@@ -43,18 +43,21 @@ rule comic_tables:
         "../scripts/comic_tables.py"
 
 
-rule comic_tables_fig9:
-    """Fig. 9's own COMIC tables, so that its target pulls no FD run."""
+rule comic_tables_section:
+    """A section's own COMIC tables (Fig. 9's, the mechanism sweeps'), so that its target pulls
+    only its own runs."""
     input:
-        summaries=summaries_of("fig9"),
-        runs=runs_of("fig9"),
+        summaries=lambda w: summaries_of(w.section),
+        runs=lambda w: runs_of(w.section),
     output:
-        comic="results/tables/fig9/comic.parquet",
-        minima="results/tables/fig9/comic_minima.parquet",
-        realisations="results/tables/fig9/comic_realisations.parquet",
-        argmin="results/tables/fig9/comic_argmin.parquet",
+        comic="results/tables/{section}/comic.parquet",
+        minima="results/tables/{section}/comic_minima.parquet",
+        realisations="results/tables/{section}/comic_realisations.parquet",
+        argmin="results/tables/{section}/comic_argmin.parquet",
     log:
-        "logs/comic_tables_fig9.log",
+        "logs/comic_tables_{section}.log",
+    wildcard_constraints:
+        section="fig9|mechanism",
     conda:
         "../../envs/particle-entropy.yaml"
     params:

@@ -1,27 +1,8 @@
 # figures/fig9_mechanism.png: the controlled experiments behind Fig. 9's minima and Fig. 8's late
-# error (config `mechanism`). Its own target: `snakemake -j2 figures/fig9_mechanism.png`.
+# error (config `mechanism`; its COMIC tables come from rule comic_tables_section). Its own
+# target: `snakemake -j2 figures/fig9_mechanism.png`.
 
 if "mechanism" in config:
-
-    rule comic_tables_mechanism:
-        """COMIC tables of the mechanism sweeps (the same tables as Fig. 9's)."""
-        input:
-            summaries=summaries_of("mechanism"),
-            runs=runs_of("mechanism"),
-        output:
-            comic="results/tables/mechanism/comic.parquet",
-            minima="results/tables/mechanism/comic_minima.parquet",
-            realisations="results/tables/mechanism/comic_realisations.parquet",
-            argmin="results/tables/mechanism/comic_argmin.parquet",
-        log:
-            "logs/comic_tables_mechanism.log",
-        conda:
-            "../../envs/particle-entropy.yaml"
-        params:
-            times=config["comic_times"],
-            code=COMIC_CODE,
-        script:
-            "../scripts/comic_tables.py"
 
     rule fd_domain:
         """Fig. 8's FD grids on the paper's domain and on longer ones, at the same dx."""
