@@ -7,7 +7,11 @@ from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
-validate(config, str(Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"))
+from particle_entropy.configcheck import check_schema, load_schema  # noqa: E402
+
+SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
+check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
+validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.aggregate import summarise_files  # noqa: E402
 from particle_entropy.case import Case  # noqa: E402

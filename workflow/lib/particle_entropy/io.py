@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 import stat
 import tempfile
 from pathlib import Path
@@ -129,3 +130,22 @@ def set_aside(path: str | os.PathLike) -> Path:
     os.replace(path, target)
     checksum_path(path).unlink(missing_ok=True)
     return target
+
+
+MIN_FREE_MB_ENV = "PARTICLE_ENTROPY_MIN_FREE_MB"  # a test sets it high to see the message
+MIN_FREE_MB = 200.0
+
+
+def disk_space_problem(path: str | os.PathLike = ".") -> str | None:
+    """A message when the file system holding ``path`` has less than MIN_FREE_MB free (none
+    otherwise): a job that fails on a full disk often cannot write its own log, so the
+    workflow says so on the terminal (Snakefile `onerror`)."""
+    limit = float(os.environ.get(MIN_FREE_MB_ENV, MIN_FREE_MB))
+    free_mb = shutil.disk_usage(path).free / 2**20
+    if free_mb >= limit:
+        return None
+    return (
+        f"No space left on device? The file system holding {Path(path).resolve()} has {free_mb:.0f} MB free "
+        f"(below {limit:.0f} MB); a job that fails on a full disk may leave an empty log. "
+        "Free some space and rerun the same command: finished tables are kept."
+    )

@@ -10,6 +10,9 @@ import numpy as np
 
 from .case import Case, SettingError, check_range
 from .registry import DEFAULT_KERNEL, FGT_TOLERANCE_RANGE, PAPER, TIME_GRIDS, TRANSFER_METHODS
+from .timegrid import MAX_STEPS, max_first_step, step_count
+
+MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
 
 
 def first_step(method: str, dt_growth: float, dt0: float, fd_dt: float, fixed_dt: float) -> float:
@@ -83,11 +86,21 @@ class RunConfig:
         check_range("D", self.D, 0.0, math.inf)
         check_range("t_final", self.t_final, 0.0, math.inf, open_low=True)
         check_range("dt0", self.dt0, 0.0, math.inf, open_low=True)
-        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise SettingError("seed", self.seed, "an integer >= 0")
+        if not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
+            raise SettingError(
+                "seed", self.seed, f"an integer in [0, 2^63 - 1 = {MAX_SEED}] (tables store it as int64)"
+            )
         check_range("omega", self.omega, 0.0, math.inf, open_low=True)
         check_range("fd_length", self.fd_length, 0.0, math.inf, open_low=True)
         check_range("fixed_kernel_time", self.fixed_kernel_time, 0.0, math.inf, open_low=True)
+        steps = step_count(self.t_final, self.dt0, self.dt_growth)
+        if steps > MAX_STEPS:
+            raise SettingError(
+                "dt0",
+                self.dt0,
+                f"a first step reaching t_final = {self.t_final:g} in at most {MAX_STEPS:,} steps with dt_growth = "
+                f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
+            )
         if self.time_grid not in TIME_GRIDS:
             raise SettingError("time_grid", self.time_grid, f"one of {', '.join(TIME_GRIDS)}")
         if self.transfer_method not in TRANSFER_METHODS:

@@ -32,7 +32,8 @@ from numba import njit
 from scipy.spatial import cKDTree
 
 from .records import Recorder
-from .runconfig import SettingError, check_range
+from .runconfig import MAX_SEED, SettingError, check_range
+from .timegrid import MAX_STEPS
 
 CASES = ("rw_nodrift", "rw_drift", "mt")
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
@@ -95,8 +96,13 @@ class ShearConfig:
         if abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
             raise SettingError("t_final", self.t_final, f"a whole number of steps dt={self.dt!r}")
         check_range("beta", self.beta, 0.0, 1.0)
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise SettingError("seed", self.seed, "an integer >= 0")
+        if steps > MAX_STEPS:
+            raise SettingError(
+                "dt", self.dt, f"at most {MAX_STEPS:,} steps to t_final: dt >= {self.t_final / MAX_STEPS:.3g}"
+            )
+        seed_ok = isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool)
+        if not seed_ok or not 0 <= self.seed <= MAX_SEED:
+            raise SettingError("seed", self.seed, f"an integer in [0, 2^63 - 1 = {MAX_SEED}] (stored as int64)")
         if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
             # the minimum-image distance in x is only exact while the kernel fits in half the box
             raise SettingError(

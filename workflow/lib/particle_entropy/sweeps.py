@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 from .case import CASE_DIR, Case, SettingError
 from .registry import PAPER
-from .runconfig import RunConfig, first_step
+from .runconfig import MAX_SEED, RunConfig, first_step
 
 RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
@@ -179,6 +179,45 @@ def check_finite(value, where: str = "") -> None:
         raise SettingError(where, value, "a finite number (YAML .nan and .inf are not settings)")
 
 
+def _first_step_key(case: Case) -> str:
+    """The config key of a case's first step (runconfig.first_step)."""
+    if case.method == "fd":
+        return "time.fd_dt"
+    return "time.fixed_dt" if case.dt_growth == 1.0 else "time.dt0"
+
+
+# RunConfig settings that come from a shared config key, not from the case: a SettingError about
+# them names that key (and the case it fails for)
+SHARED_KEYS = {"dt0": _first_step_key, **{k: f"physics.{k}" for k in PHYSICS}, "time_grid": "time.grid"}
+SHARED_KEYS.update({k: f"numerics.{k}" for k in NUMERICS})
+
+
+def check_seeds(config: Mapping) -> None:
+    """Realisation r of every case uses seed base_seed + r, stored as int64 in every table."""
+    base = int(config["base_seed"])
+    most = max((e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)), default=1)
+    if base + most - 1 > MAX_SEED:
+        raise SettingError(
+            "base_seed",
+            base,
+            f"an integer in [0, {MAX_SEED - most + 1}]: seeds run to base_seed + {most - 1} and are stored as int64",
+        )
+
+
+def check_shear(config: Mapping) -> None:
+    """Every shear case must build a valid ShearConfig (strip inside the domain, whole steps, ...)."""
+    if "shear" not in config:
+        return
+    from .shear2d import ShearConfig
+
+    settings = {k: v for k, v in config["shear"].items() if k != "cases"}
+    for case in config["shear"]["cases"]:
+        try:
+            ShearConfig(case=case, **settings)
+        except SettingError as e:
+            raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
+
+
 def check_sweeps(config: Mapping) -> None:
     """Checks the JSON schema cannot express, before any job runs: every number finite, every
     case of every section must build a valid run (kernel for its method, dimensions that apply,
@@ -197,11 +236,15 @@ def check_sweeps(config: Mapping) -> None:
     for name, spec in case_sections(config).items():
         for i, c in enumerate(spec["cases"]):
             where = f"{name}.cases[{i}]"
+            case = None
             try:
                 for n in spec["n"]:
                     case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
                     run_config(case, config)
             except SettingError as e:
+                if e.name in SHARED_KEYS:  # a shared setting, wrong for this case: name both
+                    key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
+                    raise SettingError(key, e.value, f"{e.allowed} (for {where}, {case.label()})") from None
                 raise SettingError(f"{where}.{e.name}", e.value, e.allowed) from None
         particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
         for n in spec["n"] if particles else []:
@@ -210,6 +253,8 @@ def check_sweeps(config: Mapping) -> None:
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     check_lattice(config)
+    check_seeds(config)
+    check_shear(config)
     t_final = float(config["physics"]["t_final"])
     for key, times in (
         ("comic_times", config.get("comic_times", [])),

@@ -11,6 +11,20 @@ from .registry import TIME_GRIDS
 MAX_STEPS = 10_000_000
 
 
+def step_count(t_final: float, dt0: float, growth: float) -> int:
+    """Steps from dt0 growing by ``growth`` to reach t_final (without building them)."""
+    if growth == 1.0:
+        n = math.ceil(t_final / dt0 - 1e-9)
+    else:  # smallest n with dt0 (growth^n - 1)/(growth - 1) >= t_final
+        n = math.ceil(math.log1p(t_final * (growth - 1) / dt0) / math.log(growth) - 1e-9)
+    return max(n, 1)
+
+
+def max_first_step(t_final: float, growth: float, steps: int = MAX_STEPS) -> float:
+    """The smallest dt0 that reaches t_final in ``steps`` steps growing by ``growth``."""
+    return t_final / steps if growth == 1.0 else t_final * (growth - 1) / math.expm1(steps * math.log(growth))
+
+
 def time_steps(t_final: float, dt0: float, growth: float, grid: str = "exact") -> np.ndarray:
     """Step sizes dt_n = dt0 * growth**n up to t_final: ``exact`` shortens the last step to end at
     t_final; ``authors`` keeps whole steps while t < t_final, as the authors' loop (which ends
@@ -27,12 +41,7 @@ def time_steps(t_final: float, dt0: float, growth: float, grid: str = "exact") -
         raise ValueError(f"dt0 must be positive and finite, got {dt0!r}")
     if not (growth >= 1 and math.isfinite(growth)):
         raise ValueError(f"dt growth must be >= 1, got {growth!r}")
-    if growth == 1.0:
-        n = math.ceil(t_final / dt0 - 1e-9)
-    else:
-        # smallest n with dt0 (growth^n - 1)/(growth - 1) >= t_final
-        n = math.ceil(math.log1p(t_final * (growth - 1) / dt0) / math.log(growth) - 1e-9)
-    n = max(n, 1)
+    n = step_count(t_final, dt0, growth)
     if n > MAX_STEPS:
         raise ValueError(
             f"{n} time steps needed for t_final={t_final} with dt0={dt0}, growth={growth}; at most {MAX_STEPS} allowed"

@@ -1,0 +1,119 @@
+"""Check a workflow config before any job runs, each problem in one short message.
+
+Three layers: YAML syntax (with the line and column), the JSON schema (one error, named by its
+key path, with the allowed values from the schema's own description) and the rules between
+fields that a schema cannot say (sweeps.check_sweeps). Snakemake's own loader and validator
+report the first two without a line number and with the whole schema and config around the
+one useful line.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from collections.abc import Mapping
+from pathlib import Path
+
+import yaml
+
+from .case import SettingError
+
+SCHEMA_PATH = Path(__file__).resolve().parents[2] / "schemas" / "config.schema.yaml"
+_NUMBER_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+
+class ConfigFileError(ValueError):
+    """A config file that cannot be read as YAML; the message names the file, line and column."""
+
+
+def load_yaml(path: str | Path) -> Mapping:
+    """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = yaml.safe_load(f)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}" if mark is not None else "somewhere"
+        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
+        context, start = getattr(e, "context", None), getattr(e, "context_mark", None)
+        if context and start is not None:
+            context += f" started at line {start.line + 1}, column {start.column + 1}"
+        raise ConfigFileError(
+            f"{path}: not valid YAML at {where}: {problem}" + (f" ({context})" if context else "")
+        ) from None
+    if not isinstance(data, Mapping):
+        raise ConfigFileError(f"{path}: a config is a YAML mapping of keys (physics:, time:, ...), got {data!r}")
+    return data
+
+
+def key_path(parts) -> str:
+    """('figures', 'fig9', 'cases', 3, 'eta') -> 'figures.fig9.cases[3].eta'."""
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out or "(top level)"
+
+
+def _short(value, limit: int = 60):
+    text = repr(value)
+    return value if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _number_hint(value) -> str:
+    """YAML 1.1 reads 1e-3 (no decimal point) as text: say how to write it as a number."""
+    if isinstance(value, str) and _NUMBER_TEXT.match(value.strip()):
+        mantissa, _, exponent = value.strip().lower().partition("e")
+        fixed = (mantissa if "." in mantissa else mantissa + ".0") + (f"e{exponent}" if exponent else "")
+        return f"; YAML reads {value} as text: write {fixed}"
+    return ""
+
+
+def _schema_error_to_setting(error) -> SettingError:
+    """One jsonschema ValidationError as a SettingError: key path, value, allowed values."""
+    path = list(error.absolute_path)
+    schema = error.schema if isinstance(error.schema, Mapping) else {}
+    if error.validator == "additionalProperties":
+        known = list(schema.get("properties", {}))
+        unexpected = [k for k in error.instance if k not in known]
+        unexpected = [k for k in unexpected if not any(re.match(p, k) for p in schema.get("patternProperties", {}))]
+        key = unexpected[0] if unexpected else "?"
+        allowed = "a known key: " + ", ".join(known) if known else schema.get("description", "a known key")
+        near = difflib.get_close_matches(str(key), known, n=1)
+        return SettingError(
+            key_path([*path, key]), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else "")
+        )
+    if error.validator == "required":
+        key = re.match(r"'([^']+)'", error.message)
+        key = key.group(1) if key else "?"
+        described = schema.get("properties", {}).get(key, {}).get("description", "")
+        return SettingError(
+            key_path([*path, key]), "(missing)", "a required key" + (f": {described}" if described else "")
+        )
+    described = schema.get("description", "")
+    allowed = f"{described} ({error.message})" if described else error.message
+    if error.validator in ("type", "oneOf"):
+        allowed += _number_hint(error.instance)
+    return SettingError(key_path(path), _short(error.instance), allowed)
+
+
+def check_schema(config: Mapping, schema: Mapping) -> None:
+    """SettingError for the most relevant way ``config`` breaks ``schema`` (none if it conforms)."""
+    from jsonschema import Draft202012Validator
+    from jsonschema.exceptions import best_match
+
+    error = best_match(Draft202012Validator(schema).iter_errors(dict(config)))
+    if error is not None:
+        raise _schema_error_to_setting(error)
+
+
+def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
+    with open(path, encoding="utf-8") as f:
+        return yaml.safe_load(f)
+
+
+def check_config(config: Mapping, schema: Mapping | None = None) -> None:
+    """Everything a dry run checks: the schema, then every rule between fields (sweeps.check_sweeps)."""
+    from .sweeps import check_sweeps
+
+    check_schema(config, load_schema() if schema is None else schema)
+    check_sweeps(config)
