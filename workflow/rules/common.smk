@@ -17,6 +17,7 @@ from particle_entropy.aggregate import summarise_files  # noqa: E402
 from particle_entropy.case import Case  # noqa: E402
 from particle_entropy.codeversion import code_version  # noqa: E402
 from particle_entropy.io import CORRUPT_SUFFIX, corrupt_tables, set_aside  # noqa: E402
+from particle_entropy.memory import available_bytes, estimate_mb  # noqa: E402
 from particle_entropy.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES  # noqa: E402
 from particle_entropy.sweeps import (  # noqa: E402
     CASE_DIR,
@@ -27,16 +28,20 @@ from particle_entropy.sweeps import (  # noqa: E402
     SUMMARY_PATTERN,
     Ensemble,
     case_run_paths,
+    check_memory,
     check_sweeps,
     figure_ensembles,
     lattice_cases,
     mechanism_ensembles,
+    run_config,
     run_path,
     run_settings,
     spec_ensembles,
 )
 
 check_sweeps(config)
+if workflow.is_main_process and workflow.local_exec:  # jobs run here: each must fit in this machine's memory
+    check_memory(config, available_bytes())
 
 
 def set_aside_corrupt_tables(root="results"):
@@ -144,7 +149,9 @@ def runs_of(*sections):
 
 
 def sim_mem_mb(wildcards):
-    return 300 + int(wildcards.n) // 20
+    """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
+    seeds = int(wildcards.last) - int(wildcards.first) + 1
+    return estimate_mb(run_config(Case.from_wildcards(wildcards), config), seeds)
 
 
 def sim_runtime_min(wildcards):

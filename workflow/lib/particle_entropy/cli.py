@@ -187,6 +187,17 @@ def main(argv=None) -> int:
                 check_output_path(target)
             except OutputError as e:
                 parser.error(f"{flag}: {e}")
+    from .memory import available_bytes, estimate_bytes
+    from .timegrid import step_count
+
+    need, have = estimate_bytes(cfg), available_bytes()
+    if have is not None and need > have:
+        steps = step_count(cfg.t_final, cfg.dt0, cfg.dt_growth)
+        parser.error(
+            f"--n {cfg.n} and {steps:,} time steps need about {need / 1e9:.2f} GB (the {cfg.method} arrays and "
+            f"one table row per step), more than the {have / 1e9:.2f} GB available on this machine: "
+            "lower --n or take fewer, longer steps (--dt0, --dt-growth)"
+        )
     from .io import write_parquet
     from .simulate import run
 

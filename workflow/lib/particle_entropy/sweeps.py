@@ -218,6 +218,23 @@ def check_shear(config: Mapping) -> None:
             raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
 
 
+def check_memory(config: Mapping, available: float) -> None:
+    """Every simulation job must fit in ``available`` bytes (memory.estimate_mb of its seed block)."""
+    from .memory import estimate_mb
+
+    for name, spec in case_sections(config).items():
+        for ens in spec_ensembles(spec, config):
+            runs = max(b - a + 1 for a, b in seed_blocks(ens, config))
+            need = estimate_mb(run_config(ens.case, config), runs) * 2**20
+            if need > available:
+                raise SettingError(
+                    f"{name}.n",
+                    ens.case.n,
+                    f"an N whose job fits in this machine's memory: {ens.case.label()} needs about "
+                    f"{need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available (or run it on a cluster)",
+                )
+
+
 def check_sweeps(config: Mapping) -> None:
     """Checks the JSON schema cannot express, before any job runs: every number finite, every
     case of every section must build a valid run (kernel for its method, dimensions that apply,

@@ -1,0 +1,154 @@
+"""Every config value that would make a job fail is refused before any job, in one message that
+names the key path, the value and the allowed range (configcheck.check_config = what a dry run
+checks). Each bad input is a one-key change of the shipped config.yaml."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from particle_entropy.case import SettingError
+from particle_entropy.cli import main
+from particle_entropy.configcheck import ConfigFileError, check_config, load_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = yaml.safe_load((ROOT / "config.yaml").read_text())
+TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
+
+
+def _set(path, value):
+    def change(cfg):
+        node = cfg
+        for k in path[:-1]:
+            node = node[k]
+        node[path[-1]] = value
+
+    return change
+
+
+def _add_case(section, case, n=None):
+    def change(cfg):
+        spec = cfg["figures"][section] if section.startswith("fig") else cfg[section]
+        spec["cases"].append(case)
+        if n is not None:
+            spec["n"] = n
+
+    return change
+
+
+def _rename_top(old, new):
+    return lambda cfg: cfg.update({new: cfg.pop(old)})
+
+
+# (id, change, text the message must contain: the key path, then a word of the allowed range)
+BAD = [
+    ("D nan", _set(("physics", "D"), float("nan")), ["physics.D=nan", "finite"]),
+    ("t_final inf", _set(("physics", "t_final"), float("inf")), ["physics.t_final=inf", "finite"]),
+    ("dt0 nan", _set(("time", "dt0"), float("nan")), ["time.dt0=nan", "finite"]),
+    ("omega -inf", _set(("physics", "omega"), float("-inf")), ["physics.omega=-inf", "minimum of 0"]),
+    ("D 0", _set(("physics", "D"), 0), ["physics.D=0", "> 0"]),
+    ("D as text", _set(("physics", "D"), "1e-3"), ["physics.D='1e-3'", "write 1.0e-3"]),
+    ("top-level typo", _rename_top("physics", "physic"), ["physic=", "did you mean physics?"]),
+    ("time typo", _set(("time", "dt_0"), 0.01), ["time.dt_0=", "did you mean dt0?"]),
+    ("unknown figure", lambda c: c["figures"].update(fig11=c["figures"]["fig1"]), ["figures.fig11", "fig1 ... fig9"]),
+    ("missing key", lambda c: c["physics"].pop("t_final"), ["physics.t_final='(missing)'", "Final time"]),
+    ("base_seed 2^70", _set(("base_seed",), 2**70), ["base_seed=", "int64"]),
+    ("base_seed 2^63-1", _set(("base_seed",), 2**63 - 1), ["base_seed=", "int64"]),
+    (
+        "tradeoff kernel mismatch",
+        _add_case("tradeoff", {"method": "pt", "kernel": "collision"}),
+        ["tradeoff.cases[", "kernel='collision'", "bins, fixed, adaptive"],
+    ),
+    ("tradeoff fd odd n", _set(("tradeoff", "n"), [31, 100]), ["tradeoff.cases[0].n=31", "even"]),
+    (
+        "explicit fd unstable",
+        _add_case("fig8", {"method": "fd", "kernel": "explicit"}),
+        ["time.fd_dt=0.05", "r = D dt / dx^2 <= 1/2", "figures.fig8.cases[1]"],
+    ),
+    (
+        "fixed_dt 1e-12",
+        lambda c: (
+            c["time"].update(fixed_dt=1e-12),
+            _add_case("fig3", {"method": "pt", "kernel": "bins", "dt_growth": 1})(c),
+        ),
+        ["time.fixed_dt=1e-12", "10,000,000 steps"],
+    ),
+    ("fd_dt 1e-9", _set(("time", "fd_dt"), 1e-9), ["time.fd_dt=1e-09", "10,000,000 steps"]),
+    ("t_final 1e12", _set(("physics", "t_final"), 1e12), ["time.fd_dt", "10,000,000 steps"]),
+    ("shear strip reversed", _set(("shear", "strip_lo"), 120), ["shear.strip_hi=110", "> 120"]),
+    ("shear strip outside", _set(("shear", "strip_hi"), 500), ["shear.strip_hi=500", "<= 400"]),
+    ("shear t_final not whole steps", _set(("shear", "t_final"), 500.5), ["shear.t_final=500.5", "whole number"]),
+    ("shear too many steps", _set(("shear", "dt"), 1e-6), ["shear.dt=1e-06", "10,000,000 steps"]),
+    ("shear seed 2^63", _set(("shear", "seed"), 2**63), ["shear.seed=", "int64"]),
+    ("comic time past t_final", _set(("comic_times",), [250, 2000]), ["comic_times=2000", "[0, physics.t_final"]),
+    ("tradeoff time past t_final", _set(("tradeoff", "times"), [250, 2000]), ["tradeoff.times=2000", "t_final"]),
+    (
+        "duplicate realisations",
+        lambda c: c["realisations"].append({"n": 30, "count": 5}),
+        ["realisations[", "].n=30", "each N once"],
+    ),
+    ("claims range reversed", _set(("claims", "fd_optimum_nodes"), [10000, 1000]), ["claims.fd_optimum_nodes", "low"]),
+    (
+        "N without an ensemble size",
+        lambda c: c["figures"]["fig9"]["n"].append(123),
+        ["figures.fig9.n=123", "add {n: 123, count: ...}"],
+    ),
+    (
+        "eta out of range",
+        _add_case("fig5", {"method": "mtpt", "kernel": "collision", "eta": 1.5}),
+        ["figures.fig5.cases[", "eta=1.5", "[0, 1]"],
+    ),
+    (
+        "compensated without truncation",
+        _add_case("fig9", {"method": "mtpt", "kernel": "collision", "scheme": "compensated"}),
+        ["figures.fig9.cases[", "scheme='compensated'"],
+    ),
+]
+
+
+@pytest.mark.parametrize("change,expected", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_bad_config_is_refused_naming_key_and_range(change, expected):
+    cfg = copy.deepcopy(BASE)
+    change(cfg)
+    with pytest.raises(SettingError) as err:
+        check_config(cfg)
+    message = str(err.value)
+    for text in expected:
+        assert text in message, message
+    assert len(message) < 400 and "\n" not in message  # one line, not the whole schema
+
+
+@pytest.mark.parametrize("path", [ROOT / "config.yaml", TINY], ids=["config.yaml", "tiny"])
+def test_shipped_configs_are_accepted(path):
+    check_config(load_yaml(path))  # would raise
+
+
+def test_figures_may_be_empty():
+    cfg = copy.deepcopy(BASE)
+    cfg["figures"] = {}
+    check_config(cfg)  # the claims table is then empty (test_claims), not a KeyError
+
+
+def test_yaml_error_names_line_and_column(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("physics:\n  D: 1.0e-3\n  t_final: [1000\ntime: {dt0: 0.01}\n")
+    with pytest.raises(ConfigFileError) as err:
+        load_yaml(bad)
+    assert "bad.yaml: not valid YAML at line 4" in str(err.value)
+    assert "started at line 3" in str(err.value)
+
+
+def test_check_config_command(tmp_path, capsys):
+    assert main(["check-config", str(ROOT / "config.yaml")]) == 0
+    assert "accepted" in capsys.readouterr().out
+    overlay = tmp_path / "more.yaml"
+    overlay.write_text("physics:\n  D: 0\n")  # merged over config.yaml as Snakemake merges --configfile
+    assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2
+    assert "physics.D=0 is not allowed" in capsys.readouterr().err
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("physics: {D: 1.0e-3\n")
+    assert main(["check-config", str(broken)]) == 2
+    assert "line 2" in capsys.readouterr().err

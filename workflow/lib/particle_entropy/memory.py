@@ -1,0 +1,49 @@
+"""Peak memory of one simulation, estimated before it starts, and the memory the machine has.
+
+The model is linear, peak ~ base + per_step x steps + per_unit x N, fitted to peak resident set
+sizes of `python -m particle_entropy simulate` and rounded up (benchmarks/bench_memory.py
+compares the two): each time step keeps one row of the per-step table, each particle or node its
+arrays (mass transfer also its neighbour windows). The CLI refuses a run whose estimate exceeds
+the memory available; the workflow declares it as the job's mem_mb.
+"""
+
+from __future__ import annotations
+
+import os
+
+from .runconfig import RunConfig
+from .timegrid import step_count
+
+# measured (40 runs, one at a time): base 252 MB; 1.7-1.9 kB a step; per particle or node pt 19-39 B,
+# fd 64-80 B, mtpt collision 107-138 B and SPH 126-202 B (rising with N: its FGT uses more boxes)
+BASE_BYTES = 300e6
+STEP_BYTES = 2.5e3
+UNIT_BYTES = {"fd": 150.0, "pt": 100.0, "mtpt": 400.0}
+
+
+def estimate_bytes(cfg: RunConfig) -> float:
+    """Estimated peak memory of one run of a resolved ``cfg``, in bytes (an upper estimate)."""
+    steps = step_count(cfg.t_final, cfg.dt0, cfg.dt_growth)
+    return BASE_BYTES + STEP_BYTES * steps + UNIT_BYTES[cfg.method] * cfg.n
+
+
+def estimate_mb(cfg: RunConfig, runs: int = 1) -> int:
+    """Estimated peak of ``runs`` runs in one process (a seed block keeps each run's per-step table), in MB."""
+    one = estimate_bytes(cfg)
+    steps_table = STEP_BYTES * step_count(cfg.t_final, cfg.dt0, cfg.dt_growth)
+    return int((one + (runs - 1) * steps_table) / 2**20) + 1
+
+
+def available_bytes() -> float | None:
+    """Memory a new process can use now (MemAvailable of /proc/meminfo; total memory elsewhere); None if unknown."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return None
