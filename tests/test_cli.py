@@ -71,6 +71,12 @@ def test_help_lists_every_option():
         # the Taylor Gauss transform cannot evaluate a truncated kernel (gauss.py): this
         # combination must be refused as a bad setting, not crash mid-run
         (["--truncation", "3", "--transfer-method", "taylor"], ("--truncation", "--transfer-method")),
+        # checked before the run, not an OverflowError when the table is written
+        (["--seed", str(2**70)], "--seed"),
+        (["--seed", "-1"], "--seed"),
+        # more than the step limit: a clean exit 2, not a traceback
+        (["--dt0", "1e-9", "--dt-growth", "1"], "--dt0"),
+        (["--method", "fd", "--t-final", "1e9"], "--dt0"),
     ],
 )
 def test_bad_values_exit_2_name_the_option_and_write_nothing(tmp_path, bad, option):
@@ -166,3 +172,32 @@ def test_an_out_inside_a_file_is_refused_before_the_run(tmp_path):
     res = _small_run("--out", str(blocker / "run.parquet"))
     assert res.returncode == 2 and "cannot write" in res.stderr and "notes.txt" in res.stderr
     assert blocker.read_text() == "a file where a folder would be"
+
+
+def test_a_run_larger_than_the_memory_available_is_refused_before_it_starts(tmp_path, monkeypatch, capsys):
+    import particle_entropy.memory as memory
+    from particle_entropy.cli import main
+
+    monkeypatch.setattr(memory, "available_bytes", lambda: 200e6)  # a machine with 200 MB free
+    out = tmp_path / "x.parquet"
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", "--method", "pt", "--n", "100", "--t-final", "1", "--out", str(out), "--quiet"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "need about 0.30 GB" in err and "more than the 0.20 GB available" in err and "lower --n" in err
+    assert not out.exists()
+
+
+def test_memory_estimate_is_above_a_measured_peak(tmp_path):
+    """200,000 FD steps (one table row each): the estimate the CLI checks must bound the real peak."""
+    from particle_entropy.memory import estimate_bytes
+    from particle_entropy.runconfig import RunConfig
+
+    args = ["--method", "fd", "--n", "100", "--t-final", "1000", "--dt0", "0.005", "--quiet"]
+    proc = subprocess.Popen([sys.executable, "-m", "particle_entropy", "simulate", *args, "--out", str(tmp_path / "x")])
+    _, status, usage = os.wait4(proc.pid, 0)
+    assert status == 0
+    peak = usage.ru_maxrss * 1024  # Linux reports kB
+    estimate = estimate_bytes(RunConfig(method="fd", n=100, t_final=1000.0, dt0=0.005).resolved())
+    assert peak > 400e6  # the steps do cost memory (~1.9 kB each): the check is not vacuous
+    assert peak < estimate < 2 * peak

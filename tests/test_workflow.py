@@ -301,7 +301,10 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)  # no clean-up: jobs die mid-write or mid-run
     proc.wait()
     assert not (tmp_path / target).exists(), "the run finished before it could be killed"
-    snakemake(tmp_path, target, configfile=TINY)  # the same command again
+    again = snakemake(tmp_path, target, configfile=TINY, check=False)  # the killed run's lock is still there
+    assert again.returncode != 0 and "--unlock" in again.stdout + again.stderr
+    snakemake(tmp_path, "--unlock", configfile=TINY)  # README: after a kill -9, unlock, then the same command
+    snakemake(tmp_path, target, configfile=TINY)
     assert (tmp_path / target).read_bytes() == (tiny_run / target).read_bytes()
     for new in (tmp_path / "results/runs").rglob("*.parquet"):
         old = tiny_run / new.relative_to(tmp_path)
@@ -482,3 +485,72 @@ def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
     assert all(s.exists() for s in summaries)  # no good table was lost on the way
     again = snakemake(tiny_run, "-n", configfile=TINY)
     assert "Nothing to be done" in again.stdout + again.stderr
+
+
+# --- two runs, a failing job, a full disk ---------------------------------------------------
+
+
+def test_a_second_run_in_the_same_directory_is_refused_and_the_first_completes(tiny_run, tmp_path):
+    import time
+
+    target = "results/tables/comic.parquet"
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2", target]
+    first = subprocess.Popen([*cmd, "--configfile", str(TINY)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    locks = tmp_path / ".snakemake" / "locks"
+    deadline = time.time() + 120
+    while time.time() < deadline and not (locks.exists() and any(locks.iterdir())):
+        time.sleep(0.1)
+    second = snakemake(tmp_path, target, configfile=TINY, check=False)
+    out, _ = first.communicate(timeout=600)
+    assert second.returncode != 0 and "cannot be locked" in second.stdout + second.stderr
+    assert first.returncode == 0, out[-3000:]
+    assert (tmp_path / target).read_bytes() == (tiny_run / target).read_bytes()
+
+
+def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
+    log = tmp_path / "logs" / "plot" / "fig8.log"
+    log.mkdir(parents=True)  # the plot job cannot open its log: it fails as on a full disk, with no log
+    env = {**__import__("os").environ, "PARTICLE_ENTROPY_MIN_FREE_MB": "1e12"}  # every disk looks full
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2"]
+    full = subprocess.run(
+        [*cmd, "figures/fig8.png", "--configfile", str(TINY)], capture_output=True, text=True, env=env
+    )
+    assert full.returncode != 0
+    assert "No space left on device? The file system holding" in full.stderr
+    assert "rerun the same command" in full.stderr
+    plenty = snakemake(tmp_path, "figures/fig8.png", configfile=TINY, check=False)  # the real disk has room
+    assert plenty.returncode != 0 and "No space left" not in plenty.stdout + plenty.stderr
+
+
+def test_a_config_without_figures_judges_no_claim(tmp_path):
+    cfg = load(TINY)
+    cfg["figures"] = {}
+    for key in ("shear", "tradeoff", "mechanism"):
+        del cfg[key]
+    path = tmp_path / "none.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=True))
+    snakemake(tmp_path, configfile=path)
+    assert "No claim judged" in (tmp_path / "results/paper_claims.md").read_text()
+    assert list(pd.read_parquet(tmp_path / "results/tables/paper_claims.parquet").columns) == [
+        "claim",
+        "paper",
+        "reproduced",
+        "tolerance",
+        "passed",
+    ]
+
+
+def test_a_short_message_for_a_misspelt_key(tmp_path):
+    text = (ROOT / "config.yaml").read_text().replace("physics:", "physic:", 1)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "did you mean physics?" in out
+    assert len(out.splitlines()) < 12  # not the whole schema and config around the one useful line
+
+
+def test_a_yaml_error_in_config_yaml_names_its_line(tmp_path):
+    (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\nshear: {n: 10\n")
+    proc = snakemake(tmp_path, "-n", check=False)
+    assert proc.returncode != 0 and "config.yaml: not valid YAML at line" in proc.stdout + proc.stderr

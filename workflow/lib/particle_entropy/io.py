@@ -99,6 +99,8 @@ def table_problem(path: str | os.PathLike) -> str | None:
     """Why the table at ``path`` cannot be trusted, or None: its bytes differ from its recorded
     checksum, or (without one) it lacks the Parquet magic bytes at either end."""
     path = Path(path)
+    if not path.is_file():  # never read a pipe (it would block) or a folder
+        return "it is a folder, not a table" if path.is_dir() else "it is not a regular file"
     data = path.read_bytes()
     recorded = checksum_path(path)
     if recorded.exists():
@@ -111,7 +113,8 @@ def table_problem(path: str | os.PathLike) -> str | None:
 
 
 def corrupt_tables(root: str | os.PathLike) -> dict[Path, str]:
-    """Every table below ``root`` that cannot be trusted, with the reason."""
+    """Every table below ``root`` that cannot be trusted, with the reason (a folder, pipe or device
+    with a table's name included)."""
     root = Path(root)
     if not root.exists():
         return {}
@@ -127,6 +130,8 @@ def set_aside(path: str | os.PathLike) -> Path:
     """Move a corrupt table (and its checksum) to ``<name>.corrupt`` so that it is rebuilt."""
     path = Path(path)
     target = path.with_name(path.name + CORRUPT_SUFFIX)
+    if target.is_dir() and not target.is_symlink():  # an older copy set aside
+        shutil.rmtree(target)
     os.replace(path, target)
     checksum_path(path).unlink(missing_ok=True)
     return target
