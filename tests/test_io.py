@@ -96,3 +96,27 @@ def test_corrupt_tables_are_listed_and_set_aside(tmp_path):
     assert moved.name == "bad.parquet.corrupt" and moved.exists()
     assert not bad.exists() and not checksum_path(bad).exists()
     assert corrupt_tables(tmp_path) == {} and corrupt_tables(tmp_path / "missing") == {}
+
+
+def test_a_folder_or_pipe_with_a_table_name_is_set_aside_without_reading_it(tmp_path):
+    folder, pipe = tmp_path / "runs" / "a.parquet", tmp_path / "runs" / "b.parquet"
+    folder.mkdir(parents=True)
+    os.mkfifo(pipe)  # reading it would block for ever
+    found = corrupt_tables(tmp_path)
+    assert found == {folder: "it is a folder, not a table", pipe: "it is not a regular file"}
+    (tmp_path / "runs" / "a.parquet.corrupt").mkdir()  # an older copy set aside before
+    assert set_aside(folder).is_dir() and not folder.exists()
+    assert corrupt_tables(tmp_path) == {pipe: "it is not a regular file"}
+
+
+def test_a_nearly_full_disk_is_named(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    import particle_entropy.io as io
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(io.shutil, "disk_usage", lambda path: usage(10 * 2**30, 10 * 2**30 - 50 * 2**20, 50 * 2**20))
+    message = io.disk_space_problem(tmp_path)
+    assert message.startswith("No space left on device?") and "50 MB free" in message and str(tmp_path) in message
+    monkeypatch.setattr(io.shutil, "disk_usage", lambda path: usage(10 * 2**30, 2**30, 9 * 2**30))
+    assert io.disk_space_problem(tmp_path) is None
