@@ -2,15 +2,16 @@
 
 
 rule summarise_case:
-    """Averages the realisations of one case, step by step. A `run:` block: with the default
-    profile (force-use-threads) it runs inside the Snakemake process, saving a Python
-    start-up (~1 s of CPU) for each of the ~90 summaries."""
     input:
         summary_runs,
     output:
         SUMMARY_PATTERN,
     log:
         f"logs/summarise_case/{CASE_DIR}/r~{{nreal}}.log",
+    """Averages the realisations of one case, step by step. A `run:` block: with the default
+    profile (force-use-threads) it runs inside the Snakemake process, saving a Python
+    start-up (~1 s of CPU) for each of the ~90 summaries."""
+    localrule: True
     resources:
         mem_mb=500,
     params:
@@ -21,9 +22,6 @@ rule summarise_case:
 
 
 rule comic_tables:
-    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
-    per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each
-    N is the argmin, and the minima with their bootstrap intervals."""
     input:
         summaries=summaries_of("fig8", "fig9"),
         runs=runs_of("fig8", "fig9"),
@@ -34,6 +32,10 @@ rule comic_tables:
         argmin="results/tables/comic_argmin.parquet",
     log:
         "logs/comic_tables.log",
+    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
+    per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each
+    N is the argmin, and the minima with their bootstrap intervals."""
+    localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
     params:
@@ -44,8 +46,6 @@ rule comic_tables:
 
 
 rule comic_tables_section:
-    """A section's own COMIC tables (Fig. 9's, the mechanism sweeps'), so that its target pulls
-    only its own runs."""
     input:
         summaries=lambda w: summaries_of(w.section),
         runs=lambda w: runs_of(w.section),
@@ -58,6 +58,9 @@ rule comic_tables_section:
         "logs/comic_tables_{section}.log",
     wildcard_constraints:
         section="fig9|mechanism",
+    """A section's own COMIC tables (Fig. 9's, the mechanism sweeps'), so that its target pulls
+    only its own runs."""
+    localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
     params:
@@ -78,6 +81,7 @@ rule paper_claims:
         md="results/paper_claims.md",
     log:
         "logs/paper_claims.log",
+    localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
     params:
@@ -95,6 +99,7 @@ rule tradeoff_table:
         "results/tables/tradeoff.parquet",
     log:
         "logs/tradeoff_table.log",
+    localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
     params:

@@ -18,6 +18,7 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             data=FIGURE_DATA_PATTERN.format(fig=_fig),
         log:
             f"logs/plot/{_fig}.log",
+        localrule: True
         conda:
             "../../envs/particle-entropy.yaml"
         resources:

@@ -35,6 +35,7 @@ if "mechanism" in config:
             data=FIGURE_DATA_PATTERN.format(fig="fig9_mechanism"),
         log:
             "logs/plot/fig9_mechanism.log",
+        localrule: True
         conda:
             "../../envs/particle-entropy.yaml"
         resources:
