@@ -1,4 +1,5 @@
 # Config validation, the cases of every config section, target helpers and code versions.
+import os
 import re
 import sys
 from pathlib import Path
@@ -6,7 +7,13 @@ from pathlib import Path
 from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
-sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
+LIB = str(Path(workflow.basedir) / "workflow" / "lib")
+sys.path.insert(0, LIB)
+# Every job imports this checkout's library whatever its software environment (a venv, a conda
+# env built by --sdm conda, a cluster node): the environments hold only the dependencies.
+os.environ["PYTHONPATH"] = os.pathsep.join(
+    dict.fromkeys([LIB, *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))])
+)
 from particle_entropy.configcheck import check_schema, load_schema  # noqa: E402
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
