@@ -557,3 +557,85 @@ def test_a_yaml_error_in_config_yaml_names_its_line(tmp_path):
     (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\nshear: {n: 10\n")
     proc = snakemake(tmp_path, "-n", check=False)
     assert proc.returncode != 0 and "config.yaml: not valid YAML at line" in proc.stdout + proc.stderr
+
+
+# --- docs/columns.md: every column of every derived table is documented ----------------------
+
+COLUMN_DOCS_PAGE = ROOT / "docs" / "columns.md"
+
+
+def _path_regex(pattern):
+    """A table path of docs/columns.md as a regex: `<case>` is a case folder (several segments),
+    any other `<...>` one segment."""
+    parts = re.split(r"(<[^>]+>)", pattern)
+    body = "".join(".+" if p == "<case>" else "[^/]+" if p.startswith("<") else re.escape(p) for p in parts)
+    return re.compile(body)
+
+
+def _column_doc_sections():
+    """(heading, [(path pattern, regex)], documented columns) for every `## ` section of
+    docs/columns.md whose heading names `results/...` tables. Documented columns are the
+    backticked names in the first cell of the rows of a table headed `| column |`."""
+    sections = []
+    for block in re.split(r"^(?=## )", COLUMN_DOCS_PAGE.read_text(), flags=re.M):
+        if not block.startswith("## "):
+            continue
+        heading = block.splitlines()[0]
+        paths = [p for p in re.findall(r"`([^`]+)`", heading) if p.startswith("results/")]
+        if not paths:
+            continue
+        columns, in_table = set(), False
+        for line in block.splitlines()[1:]:
+            if not line.lstrip().startswith("|"):
+                in_table = False
+                continue
+            first = line.strip().strip("|").split("|")[0].strip()
+            if first == "column":
+                in_table = True
+            elif in_table and set(first) - set("-: "):
+                columns |= set(re.findall(r"`([^`]+)`", first))
+        sections.append((heading, [(p, _path_regex(p)) for p in paths], columns))
+    return sections
+
+
+def _section_of(rel, sections):
+    """The section of a table: the one whose path matches it with the fewest placeholders."""
+    hits = [(p.count("<"), s) for s in sections for p, rx in s[1] if rx.fullmatch(rel)]
+    assert hits, f"{rel}: no section of docs/columns.md names this table"
+    fewest = min(h[0] for h in hits)
+    best = {s[0]: s for k, s in hits if k == fewest}
+    assert len(best) == 1, f"{rel}: claimed by several sections: {sorted(best)}"
+    return next(iter(best.values()))
+
+
+def test_every_derived_table_column_is_documented(tiny_run):
+    import pyarrow.parquet as pq
+
+    if not (tiny_run / "results/figures/fig9_mechanism.parquet").exists():  # the mechanism tables too
+        snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+    sections = _column_doc_sections()
+    tables = sorted((tiny_run / "results").rglob("*.parquet"))
+    found = {}  # section heading -> {table: its columns}
+    for path in tables:
+        rel = path.relative_to(tiny_run).as_posix()
+        heading, _, documented = _section_of(rel, sections)
+        columns = [c for c in pq.read_schema(path).names if not c.startswith("__index_level_")]
+        missing = [c for c in columns if c not in documented]
+        assert not missing, f"{rel}: columns not documented under '{heading}': {missing}"
+        found.setdefault(heading, {})[rel] = set(columns)
+    for kind in ("results/tables/cases/", "results/runs/", "results/snapshots/", "results/shear/"):
+        assert any(rel.startswith(kind) for cols in found.values() for rel in cols), kind
+    for name in ("mechanism/floors", "mechanism/fd_domain", "mechanism/comic_minima", "fig9/comic"):
+        assert (tiny_run / f"results/tables/{name}.parquet").exists(), name
+    # no section without a table, and no documented column that no table of its section has
+    for heading, _, documented in sections:
+        assert heading in found, f"'{heading}': no table of the tiny run matches it"
+        stale = documented - set().union(*found[heading].values())
+        assert not stale, f"'{heading}' documents columns no such table has: {sorted(stale)}"
+    # the main tables, file by file: what the page says they hold, each of them holds
+    for name in ("comic", "comic_minima"):
+        rel = f"results/tables/{name}.parquet"
+        documented = _section_of(rel, sections)[2]
+        for copy in (rel, f"results/tables/fig9/{name}.parquet", f"results/tables/mechanism/{name}.parquet"):
+            absent = documented - found[_section_of(copy, sections)[0]][copy]
+            assert not absent, f"{copy}: documented but absent: {sorted(absent)}"
