@@ -16,6 +16,9 @@ if Path("config.yaml").exists():  # Snakemake's loader does not say where a YAML
 configfile: "config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/aggregate.smk"

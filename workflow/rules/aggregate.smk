@@ -30,6 +30,8 @@ rule comic_tables:
         minima="results/tables/comic_minima.parquet",
         realisations="results/tables/comic_realisations.parquet",
         argmin="results/tables/comic_argmin.parquet",
+        comic_html=report("results/tables/comic.html", caption="../report/comic.rst", category="COMIC"),
+        minima_html=report("results/tables/comic_minima.html", caption="../report/comic_minima.rst", category="COMIC"),
     log:
         "logs/comic_tables.log",
     """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
@@ -79,6 +81,7 @@ rule paper_claims:
     output:
         table="results/tables/paper_claims.parquet",
         md="results/paper_claims.md",
+        html=report("results/paper_claims.html", caption="../report/paper_claims.rst", category="Claims"),
     log:
         "logs/paper_claims.log",
     localrule: True

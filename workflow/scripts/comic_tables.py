@@ -1,13 +1,24 @@
 """COMIC statistics per model, N and time, the per-realisation values behind them, a bootstrap of
-where the COMIC minimum lies, and the N that minimises mean COMIC with its interval."""
+where the COMIC minimum lies, and the N that minimises mean COMIC with its interval. Where the rule
+asks for them, HTML copies of the COMIC table and the minima for `snakemake --report`."""
 
 import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+import html  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import pandas as pd  # noqa: E402
 
-from particle_entropy.aggregate import comic_argmin, comic_minima, comic_table, read_realisations  # noqa: E402
+from particle_entropy.aggregate import (  # noqa: E402
+    MINIMA_COLUMN_DOCS,
+    comic_argmin,
+    comic_minima,
+    comic_table,
+    read_realisations,
+)
+from particle_entropy.case import MODEL_COLUMNS  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
@@ -19,3 +30,26 @@ minima = comic_minima(comic, argmin)
 for table, path in ((comic, out.comic), (realisations, out.realisations), (argmin, out.argmin), (minima, out.minima)):
     write_parquet(table, path)
 print(minima.to_string(), file=sys.stderr)
+
+STYLE = (
+    "body{font-family:sans-serif;margin:1em;color:#222}table{border-collapse:collapse;font-size:13px}"
+    "th,td{border:1px solid #ccc;padding:3px 6px;text-align:right}td:first-child{text-align:left}dt{font-weight:bold}"
+)
+
+
+def write_html(table: pd.DataFrame, path: str, title: str, notes: str = "") -> None:
+    """A report copy of a table: the label names the model, so its dimension columns are left out."""
+    shown = table.drop(columns=list(MODEL_COLUMNS))
+    body = shown.to_html(index=False, border=0, float_format=lambda v: f"{v:.4g}", na_rep="")
+    Path(path).write_text(
+        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}</title>'
+        f"<style>{STYLE}</style></head>\n<body><h1>{title}</h1>\n{body}\n{notes}</body></html>\n"
+    )
+
+
+if "comic_html" in out.keys():
+    write_html(comic, out.comic_html, "COMIC per model, N and time")
+if "minima_html" in out.keys():
+    shown = [c for c in MINIMA_COLUMN_DOCS if c not in MODEL_COLUMNS]
+    notes = "<dl>" + "".join(f"<dt>{c}</dt><dd>{html.escape(MINIMA_COLUMN_DOCS[c])}</dd>" for c in shown) + "</dl>\n"
+    write_html(minima, out.minima_html, "N minimising mean COMIC", notes)

@@ -1,4 +1,5 @@
-"""Judge each quantitative claim of the paper against the reproduced tables."""
+"""Judge each quantitative claim of the paper against the reproduced tables; write them as Parquet,
+Markdown and an HTML page for `snakemake --report` (which renders HTML tables, not Markdown)."""
 
 import sys
 
@@ -6,6 +7,7 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from pathlib import Path  # noqa: E402
 
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from particle_entropy import claims as C  # noqa: E402
@@ -19,4 +21,21 @@ rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), 
 claims = C.claims_table(rows)
 write_parquet(claims, snakemake.output.table)  # noqa: F821
 Path(snakemake.output.md).write_text(C.to_markdown(claims))  # noqa: F821
+
+# The report's copy: the Markdown table's columns, result cells classed for colour; no timestamp.
+STYLE = (
+    "body{font-family:sans-serif;margin:1em;color:#222}table{border-collapse:collapse;font-size:13px}"
+    "th,td{border:1px solid #ccc;padding:3px 6px;text-align:left;vertical-align:top}"
+    "td.pass{color:#05612d}td.fail{color:#b00020;font-weight:bold}"
+)
+summary = C.to_markdown(claims).splitlines()[2]  # "k of n claims pass." (or why none is judged)
+shown = claims.assign(result=np.where(claims["passed"], "pass", "FAIL")).drop(columns="passed")
+table = shown.to_html(index=False, border=0, classes="claims")
+for verdict in ("pass", "FAIL"):
+    table = table.replace(f"<td>{verdict}</td>", f'<td class="{verdict.lower()}">{verdict}</td>')
+Path(snakemake.output.html).write_text(  # noqa: F821
+    '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>Paper claims</title>'
+    f"<style>{STYLE}</style></head>\n<body><h1>Paper claims: reproduced values</h1>\n<p>{summary}</p>\n"
+    f"{table}\n</body></html>\n"
+)
 print(claims.to_string(), file=sys.stderr)
