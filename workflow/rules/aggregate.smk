@@ -1,6 +1,9 @@
 # Ensembles -> per-step means and standard deviations; COMIC tables, minima, paper claims.
 
 
+# Averages the realisations of one case, step by step. A `run:` block: with the default
+# profile (force-use-threads) it runs inside the Snakemake process, saving a Python
+# start-up (~1 s of CPU) for each of the ~90 summaries.
 rule summarise_case:
     input:
         summary_runs,
@@ -8,9 +11,6 @@ rule summarise_case:
         SUMMARY_PATTERN,
     log:
         f"logs/summarise_case/{CASE_DIR}/r~{{nreal}}.log",
-    """Averages the realisations of one case, step by step. A `run:` block: with the default
-    profile (force-use-threads) it runs inside the Snakemake process, saving a Python
-    start-up (~1 s of CPU) for each of the ~90 summaries."""
     localrule: True
     resources:
         mem_mb=500,
@@ -21,6 +21,9 @@ rule summarise_case:
         Path(log[0]).write_text(f"summarised {count} realisations\n")
 
 
+# COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
+# per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each
+# N is the argmin, and the minima with their bootstrap intervals.
 rule comic_tables:
     input:
         summaries=summaries_of("fig8", "fig9"),
@@ -34,9 +37,6 @@ rule comic_tables:
         minima_html=report("results/tables/comic_minima.html", caption="../report/comic_minima.rst", category="COMIC"),
     log:
         "logs/comic_tables.log",
-    """COMIC per model, N and time over the COMIC models: FD (Fig. 8) and Fig. 9's models; the
-    per-realisation SSE and COMIC at those times, a bootstrap over realisations of how often each
-    N is the argmin, and the minima with their bootstrap intervals."""
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
@@ -47,6 +47,8 @@ rule comic_tables:
         "../scripts/comic_tables.py"
 
 
+# A section's own COMIC tables (Fig. 9's, the mechanism sweeps'), so that its target pulls
+# only its own runs.
 rule comic_tables_section:
     input:
         summaries=lambda w: summaries_of(w.section),
@@ -60,8 +62,6 @@ rule comic_tables_section:
         "logs/comic_tables_{section}.log",
     wildcard_constraints:
         section="fig9|mechanism",
-    """A section's own COMIC tables (Fig. 9's, the mechanism sweeps'), so that its target pulls
-    only its own runs."""
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"

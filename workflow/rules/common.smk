@@ -1,5 +1,4 @@
 # Config validation, the cases of every config section, target helpers and code versions.
-import os
 import re
 import sys
 from pathlib import Path
@@ -9,11 +8,9 @@ from snakemake.utils import validate
 
 LIB = str(Path(workflow.basedir) / "workflow" / "lib")
 sys.path.insert(0, LIB)
-# Every job imports this checkout's library whatever its software environment (a venv, a conda
-# env built by --sdm conda, a cluster node): the environments hold only the dependencies.
-os.environ["PYTHONPATH"] = os.pathsep.join(
-    dict.fromkeys([LIB, *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))])
-)
+from particle_entropy.codeversion import export_library_path  # noqa: E402
+
+export_library_path(LIB)  # jobs import this checkout's library in any software environment
 from particle_entropy.configcheck import check_schema, load_schema  # noqa: E402
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"

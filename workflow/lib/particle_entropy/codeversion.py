@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import functools
 import hashlib
+import os
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent
@@ -53,3 +54,13 @@ def code_version(*entries: str, exclude=(), files=(), package: Path = PACKAGE) -
     for name, path in parts + [(Path(f).name, Path(f)) for f in files]:
         h.update(name.encode() + b"\0" + Path(path).read_bytes() + b"\0")
     return h.hexdigest()[:16]
+
+
+def export_library_path(lib: str | Path) -> str:
+    """Put ``lib`` first on PYTHONPATH for every job this process starts (once): jobs then import
+    this checkout's library in any software environment (a venv, a conda env built by --sdm
+    conda, a cluster node, where the plugin passes the environment on); the environments hold
+    only the dependencies. Returns the new PYTHONPATH."""
+    parts = [str(lib), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    os.environ["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(parts))
+    return os.environ["PYTHONPATH"]
