@@ -122,3 +122,14 @@ def test_mtpt_simulation_closure_holds_mass_transfer():
     assert code_version("simulate", "mtpt", exclude={"pt", "fd"}) != code_version(
         "simulate", "fd", exclude={"pt", "mtpt"}
     )
+
+
+def test_library_path_is_exported_first_and_once(monkeypatch, tmp_path):
+    import os
+
+    from particle_entropy.codeversion import export_library_path
+
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(["/elsewhere", str(tmp_path)]))
+    export_library_path(tmp_path)
+    export_library_path(tmp_path)  # a job re-parsing the Snakefile exports it again
+    assert os.environ["PYTHONPATH"].split(os.pathsep) == [str(tmp_path), "/elsewhere"]
