@@ -1,0 +1,156 @@
+"""The adaptive COMIC optimum search (optimum.py) on synthetic COMIC curves with a known minimum:
+it brackets the true optimum, respects its budget, refines near the minimum only, replicates
+where neighbours are not resolved, and (FD) needs one run per N."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from particle_entropy.case import Case, SettingError
+from particle_entropy.optimum import (
+    PLAN_COLUMNS,
+    REASONS,
+    RESULT_COLUMNS,
+    Search,
+    grid,
+    initial_plan,
+    next_plan,
+    result_table,
+    runs_in,
+)
+
+N_STAR = 1000.0  # the synthetic curve's minimum
+
+
+def comic(n, seed, noise):
+    """A smooth COMIC curve in log N with its minimum at N_STAR, plus per-seed noise."""
+    rng = np.random.default_rng([int(n), int(seed)])
+    return 2.0 * (math.log(n) - math.log(N_STAR)) ** 2 + noise * rng.standard_normal()
+
+
+def realisations_of(plan, noise):
+    rows = [
+        (n, s, comic(n, s, noise))
+        for _, b in plan.iterrows()
+        for n in [int(b["n"])]
+        for s in range(b["first"], b["last"] + 1)
+    ]
+    return pd.DataFrame(rows, columns=["n", "seed", "COMIC"])
+
+
+def run_search(search, noise, base_seed=0):
+    plan = initial_plan(search, base_seed)
+    while not plan["done"].any():
+        plan = next_plan(search, plan, realisations_of(plan, noise))
+    return plan
+
+
+def mtpt(**kw):
+    return Search(name="t", model=Case("mtpt", "collision", None), time=1000.0, n_lo=30, n_hi=30000, **kw)
+
+
+def fd(**kw):
+    return Search(name="t", model=Case("fd", "implicit", None), time=250.0, n_lo=30, n_hi=30000, **kw)
+
+
+def test_grid_is_geometric_with_both_ends_and_even_for_fd():
+    assert grid(30, 30000, 4) == [30, 300, 3000, 30000]
+    assert all(n % 2 == 0 for n in grid(31, 3001, 7, fd=True))
+    assert grid(10, 12, 5) == [10, 11, 12]  # rounding merges points: each N once
+
+
+def test_first_round_is_the_coarse_grid_with_the_first_seeds():
+    plan = initial_plan(mtpt(initial_points=4, initial_realisations=3), base_seed=7)
+    assert list(plan.columns) == PLAN_COLUMNS
+    assert plan["n"].tolist() == [30, 300, 3000, 30000]
+    assert (plan["first"] == 7).all() and (plan["last"] == 9).all() and runs_in(plan) == 12
+
+
+def test_fd_brackets_the_minimum_within_the_width_with_one_run_per_n():
+    search = fd(width=1.5, budget_runs=40)
+    plan = run_search(search, noise=0.0)
+    assert plan["reason"].iloc[-1] == "bracket narrow enough"
+    assert (plan["last"] == plan["first"]).all()  # deterministic: one run per N
+    table = realisations_of(plan, 0.0)
+    _, n_opt, lo, hi = _bracket(search, plan, table)
+    assert lo <= N_STAR <= hi and hi / lo <= 1.5
+    assert runs_in(plan) <= 40
+
+
+def _bracket(search, plan, table):
+    costs = table.assign(core_s=table["n"] * 1e-3)
+    out = result_table(search, plan, table, costs)
+    row = out.iloc[0]
+    return out, int(row["n_opt"]), int(row["bracket_lo"]), int(row["bracket_hi"])
+
+
+@pytest.mark.parametrize("noise", [0.05, 0.3])
+def test_noisy_search_brackets_the_true_minimum_within_budget(noise):
+    search = mtpt(width=3.0, budget_runs=300)
+    plan = run_search(search, noise)
+    table = realisations_of(plan, noise)
+    out, n_opt, lo, hi = _bracket(search, plan, table)
+    assert lo <= N_STAR <= hi
+    assert runs_in(plan) <= 300
+    assert plan["reason"].iloc[-1] in REASONS
+    if plan["reason"].iloc[-1] == "bracket narrow enough":
+        assert hi / lo <= 3.0
+    # refinement concentrates near the minimum: every N added after round 0 lies within a decade of it
+    added = plan.loc[plan["round"] > 0, "n"]
+    assert len(added) and (abs(np.log10(added / N_STAR)) <= 1.0).all()
+    assert list(out.columns) == RESULT_COLUMNS
+
+
+def test_unresolved_neighbours_get_more_realisations():
+    search = mtpt(width=1.2, budget_runs=1000, max_realisations=32)
+    plan = run_search(search, noise=1.0)  # noise comparable to the curve near its minimum
+    counts = plan.assign(r=plan["last"] - plan["first"] + 1).groupby("n")["r"].sum()
+    assert counts.max() > search.initial_realisations  # some N were replicated
+    assert counts.max() <= search.max_realisations
+    # seeds of one N are consecutive blocks: base, base + 4, base + 8, ... never reused
+    for _, g in plan.groupby("n"):
+        g = g.sort_values("first")
+        assert (g["first"].iloc[1:].to_numpy() == g["last"].iloc[:-1].to_numpy() + 1).all()
+
+
+def test_a_small_budget_stops_the_search_and_is_never_exceeded():
+    search = mtpt(width=1.2, budget_runs=30)
+    plan = run_search(search, noise=0.3)
+    assert plan["reason"].iloc[-1] == "budget spent"
+    assert runs_in(plan) <= 30
+
+
+def test_full_sweep_estimate_is_a_grid_giving_the_same_bracket():
+    search = fd(width=1.5, budget_runs=40)
+    plan = run_search(search, noise=0.0)
+    table = realisations_of(plan, 0.0)
+    out, _, lo, hi = _bracket(search, plan, table)
+    step = math.sqrt(hi / lo)  # a grid of this step brackets its minimum as narrowly
+    sweep = grid(30, 30000, math.ceil(math.log(1000) / math.log(step)) + 1, fd=True)
+    # the cost per run is 1e-3 N exactly, so the interpolated estimate is exact
+    assert out["full_sweep_core_s"].iloc[0] == pytest.approx(1e-3 * sum(sweep), rel=1e-9)
+    assert out["core_s_spent"].iloc[0] < out["full_sweep_core_s"].iloc[0] / 3
+
+
+@pytest.mark.parametrize(
+    "spec,key",
+    [
+        ({"n_range": [100, 100]}, "n_range"),
+        ({"n_range": [300, 30]}, "n_range"),
+        ({"budget_runs": 10}, "budget_runs"),
+        ({"time": 5000}, "time"),
+        ({"width": 1.0}, "width"),
+        ({"initial_points": 2}, "initial_points"),
+        ({"case": {"method": "pt", "kernel": "sph"}}, "case.kernel"),
+    ],
+)
+def test_bad_searches_are_refused_naming_the_key(spec, key):
+    config = {"physics": {"t_final": 1000}}
+    base = {"case": {"method": "mtpt", "kernel": "collision"}, "time": 1000, "n_range": [30, 30000], "budget_runs": 100}
+    with pytest.raises(SettingError) as err:
+        Search.from_config("s", {**base, **spec}, config)
+    assert err.value.name == f"optimum.s.{key}"
