@@ -154,3 +154,18 @@ def test_bad_searches_are_refused_naming_the_key(spec, key):
     with pytest.raises(SettingError) as err:
         Search.from_config("s", {**base, **spec}, config)
     assert err.value.name == f"optimum.s.{key}"
+
+
+def test_the_error_convention_can_move_the_optimum():
+    """Mean of per-run COMIC (a mean of logs) against COMIC of the mean SSE (the log of a mean):
+    rare large errors weigh little in the first and much in the second."""
+    from particle_entropy.optimum import evaluate
+
+    sse = {100: [1.0, 1.0, 1.0, 1.0], 300: [0.01, 0.01, 0.01, 10.0], 1000: [2.0, 2.0, 2.0, 2.0]}
+    rows = [
+        (n, s, v, 2 * math.log(v / 50.0) - math.log(0.1), 50, 0.1) for n, vs in sse.items() for s, v in enumerate(vs)
+    ]
+    table = pd.DataFrame(rows, columns=["n", "seed", "SSE", "COMIC", "n_sse", "dV"])
+    _, by_comic = evaluate(mtpt(), table)
+    _, by_sse = evaluate(mtpt(convention="COMIC_of_mean_SSE"), table)
+    assert by_comic["n_opt"] == 300 and by_sse["n_opt"] == 100

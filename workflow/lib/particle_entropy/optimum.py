@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .aggregate import argmin_bootstrap
+from .aggregate import CONVENTIONS, argmin_bootstrap
 from .case import Case, SettingError
 
 MAX_ROUNDS = 12  # a search that has not converged by then stops ("round limit")
@@ -37,6 +37,7 @@ RESULT_COLUMN_DOCS = {
     "search": "name of the search (config key under `optimum`)",
     "label": "legend label of the searched model",
     "time": "time at which COMIC is judged [T]",
+    "convention": "what is minimised over N: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
     "n": "a visited N (particles; FD: intervals)",
     "realisations": "realisations of this N",
     "round_added": "round in which this N was first visited (0 = the coarse grid)",
@@ -45,7 +46,7 @@ RESULT_COLUMN_DOCS = {
     "COMIC_se": "standard error of the mean (std / sqrt(realisations); 0 for FD)",
     "share": "fraction of bootstrap resamples whose argmin is this N",
     "core_s": "measured wall time of this N's runs, summed over realisations (step timings) [s]",
-    "n_opt": "N of the smallest mean COMIC",
+    "n_opt": "N minimising the search's convention (mean COMIC unless set otherwise)",
     "ci_lo": "lower end of the 95 % bootstrap interval of the argmin (a visited N)",
     "ci_hi": "its upper end",
     "bracket_lo": "visited N just below ci_lo (the range end if none): the minimum lies above it",
@@ -78,6 +79,7 @@ class Search:
     initial_realisations: int = 4
     max_realisations: int = 64
     min_step: float = 1.1  # no two visited N closer than this ratio
+    convention: str = "mean_COMIC"  # or COMIC_of_mean_SSE (aggregate.CONVENTIONS): what is minimised
 
     @property
     def fd(self) -> bool:
@@ -108,6 +110,7 @@ class Search:
             initial_points=int(spec.get("initial_points", cls.initial_points)),
             initial_realisations=int(spec.get("realisations", cls.initial_realisations)),
             max_realisations=int(spec.get("max_realisations", cls.max_realisations)),
+            convention=str(spec.get("convention", cls.convention)),
         )
         search.check(where, float(config["physics"]["t_final"]))
         return search
@@ -122,6 +125,8 @@ class Search:
             raise SettingError(f"{where}.time", self.time, f"a time in (0, physics.t_final = {t_final:g}]")
         if not self.width > self.min_step:
             raise SettingError(f"{where}.width", self.width, f"a ratio n_hi / n_lo > {self.min_step}")
+        if self.convention not in CONVENTIONS:
+            raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
         if self.initial_points < 3:
             raise SettingError(f"{where}.initial_points", self.initial_points, "an integer >= 3 (a minimum needs 3)")
         if self.max_realisations < self.initial_realisations:
@@ -163,20 +168,30 @@ def runs_in(plan: pd.DataFrame) -> int:
 
 def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
     """Per-N statistics (n, realisations, COMIC_mean, COMIC_std, COMIC_se, share) and the
-    search-level optimum (n_opt, ci_lo, ci_hi, bracket_lo, bracket_hi) from per-realisation
-    COMIC (columns n, seed, COMIC: aggregate.realisations_table at the search's time)."""
+    search-level optimum (n_opt, ci_lo, ci_hi, bracket_lo, bracket_hi) of the search's
+    convention, from per-realisation values (columns n, seed, COMIC; for COMIC_of_mean_SSE also
+    SSE, n_sse, dV: aggregate.realisations_table at the search's time)."""
     per_n = [g for _, g in realisations.groupby("n", sort=True)]
     ns = [int(g["n"].iloc[0]) for g in per_n]
     samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_n]
-    shares, lo, hi, _ = argmin_bootstrap(samples)
+    if search.convention == "COMIC_of_mean_SSE":  # Eq. 43 of the mean SSE: the paper warns it can move the optimum
+        n_sse = np.array([float(g["n_sse"].iloc[0]) for g in per_n])[:, None]
+        dV = np.array([float(g["dV"].iloc[0]) for g in per_n])[:, None]
+        objective = lambda means: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)  # noqa: E731
+        minimised = objective(np.array([g["SSE"].mean() for g in per_n])[:, None])[:, 0]
+        shares, lo, hi, _ = argmin_bootstrap([g["SSE"].to_numpy(dtype=np.float64) for g in per_n], objective)
+    else:
+        shares, lo, hi, _ = argmin_bootstrap(samples)
     means = np.array([s.mean() for s in samples])
+    if search.convention == "mean_COMIC":
+        minimised = means
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])
     counts = np.array([len(s) for s in samples])
     se = np.where(counts > 1, stds / np.sqrt(counts), 0.0)
     table = pd.DataFrame(
         {"n": ns, "realisations": counts, "COMIC_mean": means, "COMIC_std": stds, "COMIC_se": se, "share": shares}
     )
-    i_opt = int(np.argmin(means))
+    i_opt = int(np.argmin(minimised))
     optimum = {
         "n_opt": ns[i_opt],
         "ci_lo": ns[lo],
@@ -259,6 +274,7 @@ def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame,
         search=search.name,
         label=search.model.label(),
         time=search.time,
+        convention=search.convention,
         **opt,
         reason=str(plan["reason"].iloc[-1]),
         rounds=int(plan["round"].max()) + 1,
