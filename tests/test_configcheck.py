@@ -106,6 +106,22 @@ BAD = [
         _add_case("fig9", {"method": "mtpt", "kernel": "collision", "scheme": "compensated"}),
         ["figures.fig9.cases[", "scheme='compensated'"],
     ),
+    (
+        "optimum empty range",
+        _set(("optimum", "fd_t250", "n_range"), [100, 100]),
+        ["optimum.fd_t250.n_range", "low < high"],
+    ),
+    (
+        "optimum budget below one round",
+        _set(("optimum", "collision_eta1", "budget_runs"), 10),
+        ["optimum.collision_eta1.budget_runs=10", "first round's 20 runs"],
+    ),
+    (
+        "optimum case that does not exist",
+        _set(("optimum", "collision_eta1", "case"), {"method": "pt", "kernel": "sph"}),
+        ["optimum.collision_eta1.case.kernel='sph'", "bins, fixed, adaptive"],
+    ),
+    ("optimum time past t_final", _set(("optimum", "fd_t250", "time"), 2000), ["optimum.fd_t250.time=2000", "t_final"]),
 ]
 
 

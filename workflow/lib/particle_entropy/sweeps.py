@@ -218,21 +218,80 @@ def check_shear(config: Mapping) -> None:
             raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
 
 
+def optimum_searches(config: Mapping) -> dict:
+    """The adaptive COMIC searches of config `optimum` (optimum.Search), by name."""
+    from .optimum import Search
+
+    return {name: Search.from_config(name, spec, config) for name, spec in config.get("optimum", {}).items()}
+
+
+def optimum_largest_jobs(config: Mapping) -> list[tuple[str, Ensemble]]:
+    """Per search, its largest possible simulation job: the top of its N range with the most seeds
+    one block can hold (the first round's realisations, or a doubling up to max_realisations)."""
+    from .optimum import grid
+
+    out = []
+    for name, search in optimum_searches(config).items():
+        seeds = 1 if search.fd else max(search.initial_realisations, search.max_realisations // 2)
+        top = grid(search.n_lo, search.n_hi, 2, search.fd)[-1]
+        out.append((f"optimum.{name}.n_range", Ensemble(search.model.at(top), seeds)))
+    return out
+
+
 def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job must fit in ``available`` bytes (memory.estimate_mb of its seed block)."""
     from .memory import estimate_mb
 
-    for name, spec in case_sections(config).items():
-        for ens in spec_ensembles(spec, config):
-            runs = max(b - a + 1 for a, b in seed_blocks(ens, config))
-            need = estimate_mb(run_config(ens.case, config), runs) * 2**20
-            if need > available:
-                raise SettingError(
-                    f"{name}.n",
-                    ens.case.n,
-                    f"an N whose job fits in this machine's memory: {ens.case.label()} needs about "
-                    f"{need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available (or run it on a cluster)",
-                )
+    jobs = [
+        (f"{name}.n", ens, max(b - a + 1 for a, b in seed_blocks(ens, config)))
+        for name, spec in case_sections(config).items()
+        for ens in spec_ensembles(spec, config)
+    ]
+    jobs += [(key, ens, ens.realisations) for key, ens in optimum_largest_jobs(config)]
+    for key, ens, runs in jobs:
+        need = estimate_mb(run_config(ens.case, config), runs) * 2**20
+        if need > available:
+            raise SettingError(
+                key,
+                ens.case.n,
+                f"an N whose job fits in this machine's memory: {ens.case.label()} needs about "
+                f"{need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available (or run it on a cluster)",
+            )
+
+
+def _case_error(e: SettingError, where: str, case: Case) -> SettingError:
+    """A SettingError of one case's run, named by its config key: a shared setting (time.dt0, ...)
+    names that key and the case, any other the case's own key under ``where``."""
+    if e.name in SHARED_KEYS:
+        key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
+        return SettingError(key, e.value, f"{e.allowed} (for {where}, {case.label()})")
+    return SettingError(f"{where}.{e.name}", e.value, e.allowed)
+
+
+def check_optimum(config: Mapping) -> None:
+    """Every adaptive search (config `optimum`) must be able to run: a model that exists, a range
+    with room for a minimum, a budget of at least its first round, a time within t_final
+    (optimum.Search.check), runs valid at both ends of its range and seeds within int64."""
+    from .optimum import grid
+
+    base = int(config["base_seed"])
+    for name, search in optimum_searches(config).items():
+        where = f"optimum.{name}"
+        for n in grid(search.n_lo, search.n_hi, 2, search.fd):  # the range's ends (FD: even)
+            case = search.model.at(n)
+            try:
+                run_config(case, config)
+            except SettingError as e:
+                if e.name == "n":
+                    raise SettingError(f"{where}.n_range", [search.n_lo, search.n_hi], e.allowed) from None
+                raise _case_error(e, f"{where}.case", case) from None
+        if base + search.max_realisations - 1 > MAX_SEED:
+            raise SettingError(
+                "base_seed",
+                base,
+                f"an integer in [0, {MAX_SEED - search.max_realisations + 1}]: {where} runs seeds to "
+                f"base_seed + {search.max_realisations - 1}, stored as int64",
+            )
 
 
 def check_sweeps(config: Mapping) -> None:
@@ -272,6 +331,7 @@ def check_sweeps(config: Mapping) -> None:
     check_lattice(config)
     check_seeds(config)
     check_shear(config)
+    check_optimum(config)
     t_final = float(config["physics"]["t_final"])
     for key, times in (
         ("comic_times", config.get("comic_times", [])),
