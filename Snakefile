@@ -25,6 +25,7 @@ include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/shear.smk"
 include: "workflow/rules/mechanism.smk"
+include: "workflow/rules/optimum.smk"
 
 
 rule all:

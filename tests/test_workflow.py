@@ -639,3 +639,30 @@ def test_every_derived_table_column_is_documented(tiny_run):
         for copy in (rel, f"results/tables/fig9/{name}.parquet", f"results/tables/mechanism/{name}.parquet"):
             absent = documented - found[_section_of(copy, sections)[0]][copy]
             assert not absent, f"{copy}: documented but absent: {sorted(absent)}"
+
+
+def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
+    from particle_entropy.optimum import REASONS, RESULT_COLUMNS, Search
+
+    cfg = load(TINY)
+    snakemake(tiny_run, "optimum", configfile=TINY)
+    for name, spec in cfg["optimum"].items():
+        search = Search.from_config(name, spec, cfg)
+        for ext in ("png", "pdf"):
+            assert (tiny_run / f"figures/optimum_{name}.{ext}").stat().st_size > 5000
+        table = pd.read_parquet(tiny_run / f"results/optimum/{name}.parquet")
+        assert list(table.columns) == RESULT_COLUMNS
+        row = table.iloc[0]
+        assert row["runs_spent"] <= spec["budget_runs"] and row["reason"] in REASONS, row
+        assert search.n_lo <= row["n_opt"] <= search.n_hi
+        assert row["bracket_lo"] <= row["ci_lo"] <= row["n_opt"] <= row["ci_hi"] <= row["bracket_hi"]
+        assert row["rounds"] >= 2, "the tiny searches refine at least once"  # the checkpoint chain ran
+        for k in range(int(row["rounds"])):
+            assert (tiny_run / f"results/optimum/{name}/round~{k}.parquet").exists(), k
+        plan = pd.read_parquet(tiny_run / f"results/optimum/{name}/round~{int(row['rounds'])}.parquet")
+        assert plan["done"].all() and sorted(set(plan["n"])) == sorted(table["n"])
+        assert int(table["realisations"].sum()) == int(row["runs_spent"])
+        for r in plan.itertuples():  # every block is an ordinary simulation table
+            assert (tiny_run / run_path(search.model.at(r.n), r.first, r.last)).exists(), r
+    proc = snakemake(tiny_run, "-n", "optimum", configfile=TINY)
+    assert "Nothing to be done" in proc.stdout + proc.stderr

@@ -3,6 +3,7 @@ import re
 import sys
 from pathlib import Path
 
+import pandas as pd
 from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
@@ -22,6 +23,7 @@ from particle_entropy.case import Case  # noqa: E402
 from particle_entropy.codeversion import code_version  # noqa: E402
 from particle_entropy.io import CORRUPT_SUFFIX, corrupt_tables, set_aside  # noqa: E402
 from particle_entropy.memory import available_bytes, estimate_mb  # noqa: E402
+from particle_entropy.optimum import MAX_ROUNDS  # noqa: E402
 from particle_entropy.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES  # noqa: E402
 from particle_entropy.sweeps import (  # noqa: E402
     CASE_DIR,
@@ -37,6 +39,7 @@ from particle_entropy.sweeps import (  # noqa: E402
     figure_ensembles,
     lattice_cases,
     mechanism_ensembles,
+    optimum_searches,
     run_config,
     run_path,
     run_settings,
@@ -44,6 +47,7 @@ from particle_entropy.sweeps import (  # noqa: E402
 )
 
 check_sweeps(config)
+OPTIMUM = optimum_searches(config)  # the adaptive COMIC searches (workflow/rules/optimum.smk), by name
 if workflow.is_main_process and workflow.local_exec:  # jobs run here: each must fit in this machine's memory
     check_memory(config, available_bytes())
 
@@ -152,6 +156,39 @@ def runs_of(*sections):
     return list(dict.fromkeys(p for s in sections for e in ensembles(s) for p in case_run_paths(e, config)))
 
 
+def optimum_settings(wildcards):
+    """What a search needs besides its own section: case_defaults and t_final (Search.from_config)."""
+    return {"case_defaults": config.get("case_defaults", {}), "physics": {"t_final": config["physics"]["t_final"]}}
+
+
+def optimum_plan_runs(name, plan):
+    """The run tables of every seed block of a plan."""
+    model = OPTIMUM[name].model
+    return [run_path(model.at(int(r.n)), int(r.first), int(r.last)) for r in plan.itertuples()]
+
+
+def optimum_round_inputs(wildcards):
+    """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
+    k = int(wildcards.k)
+    if k == 0:
+        return {}
+    path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k - 1)).output[0]
+    plan = pd.read_parquet(path)
+    if plan["done"].any():
+        raise ValueError(f"optimum search {wildcards.name} stopped at round {k - 1}: there is no round {k}")
+    return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
+
+
+def optimum_final_inputs(wildcards):
+    """The first finished plan of a search and its runs: rounds are requested one at a time."""
+    for k in range(MAX_ROUNDS + 2):  # next_plan stops by round MAX_ROUNDS + 1
+        path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k)).output[0]
+        plan = pd.read_parquet(path)
+        if plan["done"].all():
+            return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
+    raise ValueError(f"optimum search {wildcards.name}: no finished plan after {MAX_ROUNDS + 2} rounds")
+
+
 def sim_mem_mb(wildcards):
     """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
     seeds = int(wildcards.last) - int(wildcards.first) + 1
@@ -184,3 +221,6 @@ SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10
 MECHANISM_PLOT_CODE = code_version("plots_mechanism", "io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
 FD_DOMAIN_CODE = code_version("fd_domain", "io", files=[SCRIPTS / "fd_domain.py"])
 LATTICE_CODE = code_version("lattice", "io", files=[SCRIPTS / "mechanism_floors.py"])
+OPTIMUM_ROUND_CODE = code_version("optimum", "io", files=[SCRIPTS / "optimum_round.py"])
+OPTIMUM_TABLE_CODE = code_version("optimum", "io", files=[SCRIPTS / "optimum_table.py"])
+OPTIMUM_PLOT_CODE = code_version("plots_optimum", "io", files=[SCRIPTS / "plot_optimum.py"])

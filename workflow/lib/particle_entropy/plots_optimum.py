@@ -1,0 +1,114 @@
+"""figures/optimum_<name>.png: an adaptive COMIC search (optimum.py) drawn from its result table.
+
+Mean COMIC +-1 standard error of every visited N on a log N axis, coloured by the round that
+added it and labelled with its realisations; the bracket of the optimum (light band) and the
+bootstrap interval of the argmin (dark band) shaded, a star at n_opt; below the axes, the runs
+and core-seconds spent against a full grid sweep resolving the same bracket, and why it stopped.
+"""
+
+from __future__ import annotations
+
+import matplotlib
+import numpy as np
+import pandas as pd
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+from .plots import BLACK, GREY, VERMILLION, _figure, _look
+
+BRACKET, INTERVAL = "#DCE9F5", "#9DC3E6"  # light and dark blue bands
+
+
+def _round_colours(rounds) -> dict[int, tuple]:
+    """An ordered colour per round (viridis): early rounds dark, late rounds light."""
+    rounds = sorted({int(r) for r in rounds})
+    cmap = matplotlib.colormaps["viridis"]
+    return {r: cmap(0.85 * i / max(len(rounds) - 1, 1)) for i, r in enumerate(rounds)}
+
+
+def _span(ax, lo: float, hi: float, colour: str) -> None:
+    """A vertical band from lo to hi; a single N gets a thin band around it (2 % either side)."""
+    if hi <= lo:
+        lo, hi = lo / 1.02, hi * 1.02
+    ax.axvspan(lo, hi, color=colour, zorder=0, linewidth=0)
+
+
+def _seconds(s: float) -> str:
+    """12,345 or 12.3 or 0.0331: whole seconds when large, three digits when small."""
+    return f"{s:,.0f}" if s >= 100 else f"{s:.3g}"
+
+
+def cost_text(row: pd.Series) -> str:
+    """'38 runs, 12.3 core-s (9% of a full sweep's ~137 core-s); 4 rounds; stopped: budget spent'."""
+    spent, full = float(row["core_s_spent"]), float(row["full_sweep_core_s"])
+    share = f"{spent / full:.0%} of" if full > 0 else "vs"
+    return (
+        f"{int(row['runs_spent'])} runs, {_seconds(spent)} core-s ({share} a full sweep's ~{_seconds(full)} core-s); "
+        f"{int(row['rounds'])} round{'s' if int(row['rounds']) != 1 else ''}; stopped: {row['reason']}"
+    )
+
+
+def optimum_figure(table: pd.DataFrame):
+    """The figure of one finished search (optimum.RESULT_COLUMNS, one row per visited N)."""
+    fig, (ax,) = _figure(1, width=7.0, height=4.6)
+    t = table.sort_values("n")
+    first = t.iloc[0]
+    _span(ax, float(first["bracket_lo"]), float(first["bracket_hi"]), BRACKET)
+    _span(ax, float(first["ci_lo"]), float(first["ci_hi"]), INTERVAL)
+    ax.plot(t["n"], t["COMIC_mean"], color=GREY, linewidth=0.8, zorder=1)
+    colours = _round_colours(t["round_added"])
+    size = 4.0 + 2.0 * np.sqrt(t["realisations"].to_numpy(float))  # marker area grows with realisations
+    for (_, row), ms in zip(t.iterrows(), size):
+        colour = colours[int(row["round_added"])]
+        ax.errorbar(
+            row["n"],
+            row["COMIC_mean"],
+            yerr=row["COMIC_se"] if np.isfinite(row["COMIC_se"]) else None,
+            color=colour,
+            marker="o",
+            markersize=ms,
+            markeredgecolor=BLACK,
+            markeredgewidth=0.5,
+            capsize=2.5,
+            zorder=3,
+        )
+        ax.annotate(
+            f"{int(row['realisations'])}",
+            (row["n"], row["COMIC_mean"]),
+            textcoords="offset points",
+            xytext=(ms / 2 + 3, 2),
+            ha="left",
+            va="bottom",
+            fontsize=7,
+            color="0.25",
+        )
+    best = t[t["n"] == first["n_opt"]].iloc[0]
+    ax.plot(best["n"], best["COMIC_mean"], marker="*", markersize=16, color=VERMILLION, markeredgecolor=BLACK, zorder=4)
+    handles = [
+        Line2D([], [], linestyle="", marker="o", color=c, markeredgecolor=BLACK, label=f"added in round {r}")
+        for r, c in colours.items()
+    ]
+    handles += [
+        Line2D(
+            [],
+            [],
+            linestyle="",
+            marker="*",
+            markersize=12,
+            color=VERMILLION,
+            markeredgecolor=BLACK,
+            label=f"optimum N = {int(first['n_opt']):,}",
+        ),
+        Patch(color=INTERVAL, label=f"95 % interval of the argmin: {int(first['ci_lo']):,}–{int(first['ci_hi']):,}"),
+        Patch(color=BRACKET, label=f"bracket: {int(first['bracket_lo']):,}–{int(first['bracket_hi']):,}"),
+    ]
+    title = f"{first['search']}: {first['label']}, COMIC at t = {float(first['time']):g}"
+    _look(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel="$N$ (numbers: realisations)", legend=None)
+    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    fig.text(0.01, 0.005, cost_text(first), fontsize=8, ha="left", va="bottom", color="0.2")
+    fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))
+    return fig

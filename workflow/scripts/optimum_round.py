@@ -1,0 +1,22 @@
+"""One round of an adaptive COMIC search: round 0 is the coarse grid; round k reads the COMIC of
+every run of plan k-1 at the search's time and writes the next plan (or plan k-1, done)."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+import pandas as pd  # noqa: E402
+
+from particle_entropy.aggregate import read_realisations  # noqa: E402
+from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.optimum import Search, initial_plan, next_plan  # noqa: E402
+
+inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
+search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
+if "plan" in inp.keys():
+    realisations = read_realisations(list(inp.runs), [search.time])
+    plan = next_plan(search, pd.read_parquet(inp.plan), realisations)
+else:
+    plan = initial_plan(search, int(par.base_seed))
+write_parquet(plan, out[0])
+print(plan.to_string(), file=sys.stderr)

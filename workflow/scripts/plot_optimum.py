@@ -1,0 +1,19 @@
+"""Draw figures/optimum_<name>.png from the result table of an adaptive COMIC search."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+
+import pandas as pd  # noqa: E402
+
+from particle_entropy.plots import save_figure  # noqa: E402
+from particle_entropy.plots_optimum import optimum_figure  # noqa: E402
+
+inp, out = snakemake.input, snakemake.output  # noqa: F821
+table = pd.read_parquet(inp[0])
+save_figure(optimum_figure(table), out.png, out.pdf)
+print(f"drew {len(table)} visited N of search {snakemake.wildcards.name}", file=sys.stderr)  # noqa: F821
