@@ -613,6 +613,8 @@ def test_every_derived_table_column_is_documented(tiny_run):
 
     if not (tiny_run / "results/figures/fig9_mechanism.parquet").exists():  # the mechanism tables too
         snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+    if not (tiny_run / "results/optimum").exists():  # and the optimum searches' plans and results
+        snakemake(tiny_run, "optimum", configfile=TINY)
     sections = _column_doc_sections()
     tables = sorted((tiny_run / "results").rglob("*.parquet"))
     found = {}  # section heading -> {table: its columns}
