@@ -129,16 +129,17 @@ class Search:
             raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
         if self.initial_points < 3:
             raise SettingError(f"{where}.initial_points", self.initial_points, "an integer >= 3 (a minimum needs 3)")
-        if self.max_realisations < self.initial_realisations:
+        if not self.fd and self.max_realisations < self.initial_realisations:
             raise SettingError(
                 f"{where}.max_realisations", self.max_realisations, f">= realisations ({self.initial_realisations})"
             )
-        first = len(grid(self.n_lo, self.n_hi, self.initial_points, self.fd)) * self.realisations
+        points = len(grid(self.n_lo, self.n_hi, self.initial_points, self.fd))
+        first = points * self.realisations
         if self.budget_runs < first:
             raise SettingError(
                 f"{where}.budget_runs",
                 self.budget_runs,
-                f"at least the first round's {first} runs ({self.initial_points} N x {self.realisations})",
+                f"at least the first round's {first} runs ({points} N x {self.realisations})",
             )
 
 
@@ -203,7 +204,8 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
 
 
 def _unresolved(table: pd.DataFrame, n_opt: int) -> list[int]:
-    """N whose mean COMIC is within 2 combined standard errors of the minimum's."""
+    """N whose mean COMIC is within 2 combined standard errors of the minimum's (judged on mean
+    COMIC under either convention: its standard error is the one at hand)."""
     opt = table[table["n"] == n_opt].iloc[0]
     gap = (table["COMIC_mean"] - opt["COMIC_mean"]).abs()
     noise = np.sqrt(table["COMIC_se"] ** 2 + opt["COMIC_se"] ** 2)
