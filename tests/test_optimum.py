@@ -169,3 +169,11 @@ def test_the_error_convention_can_move_the_optimum():
     _, by_comic = evaluate(mtpt(), table)
     _, by_sse = evaluate(mtpt(convention="COMIC_of_mean_SSE"), table)
     assert by_comic["n_opt"] == 300 and by_sse["n_opt"] == 100
+
+
+def test_a_minimum_at_the_end_of_the_range_is_said_so():
+    search = Search(
+        name="t", model=Case("fd", "implicit", None), time=250.0, n_lo=30, n_hi=600, width=3.0, budget_runs=40
+    )
+    plan = run_search(search, noise=0.0)  # N_STAR = 1000 lies beyond the range
+    assert plan["reason"].iloc[-1] == "minimum at an end of the range"

@@ -32,7 +32,13 @@ from .case import Case, SettingError
 
 MAX_ROUNDS = 12  # a search that has not converged by then stops ("round limit")
 PLAN_COLUMNS = ["round", "n", "first", "last", "done", "reason"]
-REASONS = ("bracket narrow enough", "budget spent", "nothing left to add", "round limit")
+REASONS = (
+    "bracket narrow enough",
+    "budget spent",
+    "nothing left to add",
+    "round limit",
+    "minimum at an end of the range",  # the bracket is narrow, but the minimum may lie beyond the range
+)
 RESULT_COLUMN_DOCS = {
     "search": "name of the search (config key under `optimum`)",
     "label": "legend label of the searched model",
@@ -225,7 +231,7 @@ def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) ->
         return out
 
     if opt["bracket_hi"] / opt["bracket_lo"] <= search.width:
-        return stop(REASONS[0])
+        return stop(REASONS[4] if opt["n_opt"] in (ns[0], ns[-1]) else REASONS[0])
     if k > MAX_ROUNDS:
         return stop(REASONS[3])
     inside = [n for n in ns if opt["bracket_lo"] <= n <= opt["bracket_hi"]]
