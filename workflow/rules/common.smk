@@ -212,9 +212,9 @@ SIM_CODE = {
     m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"]) for m in METHODS
 }
 SUMMARY_CODE = code_version("aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "aggregate.smk"])
-COMIC_CODE = code_version("aggregate", "io", files=[SCRIPTS / "comic_tables.py"])
+COMIC_CODE = code_version("aggregate", "io", "htmlpage", files=[SCRIPTS / "comic_tables.py"])
 TRADEOFF_CODE = code_version("aggregate", "io", files=[SCRIPTS / "tradeoff_table.py"])
-CLAIMS_CODE = code_version("claims", "io", files=[SCRIPTS / "paper_claims.py"])
+CLAIMS_CODE = code_version("claims", "io", "htmlpage", files=[SCRIPTS / "paper_claims.py"])
 PLOT_CODE = code_version("plots", "io", files=[SCRIPTS / "plot_figure.py"])
 SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
 SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])

@@ -19,6 +19,7 @@ from particle_entropy.aggregate import (  # noqa: E402
     read_realisations,
 )
 from particle_entropy.case import MODEL_COLUMNS  # noqa: E402
+from particle_entropy.htmlpage import page  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
@@ -32,7 +33,6 @@ for table, path in ((comic, out.comic), (realisations, out.realisations), (argmi
 print(minima.to_string(), file=sys.stderr)
 
 STYLE = (
-    "body{font-family:sans-serif;margin:1em;color:#222}table{border-collapse:collapse;font-size:13px}"
     "th,td{border:1px solid #ccc;padding:3px 6px;text-align:right}td:first-child{text-align:left}dt{font-weight:bold}"
 )
 
@@ -41,10 +41,7 @@ def write_html(table: pd.DataFrame, path: str, title: str, notes: str = "") -> N
     """A report copy of a table: the label names the model, so its dimension columns are left out."""
     shown = table.drop(columns=list(MODEL_COLUMNS))
     body = shown.to_html(index=False, border=0, float_format=lambda v: f"{v:.4g}", na_rep="")
-    Path(path).write_text(
-        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}</title>'
-        f"<style>{STYLE}</style></head>\n<body><h1>{title}</h1>\n{body}\n{notes}</body></html>\n"
-    )
+    Path(path).write_text(page(title, f"{body}\n{notes}", STYLE))
 
 
 if "comic_html" in out.keys():

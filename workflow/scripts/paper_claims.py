@@ -11,6 +11,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from particle_entropy import claims as C  # noqa: E402
+from particle_entropy.htmlpage import page  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 
 inp, par = snakemake.input, snakemake.params  # noqa: F821
@@ -24,7 +25,6 @@ Path(snakemake.output.md).write_text(C.to_markdown(claims))  # noqa: F821
 
 # The report's copy: the Markdown table's columns, result cells classed for colour; no timestamp.
 STYLE = (
-    "body{font-family:sans-serif;margin:1em;color:#222}table{border-collapse:collapse;font-size:13px}"
     "th,td{border:1px solid #ccc;padding:3px 6px;text-align:left;vertical-align:top}"
     "td.pass{color:#05612d}td.fail{color:#b00020;font-weight:bold}"
 )
@@ -33,9 +33,6 @@ shown = claims.assign(result=np.where(claims["passed"], "pass", "FAIL")).drop(co
 table = shown.to_html(index=False, border=0, classes="claims")
 for verdict in ("pass", "FAIL"):
     table = table.replace(f"<td>{verdict}</td>", f'<td class="{verdict.lower()}">{verdict}</td>')
-Path(snakemake.output.html).write_text(  # noqa: F821
-    '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>Paper claims</title>'
-    f"<style>{STYLE}</style></head>\n<body><h1>Paper claims: reproduced values</h1>\n<p>{summary}</p>\n"
-    f"{table}\n</body></html>\n"
-)
+body = f"<p>{summary}</p>\n{table}\n"
+Path(snakemake.output.html).write_text(page("Paper claims", body, STYLE, "Paper claims: reproduced values"))  # noqa: F821
 print(claims.to_string(), file=sys.stderr)

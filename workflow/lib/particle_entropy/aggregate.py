@@ -359,6 +359,17 @@ def argmin_bootstrap(
     return shares, int(math.floor(lo)), int(math.ceil(hi)), len(dist)
 
 
+def convention_samples(per_n: list[pd.DataFrame], convention: str) -> tuple[list[np.ndarray], Callable]:
+    """What a convention resamples per N and the statistic of the sample means it minimises over
+    N (CONVENTIONS): mean_COMIC, per-realisation COMIC and its mean; COMIC_of_mean_SSE,
+    per-realisation SSE and Eq. 43 of its mean. ``per_n``: realisations_table rows, one frame per N."""
+    if convention == "mean_COMIC":
+        return [s["COMIC"].to_numpy() for s in per_n], lambda means: means
+    n_sse = np.array([float(s["n_sse"].iloc[0]) for s in per_n])[:, None]
+    dV = np.array([float(s["dV"].iloc[0]) for s in per_n])[:, None]
+    return [s["SSE"].to_numpy() for s in per_n], lambda means: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)
+
+
 def comic_argmin(
     realisations: pd.DataFrame, n_resamples: int = N_RESAMPLES, seed: int = BOOTSTRAP_SEED
 ) -> pd.DataFrame:
@@ -371,14 +382,8 @@ def comic_argmin(
         for time, g in of_model.groupby("time", sort=True):
             per_n = [s for _, s in g.groupby("n", sort=True)]
             ns = [int(s["n"].iloc[0]) for s in per_n]
-            n_sse = np.array([float(s["n_sse"].iloc[0]) for s in per_n])[:, None]
-            dV = np.array([float(s["dV"].iloc[0]) for s in per_n])[:, None]
-            of_sse = lambda means, n_sse=n_sse, dV=dV: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)
-            for convention, column, value in (
-                ("mean_COMIC", "COMIC", lambda means: means),
-                ("COMIC_of_mean_SSE", "SSE", of_sse),
-            ):
-                samples = [s[column].to_numpy() for s in per_n]
+            for convention in CONVENTIONS:
+                samples, value = convention_samples(per_n, convention)
                 shares, lo, hi, drawn = argmin_bootstrap(samples, value, n_resamples, seed)
                 for n, sample, share in zip(ns, samples, shares):
                     rows.append(

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .aggregate import CONVENTIONS, argmin_bootstrap
+from .aggregate import CONVENTIONS, argmin_bootstrap, convention_samples
 from .case import Case, SettingError
 
 MAX_ROUNDS = 12  # a search that has not converged by then stops ("round limit")
@@ -181,17 +181,12 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
     per_n = [g for _, g in realisations.groupby("n", sort=True)]
     ns = [int(g["n"].iloc[0]) for g in per_n]
     samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_n]
-    if search.convention == "COMIC_of_mean_SSE":  # Eq. 43 of the mean SSE: the paper warns it can move the optimum
-        n_sse = np.array([float(g["n_sse"].iloc[0]) for g in per_n])[:, None]
-        dV = np.array([float(g["dV"].iloc[0]) for g in per_n])[:, None]
-        objective = lambda means: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)  # noqa: E731
-        minimised = objective(np.array([g["SSE"].mean() for g in per_n])[:, None])[:, 0]
-        shares, lo, hi, _ = argmin_bootstrap([g["SSE"].to_numpy(dtype=np.float64) for g in per_n], objective)
-    else:
-        shares, lo, hi, _ = argmin_bootstrap(samples)
+    # mean COMIC, or Eq. 43 of the mean SSE (the paper warns the convention can move the optimum)
+    resampled, objective = convention_samples(per_n, search.convention)
+    shares, lo, hi, _ = argmin_bootstrap(resampled, objective)
+    with np.errstate(divide="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
+        minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
     means = np.array([s.mean() for s in samples])
-    if search.convention == "mean_COMIC":
-        minimised = means
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])
     counts = np.array([len(s) for s in samples])
     se = np.where(counts > 1, stds / np.sqrt(counts), 0.0)

@@ -193,9 +193,12 @@ SHARED_KEYS.update({k: f"numerics.{k}" for k in NUMERICS})
 
 
 def check_seeds(config: Mapping) -> None:
-    """Realisation r of every case uses seed base_seed + r, stored as int64 in every table."""
+    """Realisation r of every case (and of every adaptive search, up to its max_realisations) uses
+    seed base_seed + r, stored as int64 in every table."""
     base = int(config["base_seed"])
-    most = max((e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)), default=1)
+    counts = [e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)]
+    counts += [search.max_realisations for search in optimum_searches(config).values()]
+    most = max(counts, default=1)
     if base + most - 1 > MAX_SEED:
         raise SettingError(
             "base_seed",
@@ -271,10 +274,9 @@ def _case_error(e: SettingError, where: str, case: Case) -> SettingError:
 def check_optimum(config: Mapping) -> None:
     """Every adaptive search (config `optimum`) must be able to run: a model that exists, a range
     with room for a minimum, a budget of at least its first round, a time within t_final
-    (optimum.Search.check), runs valid at both ends of its range and seeds within int64."""
+    (optimum.Search.check) and runs valid at both ends of its range (seeds: check_seeds)."""
     from .optimum import grid
 
-    base = int(config["base_seed"])
     for name, search in optimum_searches(config).items():
         where = f"optimum.{name}"
         for n in grid(search.n_lo, search.n_hi, 2, search.fd):  # the range's ends (FD: even)
@@ -285,13 +287,6 @@ def check_optimum(config: Mapping) -> None:
                 if e.name == "n":
                     raise SettingError(f"{where}.n_range", [search.n_lo, search.n_hi], e.allowed) from None
                 raise _case_error(e, f"{where}.case", case) from None
-        if base + search.max_realisations - 1 > MAX_SEED:
-            raise SettingError(
-                "base_seed",
-                base,
-                f"an integer in [0, {MAX_SEED - search.max_realisations + 1}]: {where} runs seeds to "
-                f"base_seed + {search.max_realisations - 1}, stored as int64",
-            )
 
 
 def check_sweeps(config: Mapping) -> None:
