@@ -9,14 +9,12 @@ import pandas as pd  # noqa: E402
 
 from particle_entropy.aggregate import read_realisations  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.optimum import Search, result_table  # noqa: E402
+from particle_entropy.optimum import Search, read_costs, result_table  # noqa: E402
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
 search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
 runs = list(inp.runs)
 realisations = read_realisations(runs, [search.time])
-steps = pd.concat([pd.read_parquet(p, columns=["n", "seed", "wall_s"]) for p in runs], ignore_index=True)
-costs = steps.groupby(["n", "seed"], as_index=False)["wall_s"].sum().rename(columns={"wall_s": "core_s"})
-table = result_table(search, pd.read_parquet(inp.plan), realisations, costs)
+table = result_table(search, pd.read_parquet(inp.plan), realisations, read_costs(runs))
 write_parquet(table, out[0])
 print(table.to_string(), file=sys.stderr)
