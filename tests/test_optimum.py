@@ -272,3 +272,40 @@ def test_replication_goes_to_the_cheapest_unresolved_n_first():
     assert added[["n", "first", "last"]].values.tolist() == [[300, 4, 7]]
     roomy = next_plan(replace(search, budget_core_s=1e9), plan, table, costs_of(table))
     assert sorted(roomy.loc[roomy["round"] == 1, "n"]) == [300, 1000, 3000]  # all three when affordable
+
+
+def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
+    """Section 6, point 3: with dt in the sampling volume COMIC drops by ln(mean dt); every N of a
+    model shares its time grid, so the curve shifts by a constant and the optimum stays put."""
+    from particle_entropy.optimum import evaluate
+
+    config = {"physics": {"t_final": 1000}, "time": {"dt0": 0.01, "fd_dt": 0.05, "fixed_dt": 1.0}}
+    spec = {"case": {"method": "mtpt", "kernel": "collision", "dt_growth": 1.05}, "time": 1000, "n_range": [30, 30000]}
+    plain = Search.from_config("s", {**spec, "budget_runs": 100}, config)
+    with_dt = Search.from_config("s", {**spec, "budget_runs": 100, "time_volume": True}, config)
+    rows = [(n, s, comic(n, s, 0.3), 1000.0, 10.0 / n) for n in (100, 300, 1000, 3000, 10000) for s in range(6)]
+    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC", "time_step", "dV"])
+    a, opt_a = evaluate(plain, table)
+    b, opt_b = evaluate(with_dt, table)
+    steps = math.ceil(math.log(1 + 1000 * 0.05 / 0.01) / math.log(1.05))  # dt0 1.05^k summed to 1000
+    assert steps == 175
+    assert (b["COMIC_mean"] - a["COMIC_mean"]).to_numpy() == pytest.approx(-math.log(1000 / steps), abs=1e-12)
+    assert opt_a == opt_b
+    fd_search = Search.from_config(
+        "f", {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 3000], "budget_runs": 9,
+              "time_volume": True}, config)  # fmt: skip
+    assert fd_search.first_dt == 0.05
+
+
+def test_the_common_measurement_points_replace_the_models_own():
+    """measure: points judges SSE and COMIC at the 15 common points (columns SSE_points, COMIC_points)."""
+    from particle_entropy.optimum import evaluate
+
+    rows = [
+        (n, s, comic(n, s, 0.1), comic(n * 10, s, 0.1), 1.0) for n in (100, 300, 1000, 3000, 10000) for s in range(6)
+    ]  # the points' curve has its minimum at N_STAR / 10
+    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC", "COMIC_points", "SSE_points"])
+    assert evaluate(mtpt(), table)[1]["n_best"] == 1000
+    assert evaluate(mtpt(measure="points"), table)[1]["n_best"] == 100
+    with pytest.raises(SettingError, match="measure"):
+        mtpt(measure="nodes").check("optimum.s", 1000.0)

@@ -157,8 +157,12 @@ def runs_of(*sections):
 
 
 def optimum_settings(wildcards):
-    """What a search needs besides its own section: case_defaults and t_final (Search.from_config)."""
-    return {"case_defaults": config.get("case_defaults", {}), "physics": {"t_final": config["physics"]["t_final"]}}
+    """What a search needs besides its own section: case_defaults, t_final, time steps (Search.from_config)."""
+    return {
+        "case_defaults": config.get("case_defaults", {}),
+        "physics": {"t_final": config["physics"]["t_final"]},
+        "time": config.get("time", {}),
+    }
 
 
 def optimum_plan_runs(name, plan):

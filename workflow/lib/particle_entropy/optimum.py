@@ -36,7 +36,15 @@ from scipy import stats
 
 from .aggregate import _RNG, BOOTSTRAP_SEED, CONFIDENCE, CONVENTIONS, N_RESAMPLES, argmin_bootstrap, convention_samples
 from .case import Case, SettingError
+from .registry import MEASUREMENT_POINTS, PAPER
+from .runconfig import first_step
+from .timegrid import step_count
 
+MEASURES = {
+    "own": "SSE at the model's own points: particles or nodes (Eq. 44)",
+    "points": f"SSE at the {MEASUREMENT_POINTS} measurement points common to all models (section 6, point 1)",
+}
+TIME_DEFAULTS = {"dt0": PAPER["dt0"], "fd_dt": PAPER["fd_dt"], "fixed_dt": PAPER["fixed_dt"]}
 MAX_ROUNDS = 16  # a search that has not converged by then stops ("round limit")
 PLAN_COLUMNS = ["round", "n", "first", "last", "done", "reason"]
 REASONS = (
@@ -51,6 +59,8 @@ RESULT_COLUMN_DOCS = {
     "label": "legend label of the searched model",
     "time": "time at which COMIC is judged [T]",
     "convention": "what is minimised over N: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
+    "measure": "where SSE is taken: " + "; ".join(f"{k} = {v}" for k, v in MEASURES.items()),
+    "time_volume": "the time step is part of the sampling volume: COMIC - ln(mean dt) (section 6, point 3)",
     "n": "a visited N (particles; FD: intervals)",
     "realisations": "realisations of this N",
     "round_added": "round in which this N was first visited (0 = the first coarse points)",
@@ -89,7 +99,7 @@ class Search:
     n_lo: int
     n_hi: int
     width: float = 10.0  # stop when bracket_hi / bracket_lo <= width
-    budget_runs: int = 200
+    budget_runs: float = math.inf  # runs (realisations x N); a config sets this, budget_core_s or both
     budget_core_s: float = math.inf  # stop before the predicted core-seconds would exceed this
     initial_points: int = 7  # the coarse grid over the range (7 over 30 ... 30,000: half decades)
     start_points: int = 3  # round 0 visits the lowest of them; later rounds walk up only as needed
@@ -97,6 +107,13 @@ class Search:
     max_realisations: int = 64
     min_step: float = 1.1  # no two visited N closer than this ratio
     convention: str = "mean_COMIC"  # or COMIC_of_mean_SSE (aggregate.CONVENTIONS): what is minimised
+    measure: str = "own"  # or "points": SSE at the measurement points common to all models (MEASURES)
+    first_dt: float | None = None  # the model's first time step: set, the step joins the sampling volume
+
+    @property
+    def time_volume(self) -> bool:
+        """COMIC counts the time step in the sampling volume (the paper's section 6, point 3)."""
+        return self.first_dt is not None
 
     @property
     def fd(self) -> bool:
@@ -121,6 +138,10 @@ class Search:
         except SettingError as e:
             raise SettingError(f"{where}.case.{e.name}", e.value, e.allowed) from None
         lo, hi = (int(v) for v in spec["n_range"])
+        first_dt = None
+        if spec.get("time_volume", False):
+            t = {**TIME_DEFAULTS, **config.get("time", {})}
+            first_dt = first_step(model.method, model.dt_growth, t["dt0"], t["fd_dt"], t["fixed_dt"])
         search = cls(
             name=name,
             model=model,
@@ -128,13 +149,15 @@ class Search:
             n_lo=lo,
             n_hi=hi,
             width=float(spec.get("width", cls.width)),
-            budget_runs=int(spec["budget_runs"]),
+            budget_runs=int(spec["budget_runs"]) if "budget_runs" in spec else math.inf,
             budget_core_s=float(spec.get("budget_core_s", cls.budget_core_s)),
             initial_points=int(spec.get("initial_points", cls.initial_points)),
             start_points=int(spec.get("start_points", cls.start_points)),
             initial_realisations=int(spec.get("realisations", cls.initial_realisations)),
             max_realisations=int(spec.get("max_realisations", cls.max_realisations)),
             convention=str(spec.get("convention", cls.convention)),
+            measure=str(spec.get("measure", cls.measure)),
+            first_dt=first_dt,
         )
         search.check(where, float(config["physics"]["t_final"]))
         return search
@@ -151,6 +174,8 @@ class Search:
             raise SettingError(f"{where}.width", self.width, f"a ratio n_hi / n_lo > {self.min_step}")
         if self.convention not in CONVENTIONS:
             raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
+        if self.measure not in MEASURES:
+            raise SettingError(f"{where}.measure", self.measure, f"one of {', '.join(MEASURES)}")
         if self.initial_points < 3:
             raise SettingError(f"{where}.initial_points", self.initial_points, "an integer >= 3 (a minimum needs 3)")
         if not 3 <= self.start_points <= self.initial_points:
@@ -278,13 +303,28 @@ def _fitted_interval(u, resampled, objective, counts) -> tuple[float, float]:
     return float(res.confidence_interval.low), float(res.confidence_interval.high)
 
 
+def judged(search: Search, realisations: pd.DataFrame) -> pd.DataFrame:
+    """The per-realisation values a search minimises: SSE and COMIC at the model's own points or at
+    the common measurement points (``measure``), and with the time step in the sampling volume
+    (``time_volume``): COMIC - ln(mean dt) and dV x mean dt, mean dt = time / steps to reach it."""
+    r = realisations
+    if search.measure == "points":
+        r = r.assign(COMIC=r["COMIC_points"], SSE=r["SSE_points"], n_sse=MEASUREMENT_POINTS)
+    if search.time_volume:
+        times = r["time_step"].to_numpy(np.float64)
+        steps = np.array([step_count(t, search.first_dt, search.model.dt_growth) for t in times])
+        mean_dt = times / steps
+        r = r.assign(COMIC=r["COMIC"] - np.log(mean_dt), dV=r["dV"] * mean_dt)
+    return r
+
+
 def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
     """Per-N statistics (n, realisations, COMIC_mean, COMIC_std, COMIC_se, share) and the
     search-level optimum (n_best, n_opt, ci_lo, ci_hi, bracket_lo, bracket_hi, and for the walk
     ``argmin_lo`` / ``argmin_hi``, the visited N bounding the argmin's 95 % interval) of the
     search's convention, from per-realisation values (columns n, seed, COMIC; for
     COMIC_of_mean_SSE also SSE, n_sse, dV: aggregate.realisations_table at the search's time)."""
-    per_n = [g for _, g in realisations.groupby("n", sort=True)]
+    per_n = [g for _, g in judged(search, realisations).groupby("n", sort=True)]
     ns = np.array([int(g["n"].iloc[0]) for g in per_n])
     samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_n]
     # mean COMIC, or Eq. 43 of the mean SSE (the paper warns the convention can move the optimum)
@@ -433,6 +473,8 @@ def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame,
         label=search.model.label(),
         time=search.time,
         convention=search.convention,
+        measure=search.measure,
+        time_volume=search.time_volume,
         **{k: v for k, v in opt.items() if k in RESULT_COLUMN_DOCS},
         reason=str(plan["reason"].iloc[-1]),
         rounds=int(plan["round"].max()) + 1,
