@@ -57,11 +57,11 @@ def run_search(search, noise, base_seed=0):
 
 
 def mtpt(**kw):
-    return Search(name="t", model=Case("mtpt", "collision", None), time=1000.0, n_lo=30, n_hi=30000, **kw)
+    return Search(name="t", model=Case("mtpt", "collision", None), time=1000.0, lo=30, hi=30000, **kw)
 
 
 def fd(**kw):
-    return Search(name="t", model=Case("fd", "implicit", None), time=250.0, n_lo=30, n_hi=30000, **kw)
+    return Search(name="t", model=Case("fd", "implicit", None), time=250.0, lo=30, hi=30000, **kw)
 
 
 def test_grid_is_geometric_with_both_ends_and_even_for_fd():
@@ -91,7 +91,7 @@ def test_fd_brackets_the_minimum_within_the_width_with_one_run_per_n():
 def _bracket(search, plan, table):
     out = result_table(search, plan, table, costs_of(table))
     row = out.iloc[0]
-    return out, int(row["n_opt"]), int(row["bracket_lo"]), int(row["bracket_hi"])
+    return out, int(row["optimum"]), int(row["bracket_lo"]), int(row["bracket_hi"])
 
 
 @pytest.mark.parametrize("noise", [0.05, 0.3])
@@ -176,13 +176,11 @@ def test_the_error_convention_can_move_the_optimum():
     table = pd.DataFrame(rows, columns=["n", "seed", "SSE", "COMIC", "n_sse", "dV"])
     _, by_comic = evaluate(mtpt(), table)
     _, by_sse = evaluate(mtpt(convention="COMIC_of_mean_SSE"), table)
-    assert by_comic["n_best"] == 300 and by_sse["n_best"] == 100
+    assert by_comic["best"] == 300 and by_sse["best"] == 100
 
 
 def test_a_minimum_at_the_end_of_the_range_is_said_so():
-    search = Search(
-        name="t", model=Case("fd", "implicit", None), time=250.0, n_lo=30, n_hi=600, width=3.0, budget_runs=40
-    )
+    search = Search(name="t", model=Case("fd", "implicit", None), time=250.0, lo=30, hi=600, width=3.0, budget_runs=40)
     plan = run_search(search, noise=0.0)  # N_STAR = 1000 lies beyond the range
     assert plan["reason"].iloc[-1] == "minimum at an end of the range"
 
@@ -211,8 +209,8 @@ def test_the_fit_beats_the_lowest_mean_on_noisy_curves():
     for rep in range(60):
         rows = [(n, s, comic(n, 1000 * rep + s, 0.8)) for n in ns for s in range(8)]
         _, opt = evaluate(mtpt(), pd.DataFrame(rows, columns=["n", "seed", "COMIC"]))
-        err_fit.append(math.log(opt["n_opt"] / N_STAR) ** 2)
-        err_best.append(math.log(opt["n_best"] / N_STAR) ** 2)
+        err_fit.append(math.log(opt["optimum"] / N_STAR) ** 2)
+        err_best.append(math.log(opt["best"] / N_STAR) ** 2)
     assert np.mean(err_fit) < 0.8 * np.mean(err_best)
 
 
@@ -261,10 +259,10 @@ def test_replication_goes_to_the_cheapest_unresolved_n_first():
     spread = [-2.0, -0.5, 0.5, 2.0]
     rows = [(n, s, (10.0 if n in (100, 10000) else 0.0) + d) for n in ns for s, d in enumerate(spread)]
     table = pd.DataFrame(rows, columns=["n", "seed", "COMIC"])
-    plan = pd.DataFrame([(0, n, 0, 3, False, "") for n in ns], columns=PLAN_COLUMNS)
+    plan = pd.DataFrame([(0, n, 1.05, 0, 3, False, "") for n in ns], columns=PLAN_COLUMNS)
     spent = 4 * 1e-3 * sum(ns)  # costs 1e-3 N s a run
     search = Search(
-        name="t", model=Case("mtpt", "collision", None), time=1.0, n_lo=100, n_hi=10000,
+        name="t", model=Case("mtpt", "collision", None), time=1.0, lo=100, hi=10000,
         width=1.5, min_step=4.0, budget_core_s=spent + 1.5,  # no midpoints; 1.5 s pays 300's doubling only
     )  # fmt: skip
     out = next_plan(search, plan, table, costs_of(table))
@@ -283,8 +281,8 @@ def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
     spec = {"case": {"method": "mtpt", "kernel": "collision", "dt_growth": 1.05}, "time": 1000, "n_range": [30, 30000]}
     plain = Search.from_config("s", {**spec, "budget_runs": 100}, config)
     with_dt = Search.from_config("s", {**spec, "budget_runs": 100, "time_volume": True}, config)
-    rows = [(n, s, comic(n, s, 0.3), 1000.0, 10.0 / n) for n in (100, 300, 1000, 3000, 10000) for s in range(6)]
-    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC", "time_step", "dV"])
+    rows = [(n, s, comic(n, s, 0.3), 1000.0, 10.0 / n, 1.05) for n in (100, 300, 1000, 3000, 10000) for s in range(6)]
+    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC", "time_step", "dV", "dt_growth"])
     a, opt_a = evaluate(plain, table)
     b, opt_b = evaluate(with_dt, table)
     steps = math.ceil(math.log(1 + 1000 * 0.05 / 0.01) / math.log(1.05))  # dt0 1.05^k summed to 1000
@@ -294,7 +292,7 @@ def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
     fd_search = Search.from_config(
         "f", {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 3000], "budget_runs": 9,
               "time_volume": True}, config)  # fmt: skip
-    assert fd_search.first_dt == 0.05
+    assert fd_search.steps["fd_dt"] == 0.05 and fd_search.time_volume
 
 
 def test_the_common_measurement_points_replace_the_models_own():
@@ -305,7 +303,84 @@ def test_the_common_measurement_points_replace_the_models_own():
         (n, s, comic(n, s, 0.1), comic(n * 10, s, 0.1), 1.0) for n in (100, 300, 1000, 3000, 10000) for s in range(6)
     ]  # the points' curve has its minimum at N_STAR / 10
     table = pd.DataFrame(rows, columns=["n", "seed", "COMIC", "COMIC_points", "SSE_points"])
-    assert evaluate(mtpt(), table)[1]["n_best"] == 1000
-    assert evaluate(mtpt(measure="points"), table)[1]["n_best"] == 100
+    assert evaluate(mtpt(), table)[1]["best"] == 1000
+    assert evaluate(mtpt(measure="points"), table)[1]["best"] == 100
     with pytest.raises(SettingError, match="measure"):
         mtpt(measure="nodes").check("optimum.s", 1000.0)
+
+
+G_STAR = 1.03  # the synthetic growth curve's minimum
+
+
+def growth_comic(g, seed, noise):
+    rng = np.random.default_rng([int(round(g * 1e6)), int(seed)])
+    return 2.0 * (math.log(g - 1.0) - math.log(G_STAR - 1.0)) ** 2 + noise * rng.standard_normal()
+
+
+def test_a_search_over_the_dt_growth_finds_its_minimum():
+    """over dt_growth: the same machinery on log(dt_growth - 1) at a fixed N, starting at the
+    cheap end (large growth, few steps) and walking towards small growth only as needed."""
+    config = {"physics": {"t_final": 1000}}
+    spec = {
+        "case": {"method": "mtpt", "kernel": "collision"},
+        "n": 1000,
+        "time": 1000,
+        "growth_range": [1.001, 1.5],
+        "budget_runs": 400,
+        "width": 2.0,
+    }
+    search = Search.from_config("g", spec, config)
+    assert search.over == "dt_growth" and search.model.n == 1000
+    plan = initial_plan(search, 0)
+    assert (plan["n"] == 1000).all() and plan["dt_growth"].min() > 1.05  # the cheap end first
+    while not plan["done"].any():
+        rows = [
+            (1000, g, s, growth_comic(g, s, 0.05))
+            for _, b in plan.iterrows()
+            for g in [float(b["dt_growth"])]
+            for s in range(b["first"], b["last"] + 1)
+        ]
+        table = pd.DataFrame(rows, columns=["n", "dt_growth", "seed", "COMIC"])
+        costs = table.assign(core_s=1.0 / (table["dt_growth"] - 1.0))[["n", "dt_growth", "seed", "core_s"]]
+        plan = next_plan(search, plan, table, costs)
+    out = result_table(search, plan, table, costs)
+    row = out.iloc[0]
+    assert row["bracket_lo"] <= G_STAR <= row["bracket_hi"]
+    assert abs(math.log((row["optimum"] - 1) / (G_STAR - 1))) < math.log(1.5)
+    assert plan["dt_growth"].min() > 1.005  # the most expensive end of the range was never run
+    assert (out["n"] == 1000).all() and row["over"] == "dt_growth"
+
+
+@pytest.mark.parametrize(
+    "spec,key",
+    [
+        ({"growth_range": [1.0, 1.2]}, "growth_range"),  # 1 = a fixed step
+        ({"growth_range": [1.2, 1.1]}, "growth_range"),
+        ({"growth_range": [1.01, 1.2], "n_range": [30, 300]}, "n_range"),
+        ({"growth_range": [1.01, 1.2], "n": None}, "n"),
+        ({"growth_range": [1.01, 1.2], "case": {"method": "fd", "kernel": "implicit"}}, "growth_range"),
+    ],
+)
+def test_bad_growth_searches_are_refused_naming_the_key(spec, key):
+    base = {"case": {"method": "mtpt", "kernel": "collision"}, "time": 1000, "n": 300, "budget_runs": 100}
+    spec = {k: v for k, v in {**base, **spec}.items() if v is not None}
+    with pytest.raises(SettingError) as err:
+        Search.from_config("s", spec, {"physics": {"t_final": 1000}})
+    assert err.value.name == f"optimum.s.{key}"
+
+
+@pytest.mark.parametrize("measure,time_volume", [("own", False), ("points", True)])
+def test_the_figure_names_the_options_it_was_judged_with(measure, time_volume):
+    import matplotlib.pyplot as plt
+
+    from particle_entropy.plots_optimum import optimum_figure
+
+    search = fd(width=1.5, budget_runs=40)
+    plan = run_search(search, noise=0.0)
+    out = result_table(search, plan, realisations_of(plan, 0.0), costs_of(realisations_of(plan, 0.0)))
+    fig = optimum_figure(out.assign(measure=measure, time_volume=time_volume))
+    title = fig.axes[0].get_title(loc="left")
+    plt.close(fig)
+    assert ("15 common points" in title) == (measure == "points")
+    assert ("dt in dV" in title) == time_volume
+    assert "\n" in title  # two lines: a long search name does not push the judging settings off

@@ -656,15 +656,16 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
         assert list(table.columns) == RESULT_COLUMNS
         row = table.iloc[0]
         assert row["runs_spent"] <= spec["budget_runs"] and row["reason"] in REASONS, row
-        assert search.n_lo <= row["n_opt"] <= search.n_hi
-        assert row["bracket_lo"] <= row["ci_lo"] <= row["n_opt"] <= row["ci_hi"] <= row["bracket_hi"]
+        assert search.lo <= row["optimum"] <= search.hi and row["over"] == search.over
+        assert row["bracket_lo"] <= row["ci_lo"] <= row["ci_hi"] <= row["bracket_hi"]
+        assert row["bracket_lo"] <= row["optimum"] <= row["bracket_hi"]
         assert row["rounds"] >= 2, "the tiny searches refine at least once"  # the checkpoint chain ran
         for k in range(int(row["rounds"])):
             assert (tiny_run / f"results/optimum/{name}/round~{k}.parquet").exists(), k
         plan = pd.read_parquet(tiny_run / f"results/optimum/{name}/round~{int(row['rounds'])}.parquet")
-        assert plan["done"].all() and sorted(set(plan["n"])) == sorted(table["n"])
+        assert plan["done"].all() and sorted(set(plan[search.over])) == sorted(table[search.over])
         assert int(table["realisations"].sum()) == int(row["runs_spent"])
         for r in plan.itertuples():  # every block is an ordinary simulation table
-            assert (tiny_run / run_path(search.model.at(r.n), r.first, r.last)).exists(), r
+            assert (tiny_run / run_path(search.case_at(getattr(r, search.over)), r.first, r.last)).exists(), r
     proc = snakemake(tiny_run, "-n", "optimum", configfile=TINY)
     assert "Nothing to be done" in proc.stdout + proc.stderr

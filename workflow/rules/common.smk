@@ -167,8 +167,8 @@ def optimum_settings(wildcards):
 
 def optimum_plan_runs(name, plan):
     """The run tables of every seed block of a plan."""
-    model = OPTIMUM[name].model
-    return [run_path(model.at(int(r.n)), int(r.first), int(r.last)) for r in plan.itertuples()]
+    search = OPTIMUM[name]
+    return [run_path(search.case_at(getattr(r, search.over)), int(r.first), int(r.last)) for r in plan.itertuples()]
 
 
 def optimum_round_inputs(wildcards):

@@ -28,14 +28,14 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 from scipy import stats
 
 from .aggregate import _RNG, BOOTSTRAP_SEED, CONFIDENCE, CONVENTIONS, N_RESAMPLES, argmin_bootstrap, convention_samples
-from .case import Case, SettingError
+from .case import APPLIES, Case, SettingError
 from .registry import MEASUREMENT_POINTS, PAPER
 from .runconfig import first_step
 from .timegrid import step_count
@@ -45,8 +45,12 @@ MEASURES = {
     "points": f"SSE at the {MEASUREMENT_POINTS} measurement points common to all models (section 6, point 1)",
 }
 TIME_DEFAULTS = {"dt0": PAPER["dt0"], "fd_dt": PAPER["fd_dt"], "fixed_dt": PAPER["fixed_dt"]}
+OVER = {
+    "n": "N (particles; FD intervals), searched in log N",
+    "dt_growth": "the time-step growth factor at a fixed N (pt, mtpt), searched in log(dt_growth - 1)",
+}
 MAX_ROUNDS = 16  # a search that has not converged by then stops ("round limit")
-PLAN_COLUMNS = ["round", "n", "first", "last", "done", "reason"]
+PLAN_COLUMNS = ["round", "n", "dt_growth", "first", "last", "done", "reason"]
 REASONS = (
     "bracket narrow enough",
     "budget spent",
@@ -58,30 +62,34 @@ RESULT_COLUMN_DOCS = {
     "search": "name of the search (config key under `optimum`)",
     "label": "legend label of the searched model",
     "time": "time at which COMIC is judged [T]",
-    "convention": "what is minimised over N: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
+    "convention": "what is minimised: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
     "measure": "where SSE is taken: " + "; ".join(f"{k} = {v}" for k, v in MEASURES.items()),
     "time_volume": "the time step is part of the sampling volume: COMIC - ln(mean dt) (section 6, point 3)",
-    "n": "a visited N (particles; FD: intervals)",
-    "realisations": "realisations of this N",
-    "round_added": "round in which this N was first visited (0 = the first coarse points)",
+    "over": "the searched dimension: " + "; ".join(f"{k} = {v}" for k, v in OVER.items()),
+    "n": "N of this point (particles; FD: intervals): the searched value when over = n",
+    "dt_growth": "time-step growth factor of this point: the searched value when over = dt_growth",
+    "realisations": "realisations of this point",
+    "round_added": "round in which this point was first visited (0 = the first coarse points)",
     "COMIC_mean": "mean over realisations of per-realisation COMIC (Eq. 43) [nats]",
     "COMIC_std": "its standard deviation over realisations (NaN for one realisation)",
     "COMIC_se": "standard error of the mean (std / sqrt(realisations); 0 for FD)",
-    "share": "fraction of bootstrap resamples whose lowest visited N is this N",
-    "core_s": "measured wall time of this N's runs, summed over realisations (step timings) [s]",
-    "n_best": "the visited N with the lowest value of the search's convention",
-    "n_opt": "the fitted optimum: vertex of a quadratic in log N, weighted by realisations, through the "
-    "visited N within two of n_best (n_best itself at an end of the visited N)",
-    "ci_lo": "lower end of the 95 % bootstrap interval of n_opt (FD, deterministic: the visited N below n_best)",
-    "ci_hi": "its upper end (FD: the visited N above n_best)",
-    "bracket_lo": "the largest visited N <= ci_lo (the lowest visited N if none): the minimum lies above it",
-    "bracket_hi": "the smallest visited N >= ci_hi (the highest visited N if none): the minimum lies below it",
+    "share": "fraction of bootstrap resamples whose lowest visited point is this one",
+    "core_s": "measured wall time of this point's runs, summed over realisations (step timings) [s]",
+    "best": "the visited value (N or dt growth) with the lowest value of the search's convention",
+    "optimum": "the fitted optimum: vertex of a quadratic in log N (log(dt_growth - 1)), weighted by "
+    "realisations, through the visited values within two of `best` (`best` itself at an end of them)",
+    "ci_lo": "lower end of the 95 % bootstrap interval of the optimum (FD, deterministic: the visited value "
+    "below best)",
+    "ci_hi": "its upper end (FD: the visited value above best)",
+    "bracket_lo": "the largest visited value <= ci_lo (the lowest visited if none): the minimum lies above it",
+    "bracket_hi": "the smallest visited value >= ci_hi (the highest visited if none): the minimum lies below it",
     "reason": "why the search stopped: " + ", ".join(REASONS),
     "rounds": "rounds evaluated",
     "runs_spent": "runs (realisations x N) the search used",
     "core_s_spent": "sum of core_s over every visited N [s]",
-    "full_sweep_core_s": "estimated cost of a full grid sweep giving the same bracket: every N of a "
-    "geometric grid over the range with step sqrt(bracket_hi / bracket_lo) (a grid brackets its minimum "
+    "full_sweep_core_s": "estimated cost of a full grid sweep giving the same bracket: every value of a "
+    "grid even in log N (log(dt_growth - 1)) over the range, with the step half the bracket's width in "
+    "that log (a grid brackets its minimum "
     "between the argmin's neighbours), each with the search's largest realisation count, at the "
     "measured cost per run (cost_model) [s]",
 }
@@ -90,30 +98,61 @@ RESULT_COLUMNS = list(RESULT_COLUMN_DOCS)
 
 @dataclass(frozen=True)
 class Search:
-    """One adaptive search: a model (a case without N), the time COMIC is judged at, an N range,
-    a budget and when to stop."""
+    """One adaptive search: a model (a case without N; with one for a dt-growth search), the time
+    COMIC is judged at, the searched dimension and its range, a budget and when to stop."""
 
     name: str
     model: Case
     time: float
-    n_lo: int
-    n_hi: int
-    width: float = 10.0  # stop when bracket_hi / bracket_lo <= width
+    lo: float  # the range of the searched value (OVER)
+    hi: float
+    over: str = "n"
+    width: float = 10.0  # stop when bracket_hi / bracket_lo <= width (dt growth: of dt_growth - 1)
     budget_runs: float = math.inf  # runs (realisations x N); a config sets this, budget_core_s or both
     budget_core_s: float = math.inf  # stop before the predicted core-seconds would exceed this
     initial_points: int = 7  # the coarse grid over the range (7 over 30 ... 30,000: half decades)
     start_points: int = 3  # round 0 visits the lowest of them; later rounds walk up only as needed
     initial_realisations: int = 4
     max_realisations: int = 64
-    min_step: float = 1.1  # no two visited N closer than this ratio
+    min_step: float = 1.1  # no two visited values closer than this ratio (dt growth: of dt_growth - 1)
     convention: str = "mean_COMIC"  # or COMIC_of_mean_SSE (aggregate.CONVENTIONS): what is minimised
     measure: str = "own"  # or "points": SSE at the measurement points common to all models (MEASURES)
-    first_dt: float | None = None  # the model's first time step: set, the step joins the sampling volume
+    steps: Mapping | None = None  # time.dt0, fd_dt, fixed_dt: set, the time step joins the sampling volume
 
     @property
     def time_volume(self) -> bool:
         """COMIC counts the time step in the sampling volume (the paper's section 6, point 3)."""
-        return self.first_dt is not None
+        return self.steps is not None
+
+    @property
+    def label(self) -> str:
+        """The searched model's legend label (a growth search: at its N, without a growth)."""
+        if self.over == "dt_growth":
+            return replace(self.model, dt_growth=PAPER["dt_growth"]).label()
+        return self.model.label()
+
+    def u(self, x):
+        """The searched value on the axis the search is even in: log N, or log(dt_growth - 1)."""
+        x = np.asarray(x, dtype=np.float64)
+        return np.log(x - 1.0) if self.over == "dt_growth" else np.log(x)
+
+    def x(self, u: float):
+        """The value at ``u`` (inverse of ``u``), made valid (valid)."""
+        return self.valid(1.0 + math.exp(u) if self.over == "dt_growth" else math.exp(u))
+
+    def valid(self, x: float):
+        """A value a run can take: N an integer (FD: even); a growth with 3 significant digits past 1."""
+        if self.over == "dt_growth":
+            return 1.0 + float(f"{x - 1.0:.3g}")
+        return max(2, 2 * round(x / 2)) if self.fd else max(1, round(x))
+
+    def case_at(self, x) -> Case:
+        """The simulated case at searched value ``x``."""
+        return replace(self.model, dt_growth=float(x)) if self.over == "dt_growth" else self.model.at(int(x))
+
+    def grid(self, count: int) -> list:
+        """``count`` values spaced evenly in ``u`` from lo to hi, each once."""
+        return sorted({self.x(v) for v in np.linspace(float(self.u(self.lo)), float(self.u(self.hi)), count)})
 
     @property
     def fd(self) -> bool:
@@ -125,29 +164,38 @@ class Search:
         return 1 if self.fd else self.initial_realisations
 
     @property
-    def coarse(self) -> list[int]:
+    def coarse(self) -> list:
         """The coarse grid the search starts on and walks along."""
-        return grid(self.n_lo, self.n_hi, self.initial_points, self.fd)
+        return self.grid(self.initial_points)
 
     @classmethod
     def from_config(cls, name: str, spec: Mapping, config: Mapping) -> Search:
         """The search ``optimum.<name>`` of a workflow config; SettingError names the key path."""
         where = f"optimum.{name}"
+        over = "dt_growth" if "growth_range" in spec else "n"
+        if over == "dt_growth" and "n_range" in spec:
+            raise SettingError(f"{where}.n_range", spec["n_range"], "absent when growth_range is set (one dimension)")
+        if over == "dt_growth" and "n" not in spec:
+            raise SettingError(f"{where}.n", None, "the N at which a growth_range search runs, an integer >= 1")
+        if over == "n" and "n_range" not in spec:
+            raise SettingError(f"{where}.n_range", None, "[low, high]: the N searched (or growth_range)")
         try:
-            model = Case.from_spec(spec["case"], None, config.get("case_defaults", {}))
+            n = int(spec["n"]) if over == "dt_growth" else None
+            model = Case.from_spec(spec["case"], n, config.get("case_defaults", {}))
         except SettingError as e:
             raise SettingError(f"{where}.case.{e.name}", e.value, e.allowed) from None
-        lo, hi = (int(v) for v in spec["n_range"])
-        first_dt = None
-        if spec.get("time_volume", False):
-            t = {**TIME_DEFAULTS, **config.get("time", {})}
-            first_dt = first_step(model.method, model.dt_growth, t["dt0"], t["fd_dt"], t["fixed_dt"])
+        if over == "dt_growth":
+            lo, hi = (float(v) for v in spec["growth_range"])
+        else:
+            lo, hi = (int(v) for v in spec["n_range"])
+        steps = {**TIME_DEFAULTS, **config.get("time", {})} if spec.get("time_volume", False) else None
         search = cls(
             name=name,
             model=model,
             time=float(spec["time"]),
-            n_lo=lo,
-            n_hi=hi,
+            lo=lo,
+            hi=hi,
+            over=over,
             width=float(spec.get("width", cls.width)),
             budget_runs=int(spec["budget_runs"]) if "budget_runs" in spec else math.inf,
             budget_core_s=float(spec.get("budget_core_s", cls.budget_core_s)),
@@ -157,21 +205,28 @@ class Search:
             max_realisations=int(spec.get("max_realisations", cls.max_realisations)),
             convention=str(spec.get("convention", cls.convention)),
             measure=str(spec.get("measure", cls.measure)),
-            first_dt=first_dt,
+            steps=steps,
         )
         search.check(where, float(config["physics"]["t_final"]))
         return search
 
     def check(self, where: str, t_final: float) -> None:
         """Refuse a search that cannot run: an empty range, a budget below one round, a time past t_final."""
-        if not 1 <= self.n_lo < self.n_hi:
-            raise SettingError(f"{where}.n_range", [self.n_lo, self.n_hi], "[low, high] with 1 <= low < high")
-        if self.fd and self.n_lo < 2:
-            raise SettingError(f"{where}.n_range", [self.n_lo, self.n_hi], "for fd a low end >= 2 (even intervals)")
+        if self.over == "dt_growth":
+            if self.model.method not in APPLIES["dt_growth"]:
+                methods = ", ".join(APPLIES["dt_growth"])
+                raise SettingError(f"{where}.growth_range", [self.lo, self.hi], f"a method with a dt growth: {methods}")
+            if not 1 < self.lo < self.hi or self.valid(self.lo) == self.valid(self.hi):
+                allowed = "[low, high] with 1 < low < high (1 = a fixed step, not a growth)"
+                raise SettingError(f"{where}.growth_range", [self.lo, self.hi], allowed)
+        elif not 1 <= self.lo < self.hi:
+            raise SettingError(f"{where}.n_range", [self.lo, self.hi], "[low, high] with 1 <= low < high")
+        elif self.fd and self.lo < 2:
+            raise SettingError(f"{where}.n_range", [self.lo, self.hi], "for fd a low end >= 2 (even intervals)")
         if not 0 < self.time <= t_final:
             raise SettingError(f"{where}.time", self.time, f"a time in (0, physics.t_final = {t_final:g}]")
         if not self.width > self.min_step:
-            raise SettingError(f"{where}.width", self.width, f"a ratio n_hi / n_lo > {self.min_step}")
+            raise SettingError(f"{where}.width", self.width, f"a ratio high / low > {self.min_step}")
         if self.convention not in CONVENTIONS:
             raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
         if self.measure not in MEASURES:
@@ -198,21 +253,23 @@ class Search:
             )
 
 
-def _valid_n(n: float, fd: bool) -> int:
-    return max(2, 2 * round(n / 2)) if fd else max(1, round(n))
-
-
 def grid(lo: int, hi: int, count: int, fd: bool = False) -> list[int]:
     """``count`` N spaced evenly in log N from lo to hi (FD: even), each once."""
-    points = np.exp(np.linspace(math.log(lo), math.log(hi), count))
-    return sorted({_valid_n(p, fd) for p in points})
+    search = Search("grid", Case("fd" if fd else "mtpt", "implicit" if fd else "collision", None), 1.0, lo, hi)
+    return search.grid(count)
+
+
+def _block(search: Search, k: int, x, first: int, count: int) -> tuple:
+    case = search.case_at(x)
+    return (k, case.n, case.dt_growth, first, first + count - 1, False, "")
 
 
 def initial_plan(search: Search, base_seed: int) -> pd.DataFrame:
     """Round 0: the lowest ``start_points`` of the coarse grid, each with the first realisations
-    (seeds base_seed ...): the cheap end first, larger N only when the minimum may lie there."""
-    r = search.realisations
-    rows = [(0, n, base_seed, base_seed + r - 1, False, "") for n in search.coarse[: search.start_points]]
+    (seeds base_seed ...): the cheap end first (for a growth search, the largest growth: fewest
+    steps), the expensive end only when the minimum may lie there."""
+    coarse = search.coarse[::-1] if search.over == "dt_growth" else search.coarse
+    rows = [_block(search, 0, x, base_seed, search.realisations) for x in coarse[: search.start_points]]
     return pd.DataFrame(rows, columns=PLAN_COLUMNS)
 
 
@@ -220,38 +277,42 @@ def runs_in(plan: pd.DataFrame) -> int:
     return int((plan["last"] - plan["first"] + 1).sum())
 
 
-def cost_model(costs: pd.DataFrame) -> Callable[[float], float]:
-    """Predicted core-seconds of one run at N from measured runs (columns n, seed, core_s): the mean
-    per N interpolated in log N - log cost, extrapolated with the end segments' slopes (kept in
-    [0, 2]: no method here costs more than N^2); one measured N: cost proportional to N."""
-    per_run = costs.groupby("n")["core_s"].mean()
+def cost_model(costs: pd.DataFrame, search: Search | None = None) -> Callable[[float], float]:
+    """Predicted core-seconds of one run at a searched value from measured runs (columns of the
+    searched dimension, seed, core_s): the mean per value interpolated in u (log N) - log cost,
+    extrapolated with the end segments' slopes (kept in [-2, 2]: no run here costs more than N^2
+    or steps^2); one measured value: cost proportional to N (to steps for a growth search)."""
+    column = search.over if search else "n"
+    to_u = search.u if search else np.log
+    per_run = costs.groupby(column)["core_s"].mean()
     if per_run.empty:
-        return lambda n: 0.0
-    u = np.log(per_run.index.to_numpy(np.float64))
+        return lambda x: 0.0
+    u = np.asarray(to_u(per_run.index.to_numpy(np.float64)), dtype=np.float64)
     c = np.log(np.maximum(per_run.to_numpy(np.float64), 1e-9))
+    alone = -1.0 if column == "dt_growth" else 1.0
 
     def slope(i, j):
-        return 1.0 if len(u) < 2 else float(np.clip((c[j] - c[i]) / (u[j] - u[i]), 0.0, 2.0))
+        return alone if len(u) < 2 else float(np.clip((c[j] - c[i]) / (u[j] - u[i]), -2.0, 2.0))
 
     lo, hi = slope(0, 1), slope(-2, -1)
 
-    def predict(n: float) -> float:
-        x = math.log(n)
-        if x < u[0]:
-            return float(math.exp(c[0] + lo * (x - u[0])))
-        if x > u[-1]:
-            return float(math.exp(c[-1] + hi * (x - u[-1])))
-        return float(math.exp(np.interp(x, u, c)))
+    def predict(x: float) -> float:
+        v = float(to_u(x))
+        if v < u[0]:
+            return float(math.exp(c[0] + lo * (v - u[0])))
+        if v > u[-1]:
+            return float(math.exp(c[-1] + hi * (v - u[-1])))
+        return float(math.exp(np.interp(v, u, c)))
 
     return predict
 
 
 def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach: int = 2) -> np.ndarray:
-    """Where the minimum over log N lies, for each column of ``values`` (shape (N count, columns),
-    rows in increasing ``u`` = log N): the vertex of a quadratic in u, least squares weighted by
+    """Where the minimum over u (log N) lies, for each column of ``values`` (shape (points, columns),
+    rows in increasing ``u``): the vertex of a quadratic in u, least squares weighted by
     ``weights`` (realisations), through the rows within ``reach`` of the column's lowest, kept
     between that row's neighbours; the lowest row itself when it is an end row or the fit does
-    not turn up. Fitting several N at once keeps one lucky mean from being taken for the minimum."""
+    not turn up. Fitting several points at once keeps one lucky mean from being taken for the minimum."""
     values = np.asarray(values, dtype=np.float64)
     values = values[:, None] if values.ndim == 1 else values
     k = np.argmin(np.where(np.isnan(values), np.inf, values), axis=0)
@@ -273,8 +334,8 @@ def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach
 
 
 def _fitted_interval(u, resampled, objective, counts) -> tuple[float, float]:
-    """95 % percentile interval of the fitted minimum (log N) over bootstrap resamples of the
-    realisations (scipy.stats.bootstrap, each N on its own; single realisations held fixed)."""
+    """95 % percentile interval of the fitted minimum (in u) over bootstrap resamples of the
+    realisations (scipy.stats.bootstrap, each point on its own; single realisations held fixed)."""
     free = [i for i, r in enumerate(resampled) if len(r) > 1]
     means = np.array([r.mean() for r in resampled])
 
@@ -311,171 +372,188 @@ def judged(search: Search, realisations: pd.DataFrame) -> pd.DataFrame:
     if search.measure == "points":
         r = r.assign(COMIC=r["COMIC_points"], SSE=r["SSE_points"], n_sse=MEASUREMENT_POINTS)
     if search.time_volume:
+        s, method = search.steps, search.model.method
         times = r["time_step"].to_numpy(np.float64)
-        steps = np.array([step_count(t, search.first_dt, search.model.dt_growth) for t in times])
-        mean_dt = times / steps
+        growth = r["dt_growth"].to_numpy(np.float64)
+        first = [first_step(method, g, s["dt0"], s["fd_dt"], s["fixed_dt"]) for g in growth]
+        mean_dt = times / np.array([step_count(t, d, g) for t, d, g in zip(times, first, growth)])
         r = r.assign(COMIC=r["COMIC"] - np.log(mean_dt), dV=r["dV"] * mean_dt)
     return r
 
 
 def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, dict]:
-    """Per-N statistics (n, realisations, COMIC_mean, COMIC_std, COMIC_se, share) and the
-    search-level optimum (n_best, n_opt, ci_lo, ci_hi, bracket_lo, bracket_hi, and for the walk
-    ``argmin_lo`` / ``argmin_hi``, the visited N bounding the argmin's 95 % interval) of the
-    search's convention, from per-realisation values (columns n, seed, COMIC; for
-    COMIC_of_mean_SSE also SSE, n_sse, dV: aggregate.realisations_table at the search's time)."""
-    per_n = [g for _, g in judged(search, realisations).groupby("n", sort=True)]
-    ns = np.array([int(g["n"].iloc[0]) for g in per_n])
-    samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_n]
+    """Per-point statistics (the searched column, realisations, COMIC_mean, COMIC_std, COMIC_se,
+    share) and the search-level optimum (best, optimum, ci_lo, ci_hi, bracket_lo, bracket_hi, and
+    for the walk ``argmin_lo`` / ``argmin_hi``, the visited values bounding the argmin's 95 %
+    interval) of the search's convention, from per-realisation values (columns n, dt_growth,
+    seed, COMIC; as needed SSE, n_sse, dV, time_step, SSE_points, COMIC_points:
+    aggregate.realisations_table at the search's time)."""
+    per_x = [g for _, g in judged(search, realisations).groupby(search.over, sort=True)]
+    xs = np.array([g[search.over].iloc[0] for g in per_x])
+    samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_x]
     # mean COMIC, or Eq. 43 of the mean SSE (the paper warns the convention can move the optimum)
-    resampled, objective = convention_samples(per_n, search.convention)
+    resampled, objective = convention_samples(per_x, search.convention)
     shares, lo, hi, _ = argmin_bootstrap(resampled, objective)
     counts = np.array([len(s) for s in samples])
-    u = np.log(ns.astype(np.float64))
+    u = np.asarray(search.u(xs), dtype=np.float64)
     with np.errstate(divide="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
         minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
     best = int(np.argmin(minimised))
-    n_opt = _valid_n(math.exp(fitted_minimum(u, minimised, counts)[0]), search.fd)
+    x_opt = search.x(float(fitted_minimum(u, minimised, counts)[0]))
     if (counts > 1).any():
         u_lo, u_hi = _fitted_interval(u, resampled, objective, counts)
-        ci_lo, ci_hi = math.exp(u_lo), math.exp(u_hi)
+        ci_lo, ci_hi = search.x(u_lo), search.x(u_hi)
     else:  # deterministic (FD): the minimum lies between the lowest point's neighbours
-        ci_lo, ci_hi = float(ns[max(best - 1, 0)]), float(ns[min(best + 1, len(ns) - 1)])
-    below, above = ns[ns <= ci_lo * (1 + 1e-12)], ns[ns >= ci_hi * (1 - 1e-12)]
+        ci_lo, ci_hi = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
+    below, above = xs[u <= search.u(ci_lo) + 1e-12], xs[u >= search.u(ci_hi) - 1e-12]
     means = np.array([s.mean() for s in samples])
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])
     se = np.where(counts > 1, stds / np.sqrt(counts), 0.0)
     table = pd.DataFrame(
-        {"n": ns, "realisations": counts, "COMIC_mean": means, "COMIC_std": stds, "COMIC_se": se, "share": shares}
+        {
+            search.over: xs,
+            "realisations": counts,
+            "COMIC_mean": means,
+            "COMIC_std": stds,
+            "COMIC_se": se,
+            "share": shares,
+        }
     )
     optimum = {
-        "n_best": int(ns[best]),
-        "n_opt": n_opt,
-        "ci_lo": int(round(ci_lo)),
-        "ci_hi": int(round(ci_hi)),
-        "bracket_lo": int(below.max()) if below.size else int(ns[0]),
-        "bracket_hi": int(above.min()) if above.size else int(ns[-1]),
-        "argmin_lo": int(ns[lo]),
-        "argmin_hi": int(ns[hi]),
+        "best": xs[best].item(),
+        "optimum": x_opt,
+        "ci_lo": ci_lo.item() if hasattr(ci_lo, "item") else ci_lo,
+        "ci_hi": ci_hi.item() if hasattr(ci_hi, "item") else ci_hi,
+        "bracket_lo": (below.max() if below.size else xs[0]).item(),
+        "bracket_hi": (above.min() if above.size else xs[-1]).item(),
+        "argmin_lo": xs[lo].item(),
+        "argmin_hi": xs[hi].item(),
     }
     return table, optimum
 
 
-def _unresolved(table: pd.DataFrame, n_best: int) -> list[int]:
-    """N whose mean COMIC is within 2 combined standard errors of the lowest mean's (judged on mean
-    COMIC under either convention: its standard error is the one at hand)."""
-    opt = table[table["n"] == n_best].iloc[0]
+def _unresolved(table: pd.DataFrame, search: Search, best) -> list:
+    """Values whose mean COMIC is within 2 combined standard errors of the lowest mean's (judged on
+    mean COMIC under either convention: its standard error is the one at hand)."""
+    opt = table[table[search.over] == best].iloc[0]
     gap = (table["COMIC_mean"] - opt["COMIC_mean"]).abs()
     noise = np.sqrt(table["COMIC_se"] ** 2 + opt["COMIC_se"] ** 2)
-    return table.loc[(gap <= 2 * noise) & (noise > 0), "n"].astype(int).tolist()
+    return table.loc[(gap <= 2 * noise) & (noise > 0), search.over].tolist()
 
 
-def _walk(search: Search, ns: list[int], opt: dict) -> list[int]:
-    """The next N beyond the visited ones, while the argmin's interval reaches the highest (lowest)
-    visited N and the range goes on: one coarse step, or half of one when the fitted minimum
-    already lies inside the visited N (the next point only has to show the curve turning up)."""
-    step = (search.n_hi / search.n_lo) ** (1.0 / (search.initial_points - 1))
+def _walk(search: Search, xs: list, opt: dict) -> list:
+    """The next value beyond the visited ones, while the argmin's interval reaches the highest
+    (lowest) visited one and the range goes on: one coarse step in u, or half of one when the
+    fitted minimum already lies inside the visited values (the next point only has to show the
+    curve turning up)."""
+    step = float(search.u(search.hi) - search.u(search.lo)) / (search.initial_points - 1)
+    near = math.log(search.min_step)
     out = []
-    if opt["argmin_hi"] == ns[-1] and ns[-1] < search.n_hi:
-        factor = step if opt["n_opt"] >= ns[-1] else math.sqrt(step)
-        n = ns[-1] * factor
-        out.append(search.n_hi if n * search.min_step >= search.n_hi else _valid_n(n, search.fd))
-    if opt["argmin_lo"] == ns[0] and ns[0] > search.n_lo:
-        factor = step if opt["n_opt"] <= ns[0] else math.sqrt(step)
-        n = ns[0] / factor
-        out.append(search.n_lo if n / search.min_step <= search.n_lo else _valid_n(n, search.fd))
-    return [n for n in out if n not in ns]
+    if opt["argmin_hi"] == xs[-1] and xs[-1] < search.hi:
+        v = float(search.u(xs[-1])) + (step if opt["optimum"] >= xs[-1] else step / 2)
+        out.append(search.hi if v + near >= search.u(search.hi) else search.x(v))
+    if opt["argmin_lo"] == xs[0] and xs[0] > search.lo:
+        v = float(search.u(xs[0])) - (step if opt["optimum"] <= xs[0] else step / 2)
+        out.append(search.lo if v - near <= search.u(search.lo) else search.x(v))
+    return [x for x in out if x not in xs]
 
 
 def next_plan(
     search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame | None = None
 ) -> pd.DataFrame:
     """The plan after one more round: ``plan`` plus the blocks this round adds, or ``plan``
-    with `done` set and the reason (REASONS) when the search stops. ``costs`` (columns n, seed,
-    core_s: the measured runs so far) predicts what new runs cost, for the core-seconds budget
-    and to replicate the cheapest N first; without it every run counts as free."""
-    costs = pd.DataFrame(columns=["n", "seed", "core_s"]) if costs is None else costs
+    with `done` set and the reason (REASONS) when the search stops. ``costs`` (columns n,
+    dt_growth, seed, core_s: the measured runs so far) predicts what new runs cost, for the
+    core-seconds budget and to replicate the cheapest first; without it every run counts as free."""
+    costs = pd.DataFrame(columns=["n", "dt_growth", "seed", "core_s"]) if costs is None else costs
     k = int(plan["round"].max()) + 1
     table, opt = evaluate(search, realisations)
-    ns = table["n"].tolist()
+    xs = table[search.over].tolist()
 
     def stop(reason):
         out = plan.copy()
         out["done"], out["reason"] = True, reason
         return out
 
-    walk = _walk(search, ns, opt)
-    at_end = opt["argmin_lo"] == search.n_lo or opt["argmin_hi"] == search.n_hi
-    if not walk and opt["bracket_hi"] / opt["bracket_lo"] <= search.width:
+    walk = _walk(search, xs, opt)
+    at_end = opt["argmin_lo"] == search.lo or opt["argmin_hi"] == search.hi
+    if not walk and search.u(opt["bracket_hi"]) - search.u(opt["bracket_lo"]) <= math.log(search.width) + 1e-12:
         return stop(REASONS[4] if at_end else REASONS[0])
     if k > MAX_ROUNDS:
         return stop(REASONS[3])
-    inside = [n for n in ns if opt["bracket_lo"] <= n <= opt["bracket_hi"]]
-    new_n = []
+    inside = [x for x in xs if opt["bracket_lo"] <= x <= opt["bracket_hi"]]
+    new = []
     for a, b in zip(inside, inside[1:]):  # refine every gap of the bracket
-        if b / a > search.min_step:
-            mid = _valid_n(math.sqrt(a * b), search.fd)
-            if a < mid < b and mid not in ns:
-                new_n.append(mid)
-    new_n.sort(key=lambda n: abs(math.log(n / opt["n_opt"])))  # nearest the optimum first
-    predict = cost_model(costs)
-    more = [] if search.fd else sorted((n for n in _unresolved(table, opt["n_best"]) if n in inside), key=predict)
+        ua, ub = float(search.u(a)), float(search.u(b))
+        if ub - ua > math.log(search.min_step):
+            mid = search.x((ua + ub) / 2)
+            if a < mid < b and mid not in xs:
+                new.append(mid)
+    u_opt = float(search.u(opt["optimum"]))
+    new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
+    predict = cost_model(costs, search)
+    more = [] if search.fd else sorted((x for x in _unresolved(table, search, opt["best"]) if x in inside), key=predict)
     base = int(plan["first"].min())
     added = []
     spent, spent_s = runs_in(plan), float(costs["core_s"].sum())
 
-    def add(n, first, count):
+    def add(x, first, count):
         nonlocal spent, spent_s
-        cost = count * predict(n)
+        cost = count * predict(x)
         if spent + count > search.budget_runs or spent_s + cost > search.budget_core_s:
             return
-        added.append((k, n, first, first + count - 1, False, ""))
+        added.append(_block(search, k, x, first, count))
         spent, spent_s = spent + count, spent_s + cost
 
-    for n in [*walk, *new_n]:
-        add(n, base, search.realisations)
-    counts = dict(zip(table["n"], table["realisations"]))
-    for n in more:  # cheapest first: a doubling at small N costs little
-        have = int(counts[n])
-        add(n, base + have, min(have, search.max_realisations - have))
+    for x in [*walk, *new]:
+        add(x, base, search.realisations)
+    counts = dict(zip(table[search.over], table["realisations"]))
+    for x in more:  # cheapest first: a doubling at small N costs little
+        have = int(counts[x])
+        add(x, base + have, min(have, search.max_realisations - have))
     if not added:
-        wanted = bool(walk or new_n) or any(counts[n] < search.max_realisations for n in more)
+        wanted = bool(walk or new) or any(counts[x] < search.max_realisations for x in more)
         return stop(REASONS[1] if wanted else REASONS[2])
     return pd.concat([plan, pd.DataFrame(added, columns=PLAN_COLUMNS)], ignore_index=True)
 
 
 def read_costs(paths: list[str]) -> pd.DataFrame:
-    """Measured core-seconds of every run (n, seed, core_s: summed step wall times) in run tables."""
+    """Measured core-seconds of every run (n, dt_growth, seed, core_s: summed step wall times)."""
+    keys = ["n", "dt_growth", "seed"]
     if not paths:
-        return pd.DataFrame(columns=["n", "seed", "core_s"])
-    steps = pd.concat([pd.read_parquet(p, columns=["n", "seed", "wall_s"]) for p in paths], ignore_index=True)
-    costs = steps.groupby(["n", "seed"], as_index=False)["wall_s"].sum()
-    return costs.rename(columns={"wall_s": "core_s"})
+        return pd.DataFrame(columns=[*keys, "core_s"])
+    steps = pd.concat([pd.read_parquet(p, columns=[*keys, "wall_s"]) for p in paths], ignore_index=True)
+    return steps.groupby(keys, as_index=False)["wall_s"].sum().rename(columns={"wall_s": "core_s"})
 
 
 def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame) -> pd.DataFrame:
-    """Every visited N of a finished search with its statistics, the optimum, the cost spent and
-    the estimated cost of the full sweep (RESULT_COLUMN_DOCS). ``costs``: columns n, seed, core_s."""
+    """Every visited point of a finished search with its statistics, the optimum, the cost spent
+    and the estimated cost of the full sweep (RESULT_COLUMN_DOCS). ``costs``: columns n,
+    dt_growth, seed, core_s."""
     table, opt = evaluate(search, realisations)
-    first_round = plan.groupby("n")["round"].min()
-    cost_n = costs.groupby("n")["core_s"].sum()
-    table["round_added"] = table["n"].map(first_round).astype(int)
-    table["core_s"] = table["n"].map(cost_n).astype(float)
+    first_round = plan.groupby(search.over)["round"].min()
+    cost_x = costs.groupby(search.over)["core_s"].sum()
+    table["round_added"] = table[search.over].map(first_round).astype(int)
+    table["core_s"] = table[search.over].map(cost_x).astype(float)
+    other = "dt_growth" if search.over == "n" else "n"
+    table[other] = getattr(search.model, other)
     # a grid brackets its minimum between the argmin's two neighbours: to give the same bracket
-    # a full sweep needs the step sqrt(bracket_hi / bracket_lo) over the whole range
-    step = max(search.min_step, math.sqrt(opt["bracket_hi"] / opt["bracket_lo"]))
-    count = math.ceil(math.log(search.n_hi / search.n_lo) / math.log(step)) + 1
-    predict = cost_model(costs)
-    sweep = grid(search.n_lo, search.n_hi, count, search.fd)
-    full = float(sum(predict(n) for n in sweep) * table["realisations"].max())
+    # a full sweep needs half the bracket's width in u as its step over the whole range
+    width = float(search.u(opt["bracket_hi"]) - search.u(opt["bracket_lo"]))
+    step = max(math.log(search.min_step), width / 2)
+    span = float(search.u(search.hi) - search.u(search.lo))
+    predict = cost_model(costs, search)
+    sweep = search.grid(math.ceil(span / step - 1e-9) + 1)
+    full = float(sum(predict(x) for x in sweep) * table["realisations"].max())
     out = table.assign(
         search=search.name,
-        label=search.model.label(),
+        label=search.label,
         time=search.time,
         convention=search.convention,
         measure=search.measure,
         time_volume=search.time_volume,
-        **{k: v for k, v in opt.items() if k in RESULT_COLUMN_DOCS},
+        over=search.over,
+        **{k: float(v) for k, v in opt.items() if k in RESULT_COLUMN_DOCS},
         reason=str(plan["reason"].iloc[-1]),
         rounds=int(plan["round"].max()) + 1,
         runs_spent=runs_in(plan),

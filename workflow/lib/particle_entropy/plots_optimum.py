@@ -1,9 +1,11 @@
 """figures/optimum_<name>.png: an adaptive COMIC search (optimum.py) drawn from its result table.
 
-Mean COMIC +-1 standard error of every visited N on a log N axis, coloured by the round that
-added it and labelled with its realisations; the bracket of the optimum (light band) and the
-bootstrap interval of the argmin (dark band) shaded, a star at n_opt; below the axes, the runs
-and core-seconds spent against a full grid sweep resolving the same bracket, and why it stopped.
+Mean COMIC +-1 standard error of every visited point on a log N axis (a growth search: log of
+dt_growth - 1), coloured by the round that added it and labelled with its realisations; the
+bracket of the optimum (light band) and the bootstrap interval of the fitted optimum (dark band)
+shaded, a star at the lowest visited mean and a dashed line at the fitted optimum; below the
+axes, the runs and core-seconds spent against a full grid sweep resolving the same bracket, and
+why it stopped.
 """
 
 from __future__ import annotations
@@ -49,20 +51,28 @@ def cost_text(row: pd.Series) -> str:
     )
 
 
+def _value(v, growth: bool) -> str:
+    return f"{float(v):.4g}" if growth else f"{int(round(float(v))):,}"
+
+
 def optimum_figure(table: pd.DataFrame):
     """The figure of one finished search (optimum.RESULT_COLUMNS, one row per visited N)."""
     fig, (ax,) = _figure(1, width=7.0, height=4.6)
-    t = table.sort_values("n")
-    first = t.iloc[0]
-    _span(ax, float(first["bracket_lo"]), float(first["bracket_hi"]), BRACKET)
-    _span(ax, float(first["ci_lo"]), float(first["ci_hi"]), INTERVAL)
-    ax.plot(t["n"], t["COMIC_mean"], color=GREY, linewidth=0.8, zorder=1)
+    first = table.iloc[0]
+    over = str(first["over"])
+    t = table.sort_values(over)
+    growth = over == "dt_growth"
+    x = t[over] - 1.0 if growth else t[over]  # a growth search is drawn over dt_growth - 1 (log axis)
+    shift = 1.0 if growth else 0.0
+    _span(ax, float(first["bracket_lo"]) - shift, float(first["bracket_hi"]) - shift, BRACKET)
+    _span(ax, float(first["ci_lo"]) - shift, float(first["ci_hi"]) - shift, INTERVAL)
+    ax.plot(x, t["COMIC_mean"], color=GREY, linewidth=0.8, zorder=1)
     colours = _round_colours(t["round_added"])
     size = 4.0 + 2.0 * np.sqrt(t["realisations"].to_numpy(float))  # marker area grows with realisations
-    for (_, row), ms in zip(t.iterrows(), size):
+    for (_, row), xv, ms in zip(t.iterrows(), x, size):
         colour = colours[int(row["round_added"])]
         ax.errorbar(
-            row["n"],
+            xv,
             row["COMIC_mean"],
             yerr=row["COMIC_se"] if np.isfinite(row["COMIC_se"]) else None,
             color=colour,
@@ -75,7 +85,7 @@ def optimum_figure(table: pd.DataFrame):
         )
         ax.annotate(
             f"{int(row['realisations'])}",
-            (row["n"], row["COMIC_mean"]),
+            (xv, row["COMIC_mean"]),
             textcoords="offset points",
             xytext=(ms / 2 + 3, 2),
             ha="left",
@@ -83,8 +93,18 @@ def optimum_figure(table: pd.DataFrame):
             fontsize=7,
             color="0.25",
         )
-    best = t[t["n"] == first["n_opt"]].iloc[0]
-    ax.plot(best["n"], best["COMIC_mean"], marker="*", markersize=16, color=VERMILLION, markeredgecolor=BLACK, zorder=4)
+    best = t[t[over] == first["best"]].iloc[0]
+    ax.plot(
+        float(best[over]) - shift,
+        best["COMIC_mean"],
+        marker="*",
+        markersize=16,
+        color=VERMILLION,
+        markeredgecolor=BLACK,
+        zorder=4,
+    )
+    ax.axvline(float(first["optimum"]) - shift, color=VERMILLION, linestyle="--", linewidth=1.0, zorder=2)
+    name = "dt growth" if growth else "N"
     handles = [
         Line2D([], [], linestyle="", marker="o", color=c, markeredgecolor=BLACK, label=f"added in round {r}")
         for r, c in colours.items()
@@ -98,16 +118,28 @@ def optimum_figure(table: pd.DataFrame):
             markersize=12,
             color=VERMILLION,
             markeredgecolor=BLACK,
-            label=f"optimum N = {int(first['n_opt']):,}",
+            label=f"lowest mean: {name} = {_value(first['best'], growth)}",
         ),
-        Patch(color=INTERVAL, label=f"95 % interval of the argmin: {int(first['ci_lo']):,}–{int(first['ci_hi']):,}"),
-        Patch(color=BRACKET, label=f"bracket: {int(first['bracket_lo']):,}–{int(first['bracket_hi']):,}"),
+        Line2D([], [], color=VERMILLION, linestyle="--", label=f"fitted optimum: {_value(first['optimum'], growth)}"),
+        Patch(
+            color=INTERVAL,
+            label=f"95 % interval: {_value(first['ci_lo'], growth)}–{_value(first['ci_hi'], growth)}",
+        ),
+        Patch(
+            color=BRACKET,
+            label=f"bracket: {_value(first['bracket_lo'], growth)}–{_value(first['bracket_hi'], growth)}",
+        ),
     ]
-    title = f"{first['search']}: {first['label']}, COMIC at t = {float(first['time']):g}"
-    _look(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel="$N$ (numbers: realisations)", legend=None)
+    flags = (("SSE at the 15 common points", first["measure"] == "points"), ("dt in dV", bool(first["time_volume"])))
+    options = [o for o, on in flags if on]
+    options += [] if first["convention"] == "mean_COMIC" else ["COMIC of mean SSE"]
+    judged = f"COMIC at t = {float(first['time']):g}" + "".join(f"; {o}" for o in options)
+    title = f"{first['search']}: {first['label']}\n{judged}"  # two lines: long names are not clipped
+    xlabel = "dt growth − 1 (numbers: realisations)" if growth else "$N$ (numbers: realisations)"
+    _look(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel=xlabel, legend=None)
     ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}" if growth else f"{v:,.0f}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
     fig.text(0.01, 0.005, cost_text(first), fontsize=8, ha="left", va="bottom", color="0.2")
     fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))

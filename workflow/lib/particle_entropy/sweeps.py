@@ -229,15 +229,14 @@ def optimum_searches(config: Mapping) -> dict:
 
 
 def optimum_largest_jobs(config: Mapping) -> list[tuple[str, Ensemble]]:
-    """Per search, its largest possible simulation job: the top of its N range with the most seeds
-    one block can hold (the first round's realisations, or a doubling up to max_realisations)."""
-    from .optimum import grid
-
+    """Per search, its largest possible simulation jobs: both ends of its range (the top N; the
+    smallest growth, most steps) with the most seeds one block can hold (the first round's
+    realisations, or a doubling up to max_realisations)."""
     out = []
     for name, search in optimum_searches(config).items():
         seeds = 1 if search.fd else max(search.initial_realisations, search.max_realisations // 2)
-        top = grid(search.n_lo, search.n_hi, 2, search.fd)[-1]
-        out.append((f"optimum.{name}.n_range", Ensemble(search.model.at(top), seeds)))
+        key = f"optimum.{name}.{'growth_range' if search.over == 'dt_growth' else 'n_range'}"
+        out += [(key, Ensemble(search.case_at(x), seeds)) for x in search.grid(2)]
     return out
 
 
@@ -275,17 +274,16 @@ def check_optimum(config: Mapping) -> None:
     """Every adaptive search (config `optimum`) must be able to run: a model that exists, a range
     with room for a minimum, a budget of at least its first round, a time within t_final
     (optimum.Search.check) and runs valid at both ends of its range (seeds: check_seeds)."""
-    from .optimum import grid
-
     for name, search in optimum_searches(config).items():
         where = f"optimum.{name}"
-        for n in grid(search.n_lo, search.n_hi, 2, search.fd):  # the range's ends (FD: even)
-            case = search.model.at(n)
+        key = "growth_range" if search.over == "dt_growth" else "n_range"
+        for x in search.grid(2):  # the range's ends (FD: even)
+            case = search.case_at(x)
             try:
                 run_config(case, config)
             except SettingError as e:
-                if e.name == "n":
-                    raise SettingError(f"{where}.n_range", [search.n_lo, search.n_hi], e.allowed) from None
+                if e.name in ("n", "dt_growth"):
+                    raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
                 raise _case_error(e, f"{where}.case", case) from None
 
 
