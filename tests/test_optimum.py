@@ -220,6 +220,10 @@ def test_the_search_walks_up_only_as_far_as_the_minimum_needs():
         plan = run_search(search, noise=0.0 if search.fd else 0.05)
         assert plan["n"].max() < 10_000  # N_STAR = 1000; the range goes to 30,000
         assert plan["n"].max() > N_STAR  # but far enough to see the curve turn up
+        for k in range(1, int(plan["round"].max()) + 1):  # a round that walks does nothing else
+            before, added = plan[plan["round"] < k], plan[plan["round"] == k]
+            if added["n"].max() > before["n"].max():
+                assert (added["n"] > before["n"].max()).all() and (added["first"] == 0).all()
 
 
 def test_a_minimum_high_in_the_range_is_reached_by_walking():

@@ -9,7 +9,7 @@ may lie there:
   lowest mean (``fitted_minimum``); its bootstrap over realisations gives the interval. While
   that interval reaches the highest (lowest) visited N and the range goes on, the search
   *walks* one coarse step further (half a step when the fit already turns up inside);
-- once bracketed, a round *refines* (a geometric midpoint in every gap of the bracket wider
+- once bracketed (never in a walking round), a round *refines* (a geometric midpoint in every gap of the bracket wider
   than ``min_step``, nearest the optimum first) and *replicates* (doubles the realisations,
   cheapest N first, of every N of the bracket whose mean is within 2 combined standard errors
   of the lowest, up to ``max_realisations``).
@@ -481,7 +481,9 @@ def next_plan(
         return stop(REASONS[4] if at_end else REASONS[0])
     if k > MAX_ROUNDS:
         return stop(REASONS[3])
-    inside = [x for x in xs if opt["bracket_lo"] <= x <= opt["bracket_hi"]]
+    # while walking, the bracket is not known yet: refining or replicating inside it would be spent
+    # on N the walk may leave behind
+    inside = [] if walk else [x for x in xs if opt["bracket_lo"] <= x <= opt["bracket_hi"]]
     new = []
     for a, b in zip(inside, inside[1:]):  # refine every gap of the bracket
         ua, ub = float(search.u(a)), float(search.u(b))
