@@ -273,11 +273,13 @@ def test_realisations_are_the_runs_at_the_nearest_step_and_average_to_the_summar
         for seed, run_ in zip(SEEDS, runs, strict=True):
             r = rows[rows["seed"] == seed].iloc[0]
             want = run_[run_["time"] == step_time].iloc[0]
-            assert (r["SSE"], r["COMIC"], r["n_sse"], r["dV"]) == (
+            assert (r["SSE"], r["COMIC"], r["n_sse"], r["dV"], r["SSE_points"], r["COMIC_points"]) == (
                 want["SSE"],
                 want["COMIC"],
                 want["n_sse"],
                 want["dV"],
+                want["SSE_points"],
+                want["COMIC_points"],
             )
         # the per-seed values average to the ensemble mean of the COMIC table
         comic = comic_table([summarise_runs(runs)], [requested]).iloc[0]

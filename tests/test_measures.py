@@ -151,3 +151,64 @@ def test_analytic_sampled_is_the_normalised_gaussian():
     ref = gaussian(x, D, t)
     ref = ref / (ref.sum() * dV)
     np.testing.assert_allclose(g, ref, rtol=1e-12, atol=0)
+
+
+# --------------------------------------------------------------------------- measurement points
+def test_measurement_points_are_fixed_sorted_and_in_the_fd_domain():
+    """Section 6, point 1: 15 points common to all simulations, uniform on [-6, 6] (the paper's FD
+    domain), drawn once from the registry's seed."""
+    from particle_entropy.registry import MEASUREMENT_POINTS, MEASUREMENT_SEED, PAPER
+
+    p = M.measurement_points()
+    assert p.shape == (MEASUREMENT_POINTS,) == (15,)
+    assert PAPER["fd_length"] == 12.0
+    assert np.all(np.diff(p) > 0) and np.all(np.abs(p) < 6.0)
+    want = np.sort(np.random.default_rng(MEASUREMENT_SEED).uniform(-6.0, 6.0, 15))
+    np.testing.assert_array_equal(p, want)
+    np.testing.assert_array_equal(M.measurement_points(12.0), p)
+    assert M.measurement_points() is p and not p.flags.writeable  # one shared array nobody can change
+
+
+def test_at_points_interpolates_linearly_and_is_zero_outside():
+    x = np.array([-1.0, 0.0, 2.0])
+    c = np.array([4.0, 2.0, 6.0])
+    got = M.at_points(np.array([-3.0, -1.0, -0.5, 1.5, 2.0, 2.5]), x, c)
+    np.testing.assert_array_equal(got, [0.0, 4.0, 3.0, 5.0, 6.0, 0.0])
+
+
+def test_gaussian_density_is_the_exact_solution():
+    x = np.linspace(-3, 3, 41)
+    np.testing.assert_allclose(M.gaussian_density(x, 0.5, 2.0), gaussian(x, 0.5, 2.0), rtol=1e-14)
+
+
+def test_sse_points_of_the_exact_gaussian_is_zero():
+    """A model whose concentration is the exact Gaussian at every point it carries, the
+    measurement points among them, scores 0 to round-off."""
+    D, t = 1e-3, 250.0
+    p = M.measurement_points()
+    assert M.sse_points(p, p, M.gaussian_density(p, D, t), D, t, 0.1) == 0.0
+    x = np.union1d(np.linspace(-6, 6, 101), p)  # a grid with the points on it
+    assert M.sse_points(p, x, gaussian(x, D, t), D, t, 0.12) <= 1e-28
+
+
+def test_sse_points_by_hand_on_a_tiny_grid():
+    """Three points on a four-node grid: interpolation weights and the Gaussian written out."""
+    x = np.array([-1.0, 0.0, 1.0, 2.0])
+    c = np.array([0.0, 2.0, 1.0, 0.0])
+    p = np.array([-0.5, 0.25, 1.5])
+    D, t = 0.5, 1.0  # variance 2 D t = 1
+    model = [0.5 * 0.0 + 0.5 * 2.0, 0.75 * 2.0 + 0.25 * 1.0, 0.5 * 1.0 + 0.5 * 0.0]
+    exact = [math.exp(-(v**2) / 2) / math.sqrt(2 * math.pi) for v in p]
+    want = sum((a - b) ** 2 for a, b in zip(model, exact, strict=True))
+    assert M.sse_points(p, x, c, D, t, 1.0) == pytest.approx(want, rel=1e-14)
+
+
+def test_sse_points_at_t_zero_compares_with_the_models_own_delta():
+    """At t = 0, as SSE does, the reference is the delta on the model point nearest 0 (height
+    1 / dV): the model's own discrete delta scores 0, a displaced one does not."""
+    x = np.linspace(-1.0, 1.0, 5)  # spacing 0.5, node 2 at 0
+    p = np.array([-0.2, 0.1, 0.6])
+    delta = np.array([0.0, 0.0, 2.0, 0.0, 0.0])
+    assert M.sse_points(p, x, delta, 1e-3, 0.0, 0.5) == 0.0
+    moved = np.roll(delta, 1)  # 2 at x = 0.5: the model is 0, 0.4, 1.6; the reference 1.2, 1.6, 0
+    assert M.sse_points(p, x, moved, 1e-3, 0.0, 0.5) == pytest.approx(1.2**2 + 1.2**2 + 1.6**2, rel=1e-14)

@@ -199,6 +199,8 @@ def test_same_seed_same_bytes_different_seed_different_results(tmp_path, kwargs)
     assert _bytes(a, tmp_path / "a.parquet") == _bytes(b, tmp_path / "b.parquet")
     assert sa.equals(sb)
     assert not np.array_equal(a["H_C"].to_numpy()[1:], c["H_C"].to_numpy()[1:])
+    np.testing.assert_array_equal(a["SSE_points"], b["SSE_points"])  # the measurement points too
+    assert not np.array_equal(a["SSE_points"].to_numpy()[-5:], c["SSE_points"].to_numpy()[-5:])
     assert _bytes(a, tmp_path / "a.parquet") != _bytes(c, tmp_path / "c.parquet")
     # the timing columns (wall_s, peak_rss_mb) are the only ones allowed to differ
     pd.testing.assert_frame_equal(a.drop(columns=TIMING_COLUMNS), b.drop(columns=TIMING_COLUMNS))
@@ -212,7 +214,7 @@ def test_fd_is_deterministic(tmp_path):
 
 
 # --------------------------------------------------------------------------- NaN / warnings
-NUMERIC_SKIP = {"H_C_analytic", "H_C", "H_I", "E", "AIC", "COMIC"}  # may be -inf at t = 0
+NUMERIC_SKIP = {"H_C_analytic", "H_C", "H_I", "E", "AIC", "COMIC", "COMIC_points"}  # may be -inf at t = 0
 
 
 @pytest.mark.parametrize(
@@ -413,3 +415,96 @@ def test_authors_time_grid_ends_after_t_final():
     tab, _ = run(RunConfig(method="mtpt", kernel="collision", n=30, time_grid="authors"))
     assert len(tab) - 1 == 175 and tab["time"].iloc[-1] == pytest.approx(1021.1, abs=0.05)
     assert set(tab["time_grid"]) == {"authors"}
+
+
+# --------------------------------------------------------------------------- measurement points
+POINT_RUNS = [
+    dict(method="pt", kernel="bins", n=200, t_final=20.0, seed=1),
+    dict(method="pt", kernel="fixed", n=200, t_final=20.0, seed=2),
+    dict(method="pt", kernel="adaptive", n=200, t_final=20.0, seed=2),
+    dict(method="mtpt", kernel="collision", n=200, t_final=20.0, seed=3),
+    dict(method="mtpt", kernel="sph", n=200, eta=0.5, truncation=3.0, t_final=20.0, seed=4),
+    dict(method="mtpt", kernel="collision", n=200, t_final=20.0, seed=4, truncation=3.0, scheme="sequential"),
+    dict(method="fd", kernel="implicit", n=60, t_final=20.0),
+    dict(method="fd", kernel="explicit", n=60, t_final=20.0, fd_length=2.0),  # points beyond its domain
+]
+
+
+def test_every_run_measures_at_the_same_points_and_comic_points_is_eq43(monkeypatch):
+    """Section 6, point 1: every case and seed is sampled at the same 15 points (those of the
+    registry, whatever the run's own domain); COMIC_points = 2 ln(SSE_points / 15) - ln dV."""
+    import particle_entropy.measures as M
+    from particle_entropy.registry import MEASUREMENT_SEED
+
+    seen = []
+    at_points = M.at_points
+    monkeypatch.setattr(M, "at_points", lambda p, x, c: seen.append(np.array(p)) or at_points(p, x, c))
+    want = np.sort(np.random.default_rng(MEASUREMENT_SEED).uniform(-6.0, 6.0, 15))
+    for kwargs in POINT_RUNS:
+        seen.clear()
+        tab, _ = run(RunConfig(**kwargs))
+        assert len(seen) >= len(tab) - 1, kwargs  # every step measured at the points (PT adaptive: not t = 0)
+        for p in seen:
+            np.testing.assert_array_equal(p, want)
+        sse_p = tab["SSE_points"].to_numpy()
+        assert np.all(sse_p >= 0) and np.all(sse_p[1:] > 0), kwargs
+        with np.errstate(divide="ignore"):
+            comic = 2.0 * np.log(sse_p / 15.0) - np.log(tab["dV"].to_numpy())
+        np.testing.assert_allclose(tab["COMIC_points"], comic, rtol=1e-13, atol=0)
+        if kwargs["method"] in ("fd", "mtpt") or kwargs["kernel"] == "adaptive":
+            # at t = 0 the model is its own discrete delta, the reference of SSE and SSE_points
+            assert tab["SSE"].iloc[0] == tab["SSE_points"].iloc[0] == 0.0, kwargs
+
+
+def test_fd_sse_points_by_hand_at_three_points(monkeypatch):
+    """A six-interval FD run measured at three points: the final row's SSE_points and
+    COMIC_points from the final nodal state, with interpolation weights written out."""
+    import particle_entropy.measures as M
+
+    monkeypatch.setattr(M, "measurement_points", lambda fd_length=12.0: np.array([-3.0, 0.5, 5.5]))
+    tab, st = run(RunConfig(method="fd", n=6, D=0.01, dt0=5.0, t_final=100.0), want_state=True)
+    x, c = st["x"].to_numpy(), st["c"].to_numpy()
+    np.testing.assert_allclose(x, [-6, -4, -2, 0, 2, 4, 6], rtol=0, atol=1e-15)
+    model = [0.5 * c[1] + 0.5 * c[2], 0.75 * c[3] + 0.25 * c[4], 0.25 * c[5] + 0.75 * c[6]]
+    var = 2 * 0.01 * 100.0
+    exact = [math.exp(-p * p / (2 * var)) / math.sqrt(2 * math.pi * var) for p in (-3.0, 0.5, 5.5)]
+    sse = sum((a - b) ** 2 for a, b in zip(model, exact, strict=True))
+    last = tab.iloc[-1]
+    assert last["SSE_points"] == pytest.approx(sse, rel=1e-12)
+    assert last["COMIC_points"] == pytest.approx(2 * math.log(sse / 3) - math.log(2.0), rel=1e-12)
+
+
+def _g4(x, t):
+    """Fourth derivative of the Gaussian of variance s2 = 2 D t."""
+    s2 = 2 * D * t
+    return gaussian(x, D, t) * (x**4 - 6 * x**2 * s2 + 3 * s2**2) / s2**4
+
+
+def test_fd_sse_points_falls_with_n_as_the_leading_error_predicts():
+    """FD at t = 250 (the paper's dt = 0.05) at the 15 points. Leading error of the nodal
+    solution (modified equation): backward Euler's symbol 1 / (1 + D k^2 dt) and the 3-point
+    Laplacian's -k^2 + k^4 dx^2 / 12 add eps k^4 to -D k^2, eps = D^2 dt / 2 + D dx^2 / 12, so
+    the node error is eps t g''''; the points add linear interpolation's O(dx^2) error. So
+    SSE_points falls as dx^4 while space dominates and stops at the time floor
+    sum (D^2 dt t g'''' / 2)^2: by ~10^3 from N = 100 to 1000, by little from 1000 to 10000.
+    Next-order terms are O(dx^2 / s^2) <= 3 % of the error at N = 100, so each measured
+    SSE_points is within 10 % of the prediction."""
+    import particle_entropy.measures as M
+
+    t, dt = 250.0, 0.05
+    p = M.measurement_points()
+    sse, pred = {}, {}
+    for n in (100, 1000, 10000):
+        tab, _ = run(RunConfig(method="fd", n=n, t_final=t))
+        assert tab["time"].iloc[-1] == t and tab["dt"].iloc[-1] == pytest.approx(dt, rel=1e-6)
+        sse[n] = tab["SSE_points"].iloc[-1]
+        dx = 12.0 / n
+        x = -6.0 + dx * np.arange(n + 1)
+        eps = D * D * dt / 2 + D * dx * dx / 12
+        nodes = gaussian(x, D, t) + eps * t * _g4(x, t)
+        pred[n] = np.sum((np.interp(p, x, nodes) - gaussian(p, D, t)) ** 2)
+        assert sse[n] == pytest.approx(pred[n], rel=0.1), (n, sse[n], pred[n])
+    floor = np.sum((D * D * dt / 2 * t * _g4(p, t)) ** 2)
+    assert sse[100] > sse[1000] > sse[10000] > 0.9 * floor
+    assert sse[100] / sse[1000] > 0.8 * pred[100] / pred[1000] > 500  # second order in space
+    assert sse[10000] == pytest.approx(floor, rel=0.05)  # backward Euler's time error is all that is left

@@ -234,9 +234,13 @@ REALISATION_COLUMN_DOCS = {
     "COMIC": "2 ln(SSE / n_sse) - ln dV of this realisation, Eq. 43",
     "n_sse": "number of points in SSE",
     "dV": "sampling volume [L]",
+    "SSE_points": "SSE of this realisation at the 15 measurement points common to all models (Section 6, "
+    "point 1; records.COLUMNS)",
+    "COMIC_points": "2 ln(SSE_points / 15) - ln dV of this realisation, Eq. 43 at the measurement points",
 }
 REALISATION_COLUMNS = list(REALISATION_COLUMN_DOCS)
-RUN_COLUMNS = ["step", "time", "seed", "SSE", "COMIC", "n_sse", "dV", *CASE_COLUMNS]  # what they are read from
+# the run-table columns they are read from
+RUN_COLUMNS = ["step", "time", "seed", "SSE", "COMIC", "n_sse", "dV", "SSE_points", "COMIC_points", *CASE_COLUMNS]
 
 
 def read_realisations(paths: list[str], times: list[float]) -> pd.DataFrame:
@@ -245,9 +249,10 @@ def read_realisations(paths: list[str], times: list[float]) -> pd.DataFrame:
 
 
 def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
-    """Per-realisation SSE and COMIC of every case in the run tables ``runs`` (each one case,
-    one or more seeds) at the recorded step nearest to each of ``times``: one row per case,
-    time and seed (REALISATION_COLUMN_DOCS). A seed read twice counts once."""
+    """Per-realisation SSE and COMIC, at the model's own and at the measurement points, of every
+    case in the run tables ``runs`` (each one case, one or more seeds) at the recorded step
+    nearest to each of ``times``: one row per case, time and seed (REALISATION_COLUMN_DOCS). A
+    seed read twice counts once."""
     parts = []
     for run in runs:
         case = case_of_table(run)
@@ -265,6 +270,8 @@ def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataF
                         "COMIC": rows["COMIC"].to_numpy(dtype=np.float64),
                         "n_sse": rows["n_sse"].to_numpy(dtype=np.int64),
                         "dV": rows["dV"].to_numpy(dtype=np.float64),
+                        "SSE_points": rows["SSE_points"].to_numpy(dtype=np.float64),
+                        "COMIC_points": rows["COMIC_points"].to_numpy(dtype=np.float64),
                     }
                 )
             )

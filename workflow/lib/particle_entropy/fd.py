@@ -77,12 +77,15 @@ class ExplicitSolver:
 
 
 def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -> dict:
-    """H_C of the node masses c dx (Eq. 7 with dV = dx), E, SSE over all nodes, COMIC (Eq. 43)."""
+    """H_C of the node masses c dx (Eq. 7 with dV = dx), E, SSE over all nodes, COMIC (Eq. 43), and
+    both at the measurement points (the nodal c linearly interpolated, measures.sse_points)."""
     p = c * dx
     total = float(p.sum())
     h_c = M.entropy_discrete(p / total) if total > 0 else -math.inf
     err = M.sse(c, M.analytic_sampled(x, cfg.D, t, dx))
     n = x.size
+    points = M.measurement_points()
+    err_points = M.sse_points(points, x, c, cfg.D, t, dx)
     return {
         "H_D": h_c,
         "H_C": h_c,
@@ -93,6 +96,8 @@ def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -
         "n_sse": n,
         "AIC": M.aic(err, n),
         "COMIC": M.comic(err, n, dx),
+        "SSE_points": err_points,
+        "COMIC_points": M.comic(err_points, points.size, dx),
         "dV": dx,
         "mass_total": total,
         "mass_min": float(c.min() * dx),

@@ -6,9 +6,12 @@ the paper says the quantity is -infinity (H_C of a delta, ln of a zero SSE).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
+
+from .registry import MEASUREMENT_POINTS, MEASUREMENT_SEED, PAPER
 
 
 def entropy_discrete(p: np.ndarray) -> float:
@@ -81,6 +84,12 @@ def analytic_sampled(x: np.ndarray, D: float, t: float, dV: float) -> np.ndarray
     return g / (g.sum() * dV)
 
 
+def gaussian_density(x: np.ndarray, D: float, t: float) -> np.ndarray:
+    """Exact density exp(-x^2 / (4 D t)) / sqrt(4 pi D t) of the Gaussian with variance 2 D t (D t > 0) [1/L]."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.exp(-x * x / (4.0 * D * t)) / math.sqrt(4.0 * math.pi * D * t)
+
+
 def sse(model: np.ndarray, reference: np.ndarray) -> float:
     """Sum of squared errors (Eq. 44)."""
     d = np.asarray(model, dtype=np.float64) - np.asarray(reference, dtype=np.float64)
@@ -99,3 +108,40 @@ def aic(sse_value: float, n: int, k: int = 0) -> float:
 def comic(sse_value: float, n: int, dV: float) -> float:
     """COMIC = 2 ln(SSE / n) - ln dV (Eq. 43)."""
     return 2.0 * _log_mse(sse_value, n) - math.log(dV)
+
+
+@functools.cache
+def _measurement_points(fd_length: float) -> np.ndarray:
+    rng = np.random.default_rng(MEASUREMENT_SEED)
+    points = np.sort(rng.uniform(-fd_length / 2.0, fd_length / 2.0, MEASUREMENT_POINTS))
+    points.flags.writeable = False  # shared by every run of the process
+    return points
+
+
+def measurement_points(fd_length: float = PAPER["fd_length"]) -> np.ndarray:
+    """The 15 measurement points common to all models, uniform on [-L/2, L/2], sorted (Section 6, point 1) [L]."""
+    return _measurement_points(float(fd_length))
+
+
+def at_points(points: np.ndarray, x: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Concentration ``c`` given at increasing ``x``, linearly interpolated at ``points``; 0 outside [x_0, x_-1]."""
+    return np.interp(points, x, c, left=0.0, right=0.0)
+
+
+def sse_points(points: np.ndarray, x: np.ndarray, c: np.ndarray, D: float, t: float, dV: float) -> float:
+    """SSE (Eq. 44) at the measurement ``points`` of the model concentration ``c`` at increasing
+    ``x`` (at_points) against the exact Gaussian density of variance 2 D t there [1/L^2].
+
+    Like SSE, the reference is the Gaussian sampled at a point (not averaged over a bin); unlike
+    SSE's analytic_sampled, it is not rescaled to unit mass on the model's points (a factor that
+    differs between models and tends to 1 as a model resolves the plume), so every model meets
+    the same reference values. At t = 0 (or D = 0) the Gaussian is a delta with no value at a
+    point: as in SSE, the reference is then the delta that analytic_sampled puts on the model
+    point nearest x = 0 (height 1 / dV), interpolated like the model, so a model still at its
+    initial delta scores 0."""
+    model = at_points(points, x, c)
+    if D * t > 0:
+        reference = gaussian_density(points, D, t)
+    else:
+        reference = at_points(points, x, analytic_sampled(x, D, t, dV))
+    return sse(model, reference)

@@ -67,12 +67,17 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
 
 
 def measure(cfg: RunConfig, x, m, t: float) -> dict:
-    """H_D of the masses (Eq. 2), E (Eq. 9), H_PMF, SSE and COMIC against the Gaussian."""
+    """H_D of the masses (Eq. 2), E (Eq. 9), H_PMF, SSE and COMIC against the Gaussian, and both at
+    the measurement points (m / dV linearly interpolated between the sorted particles, 0 outside
+    the cloud, measures.sse_points)."""
     dV = cfg.omega / cfg.n
     total = float(m.sum())
     h_d = M.entropy_discrete(m / total)
     g = M.analytic_sampled(x, cfg.D, t, dV)
-    err = M.sse(m / dV, g)
+    c = m / dV
+    err = M.sse(c, g)
+    points = M.measurement_points()
+    err_points = M.sse_points(points, x, c, cfg.D, t, dV)
     return {
         "H_D": h_d,
         "H_C": h_d,  # particles carry the sampling volume dV = Omega / N: H_C = H_D
@@ -83,6 +88,8 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
         "n_sse": cfg.n,
         "AIC": M.aic(err, cfg.n),
         "COMIC": M.comic(err, cfg.n, dV),
+        "SSE_points": err_points,
+        "COMIC_points": M.comic(err_points, points.size, dV),
         "dV": dV,
         "mass_total": total,
         "mass_min": float(m.min()),

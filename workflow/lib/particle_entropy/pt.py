@@ -60,14 +60,18 @@ def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
 
 
 def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
-    """Entropies, dilution index and fitness of the reconstruction at time t."""
+    """Entropies, dilution index and fitness of the reconstruction at time t; SSE_points and
+    COMIC_points interpolate the same reconstruction (bin centres or the kernel's grid) to the
+    measurement points (measures.sse_points)."""
     dV = cfg.omega / cfg.n
     pts, f, spacing, h = reconstruct(cfg, x_sorted, t)
+    points = M.measurement_points()
     if h == 0.0:
-        h_i, err, n_pts = -math.inf, 0.0, 1
+        h_i, err, n_pts, err_points = -math.inf, 0.0, 1, 0.0
     else:
         h_i = M.entropy_inconsistent(f, spacing)
         err, n_pts = M.sse(f, M.analytic_sampled(pts, cfg.D, t, spacing)), pts.size
+        err_points = M.sse_points(points, pts, f, cfg.D, t, spacing)
     h_c = M.entropy_consistent(h_i, dV)
     h_d = math.log(cfg.n)  # Eq. 13: equal masses 1/N
     return {
@@ -80,6 +84,8 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
         "n_sse": n_pts,
         "AIC": M.aic(err, n_pts),
         "COMIC": M.comic(err, n_pts, dV),
+        "SSE_points": err_points,
+        "COMIC_points": M.comic(err_points, points.size, dV),
         "dV": dV,
         "mass_total": 1.0,
         "mass_min": 1.0 / cfg.n,

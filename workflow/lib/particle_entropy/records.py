@@ -24,6 +24,11 @@ COLUMNS = {
     "n_sse": "number of points in SSE (particles, nodes or reconstruction points)",
     "AIC": "2 ln(SSE / n), Eq. 41 with k = 0",
     "COMIC": "2 ln(SSE / n) - ln dV, Eq. 43",
+    "SSE_points": "SSE, Eq. 44, at the m = 15 measurement points common to all models (Section 6, point 1; "
+    "measures.measurement_points): the model's concentration linearly interpolated there (FD nodes, MTPT "
+    "m / dV at the particles, PT its reconstruction points; 0 outside them) against the exact Gaussian "
+    "density; at t = 0 against the model's discrete delta, as SSE (measures.sse_points) [L^-2]",
+    "COMIC_points": "2 ln(SSE_points / m) - ln dV, Eq. 43 at the measurement points (m = 15, dV as COMIC)",
     "dV": "sampling volume [L]",
     "mass_total": "total mass (1 at t = 0)",
     "mass_min": "smallest particle or node mass",

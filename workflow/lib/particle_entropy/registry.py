@@ -37,6 +37,14 @@ TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or w
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
 
+# The measurement points common to every model (Section 6, "Four important points regarding the
+# COMIC", point 1: "15 randomly chosen 'measurement points' common to all simulations"): this many
+# points, uniform on the paper's FD domain [-fd_length/2, fd_length/2], drawn once from
+# numpy.random.default_rng(MEASUREMENT_SEED) and sorted (measures.measurement_points). The same
+# for every case and every seed; the SSE_points and COMIC_points columns are taken at them.
+MEASUREMENT_POINTS = 15
+MEASUREMENT_SEED = 20200615  # fixed: changing it changes every SSE_points and COMIC_points
+
 FGT_TOLERANCE = 1e-17  # fast Gauss transform error / summed |weights| in reach: round-off
 FGT_TOLERANCE_RANGE = (1e-30, 0.1)
 
