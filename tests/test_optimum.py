@@ -108,6 +108,8 @@ def test_noisy_search_brackets_the_true_minimum_within_budget(noise):
     # refinement concentrates near the minimum: every N added after round 0 lies within a decade of it
     added = plan.loc[plan["round"] > 0, "n"]
     assert len(added) and (abs(np.log10(added / N_STAR)) <= 1.0).all()
+    new_per_round = plan.groupby("n")["round"].min().value_counts()
+    assert (new_per_round.drop(0, errors="ignore") <= 2).all()  # beside the lowest mean and the fit only
     assert list(out.columns) == RESULT_COLUMNS
 
 

@@ -8,11 +8,15 @@ may lie there:
   and locates the minimum by a weighted quadratic in log N through the points around the
   lowest mean (``fitted_minimum``); its bootstrap over realisations gives the interval. While
   that interval reaches the highest (lowest) visited N and the range goes on, the search
-  *walks* one coarse step further (half a step when the fit already turns up inside);
-- once bracketed (never in a walking round), a round *refines* (a geometric midpoint in every gap of the bracket wider
-  than ``min_step``, nearest the optimum first) and *replicates* (doubles the realisations,
-  cheapest N first, of every N of the bracket whose mean is within 2 combined standard errors
-  of the lowest, up to ``max_realisations``).
+  *walks* one coarse step further (half a step when the fit already turns up inside), and
+  does nothing else;
+- once bracketed, a round *refines* (a geometric midpoint in each gap beside the lowest mean
+  and beside the fitted optimum, if wider than ``min_step``) and *replicates* (doubles the
+  realisations, cheapest first, of every N of the bracket whose mean is within 2 combined
+  standard errors of the lowest, up to ``max_realisations``): on a flat, noisy minimum the
+  interval narrows by replication, not by more points.
+A search over the dt growth (``over``) does the same in log(dt_growth - 1) at a fixed N,
+starting at the cheap end (the largest growth, fewest steps).
 The search stops when the bracket (the visited N around the interval) is no wider than
 ``width``, when nothing is left to add, or when the next runs would exceed the budget of runs
 or of core-seconds (predicted from the measured cost per run, ``cost_model``). FD is
@@ -484,14 +488,17 @@ def next_plan(
     # while walking, the bracket is not known yet: refining or replicating inside it would be spent
     # on N the walk may leave behind
     inside = [] if walk else [x for x in xs if opt["bracket_lo"] <= x <= opt["bracket_hi"]]
+    u_opt = float(search.u(opt["optimum"]))
+    anchors = {opt["best"], min(xs, key=lambda x: abs(float(search.u(x)) - u_opt))}
     new = []
-    for a, b in zip(inside, inside[1:]):  # refine every gap of the bracket
+    for a, b in zip(inside, inside[1:]):  # refine the gaps beside the lowest mean and the fitted optimum
+        if a not in anchors and b not in anchors:
+            continue
         ua, ub = float(search.u(a)), float(search.u(b))
         if ub - ua > math.log(search.min_step):
             mid = search.x((ua + ub) / 2)
             if a < mid < b and mid not in xs:
                 new.append(mid)
-    u_opt = float(search.u(opt["optimum"]))
     new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
     predict = cost_model(costs, search)
     more = [] if search.fd else sorted((x for x in _unresolved(table, search, opt["best"]) if x in inside), key=predict)
