@@ -390,3 +390,22 @@ def test_the_figure_names_the_options_it_was_judged_with(measure, time_volume):
     assert ("15 common points" in title) == (measure == "points")
     assert ("dt in dV" in title) == time_volume
     assert "\n" in title  # two lines: a long search name does not push the judging settings off
+
+
+def test_an_end_point_within_the_noise_is_replicated_not_walked_past():
+    """The lowest mean at 95; 300 is within its noise. Walking to 949 would cost ~3x a doubling at
+    300 and, on a flat curve, would walk to the range end: 300 gets more realisations instead."""
+    spread = [-1.5, -0.5, 0.5, 1.5]
+    level = {30: 5.0, 95: 0.0, 300: 0.3}
+    rows = [(n, s, level[n] + d) for n in level for s, d in enumerate(spread)]
+    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC"])
+    plan = pd.DataFrame([(0, n, 1.05, 0, 3, False, "") for n in level], columns=PLAN_COLUMNS)
+    out = next_plan(mtpt(width=1.5, budget_runs=1000), plan, table, costs_of(table))
+    added = out[out["round"] == 1]
+    assert added["n"].max() <= 300  # no walk beyond the visited N
+    assert 300 in added.loc[added["first"] == 4, "n"].tolist()  # the end point is replicated
+    # while the lowest mean itself sits at the end, the search does walk
+    level[300] = -3.0
+    rows = [(n, s, level[n] + d) for n in level for s, d in enumerate(spread)]
+    walked = next_plan(mtpt(width=1.5, budget_runs=1000), plan, pd.DataFrame(rows, columns=table.columns))
+    assert walked.loc[walked["round"] == 1, "n"].tolist() == [949]

@@ -7,7 +7,7 @@ may lie there:
 - every later round reads the per-realisation COMIC of every run so far at the search's time
   and locates the minimum by a weighted quadratic in log N through the points around the
   lowest mean (``fitted_minimum``); its bootstrap over realisations gives the interval. While
-  that interval reaches the highest (lowest) visited N and the range goes on, the search
+  the lowest mean is at the highest (lowest) visited N and the range goes on, the search
   *walks* one coarse step further (half a step when the fit already turns up inside), and
   does nothing else;
 - once bracketed, a round *refines* (a geometric midpoint in each gap beside the lowest mean
@@ -446,17 +446,18 @@ def _unresolved(table: pd.DataFrame, search: Search, best) -> list:
 
 
 def _walk(search: Search, xs: list, opt: dict) -> list:
-    """The next value beyond the visited ones, while the argmin's interval reaches the highest
-    (lowest) visited one and the range goes on: one coarse step in u, or half of one when the
-    fitted minimum already lies inside the visited values (the next point only has to show the
-    curve turning up)."""
+    """The next value beyond the visited ones, while the lowest mean is the highest (lowest)
+    visited one and the range goes on: one coarse step in u, or half of one when the fitted
+    minimum already lies inside the visited values (the next point only has to show the curve
+    turning up). An end point merely within the noise of the lowest is replicated instead (it
+    is in the bracket): a step further costs more, and a flat curve would walk to the range end."""
     step = float(search.u(search.hi) - search.u(search.lo)) / (search.initial_points - 1)
     near = math.log(search.min_step)
     out = []
-    if opt["argmin_hi"] == xs[-1] and xs[-1] < search.hi:
+    if opt["best"] == xs[-1] and xs[-1] < search.hi:
         v = float(search.u(xs[-1])) + (step if opt["optimum"] >= xs[-1] else step / 2)
         out.append(search.hi if v + near >= search.u(search.hi) else search.x(v))
-    if opt["argmin_lo"] == xs[0] and xs[0] > search.lo:
+    if opt["best"] == xs[0] and xs[0] > search.lo:
         v = float(search.u(xs[0])) - (step if opt["optimum"] <= xs[0] else step / 2)
         out.append(search.lo if v - near <= search.u(search.lo) else search.x(v))
     return [x for x in out if x not in xs]
