@@ -53,6 +53,7 @@ def run_search(search, noise, base_seed=0):
     while not plan["done"].any():
         table = realisations_of(plan, noise)
         plan = next_plan(search, plan, table, costs_of(table))
+        assert (plan["last"] >= plan["first"]).all(), "an empty seed block"
     return plan
 
 
@@ -404,6 +405,15 @@ def test_an_end_point_within_the_noise_is_replicated_not_walked_past():
     added = out[out["round"] == 1]
     assert added["n"].max() <= 300  # no walk beyond the visited N
     assert 300 in added.loc[added["first"] == 4, "n"].tolist()  # the end point is replicated
+    # once doubled and still within the noise, the search walks on (a flat start must not stop it)
+    eight = [(n, s, level[n] + spread[s % 4] * (1.0 if s < 4 else 0.9)) for n in level for s in range(8)]
+    plan8 = pd.DataFrame(
+        [(0, n, 1.05, 0, 3, False, "") for n in level] + [(1, 300, 1.05, 4, 7, False, "")], columns=PLAN_COLUMNS
+    )
+    table8 = pd.DataFrame([r for r in eight if r[0] == 300 or r[1] < 4], columns=table.columns)
+    later = next_plan(mtpt(width=1.5, budget_runs=1000), plan8, table8)
+    walked_to = later.loc[later["round"] == 2, "n"].tolist()
+    assert len(walked_to) == 1 and 300 < walked_to[0] <= 949  # half a step: the fit turns up below 300
     # while the lowest mean itself sits at the end, the search does walk
     level[300] = -3.0
     rows = [(n, s, level[n] + d) for n in level for s, d in enumerate(spread)]

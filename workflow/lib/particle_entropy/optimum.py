@@ -7,9 +7,10 @@ may lie there:
 - every later round reads the per-realisation COMIC of every run so far at the search's time
   and locates the minimum by a weighted quadratic in log N through the points around the
   lowest mean (``fitted_minimum``); its bootstrap over realisations gives the interval. While
-  the lowest mean is at the highest (lowest) visited N and the range goes on, the search
-  *walks* one coarse step further (half a step when the fit already turns up inside), and
-  does nothing else;
+  the lowest mean is at the highest (lowest) visited N, or that end stays within the argmin's
+  95 % interval once its realisations are doubled, and the range goes on, the search *walks*
+  one coarse step further (half a step when the fit already turns up inside), and does
+  nothing else;
 - once bracketed, a round *refines* (a geometric midpoint in each gap beside the lowest mean
   and beside the fitted optimum, if wider than ``min_step``) and *replicates* (doubles the
   realisations, cheapest first, of every N of the bracket whose mean is within 2 combined
@@ -445,22 +446,30 @@ def _unresolved(table: pd.DataFrame, search: Search, best) -> list:
     return table.loc[(gap <= 2 * noise) & (noise > 0), search.over].tolist()
 
 
-def _walk(search: Search, xs: list, opt: dict) -> list:
-    """The next value beyond the visited ones, while the lowest mean is the highest (lowest)
-    visited one and the range goes on: one coarse step in u, or half of one when the fitted
-    minimum already lies inside the visited values (the next point only has to show the curve
-    turning up). An end point merely within the noise of the lowest is replicated instead (it
-    is in the bracket): a step further costs more, and a flat curve would walk to the range end."""
+def _walk(search: Search, table: pd.DataFrame, opt: dict) -> tuple[list, list]:
+    """(the next values beyond the visited ones, the end points to replicate first). The search
+    walks one coarse step in u past the highest (lowest) visited value when the lowest mean is
+    there, or when that end is still within the argmin's 95 % interval after its realisations
+    were doubled once: half a step when the fitted minimum already lies inside the visited values
+    (the next point only has to show the curve turning up). An end within the interval that has
+    not been doubled yet is replicated instead: a doubling there costs less than a step further,
+    and decides whether the curve still falls (a flat or bumpy start must not stop the search)."""
+    xs = table[search.over].tolist()
+    counts = dict(zip(xs, table["realisations"]))
     step = float(search.u(search.hi) - search.u(search.lo)) / (search.initial_points - 1)
     near = math.log(search.min_step)
-    out = []
-    if opt["best"] == xs[-1] and xs[-1] < search.hi:
-        v = float(search.u(xs[-1])) + (step if opt["optimum"] >= xs[-1] else step / 2)
-        out.append(search.hi if v + near >= search.u(search.hi) else search.x(v))
-    if opt["best"] == xs[0] and xs[0] > search.lo:
-        v = float(search.u(xs[0])) - (step if opt["optimum"] <= xs[0] else step / 2)
-        out.append(search.lo if v - near <= search.u(search.lo) else search.x(v))
-    return [x for x in out if x not in xs]
+    out, replicate = [], []
+    for end, bound, sign, limit in ((xs[-1], opt["argmin_hi"], 1, search.hi), (xs[0], opt["argmin_lo"], -1, search.lo)):
+        if end == limit or (end != opt["best"] and bound != end):
+            continue
+        if end != opt["best"] and counts[end] < 2 * search.realisations:
+            replicate.append(end)
+            continue
+        beyond = sign * (float(search.u(opt["optimum"])) - float(search.u(end))) >= 0
+        v = float(search.u(end)) + sign * (step if beyond else step / 2)
+        reach = sign * (v + sign * near - float(search.u(limit))) >= 0
+        out.append(limit if reach else search.x(v))
+    return [x for x in out if x not in xs], replicate
 
 
 def next_plan(
@@ -480,9 +489,13 @@ def next_plan(
         out["done"], out["reason"] = True, reason
         return out
 
-    walk = _walk(search, xs, opt)
+    walk, ends = _walk(search, table, opt)
     at_end = opt["argmin_lo"] == search.lo or opt["argmin_hi"] == search.hi
-    if not walk and search.u(opt["bracket_hi"]) - search.u(opt["bracket_lo"]) <= math.log(search.width) + 1e-12:
+    if (
+        not walk
+        and not ends
+        and search.u(opt["bracket_hi"]) - search.u(opt["bracket_lo"]) <= math.log(search.width) + 1e-12
+    ):
         return stop(REASONS[4] if at_end else REASONS[0])
     if k > MAX_ROUNDS:
         return stop(REASONS[3])
@@ -502,7 +515,8 @@ def next_plan(
                 new.append(mid)
     new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
     predict = cost_model(costs, search)
-    more = [] if search.fd else sorted((x for x in _unresolved(table, search, opt["best"]) if x in inside), key=predict)
+    unresolved = [x for x in _unresolved(table, search, opt["best"]) if x in inside]
+    more = [] if search.fd else sorted(set(ends) | set(unresolved), key=predict)
     base = int(plan["first"].min())
     added = []
     spent, spent_s = runs_in(plan), float(costs["core_s"].sum())
@@ -520,7 +534,8 @@ def next_plan(
     counts = dict(zip(table[search.over], table["realisations"]))
     for x in more:  # cheapest first: a doubling at small N costs little
         have = int(counts[x])
-        add(x, base + have, min(have, search.max_realisations - have))
+        if have < search.max_realisations:
+            add(x, base + have, min(have, search.max_realisations - have))
     if not added:
         wanted = bool(walk or new) or any(counts[x] < search.max_realisations for x in more)
         return stop(REASONS[1] if wanted else REASONS[2])
