@@ -114,7 +114,7 @@ BAD = [
     (
         "optimum budget below one round",
         _set(("optimum", "collision_eta1", "budget_runs"), 10),
-        ["optimum.collision_eta1.budget_runs=10", "first round's 20 runs"],
+        ["optimum.collision_eta1.budget_runs=10", "first round's 12 runs"],
     ),
     (
         "optimum case that does not exist",

@@ -419,3 +419,21 @@ def test_an_end_point_within_the_noise_is_replicated_not_walked_past():
     rows = [(n, s, level[n] + d) for n in level for s, d in enumerate(spread)]
     walked = next_plan(mtpt(width=1.5, budget_runs=1000), plan, pd.DataFrame(rows, columns=table.columns))
     assert walked.loc[walked["round"] == 1, "n"].tolist() == [949]
+
+
+def test_a_lucky_new_point_is_replicated_before_it_wins():
+    """Winner's curse: a midpoint with 4 realisations beats neighbours with 16 by luck. The search
+    does not stop on it (the bracket is narrow enough) but doubles it first."""
+    spread = [-1.5, -0.5, 0.5, 1.5]
+    level = {300: 0.0, 400: -1.0, 533: 0.2}  # 400 lowest, but within 2 combined s.e. of 300
+    count = {300: 16, 400: 4, 533: 16}
+    rows = [(n, s, level[n] + spread[s % 4]) for n in level for s in range(count[n])]
+    table = pd.DataFrame(rows, columns=["n", "seed", "COMIC"])
+    plan = pd.DataFrame(
+        [(0, n, 1.05, 0, count[n] - 1, False, "") for n in level], columns=PLAN_COLUMNS
+    )  # fmt: skip
+    search = Search(name="t", model=Case("mtpt", "collision", None), time=1.0, lo=300, hi=533, width=10.0)
+    out = next_plan(search, plan, table)
+    assert not out["done"].any()
+    added = out[out["round"] == 1]
+    assert [400, 4, 7] in added[["n", "first", "last"]].values.tolist()

@@ -490,10 +490,16 @@ def next_plan(
         return out
 
     walk, ends = _walk(search, table, opt)
+    counts = dict(zip(table[search.over], table["realisations"]))
+    rivals = [] if search.fd else _unresolved(table, search, opt["best"])
+    # winner's curse: a point newly added with few realisations may hold the lowest mean by luck;
+    # it wins only once it has as many realisations as the rivals within its noise
+    lucky = [opt["best"]] if rivals and counts[opt["best"]] < max(counts[x] for x in rivals) else []
     at_end = opt["argmin_lo"] == search.lo or opt["argmin_hi"] == search.hi
     if (
         not walk
         and not ends
+        and not lucky
         and search.u(opt["bracket_hi"]) - search.u(opt["bracket_lo"]) <= math.log(search.width) + 1e-12
     ):
         return stop(REASONS[4] if at_end else REASONS[0])
@@ -515,8 +521,8 @@ def next_plan(
                 new.append(mid)
     new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
     predict = cost_model(costs, search)
-    unresolved = [x for x in _unresolved(table, search, opt["best"]) if x in inside]
-    more = [] if search.fd else sorted(set(ends) | set(unresolved), key=predict)
+    unresolved = [x for x in rivals if x in inside]
+    more = sorted(set(ends) | set(unresolved) | set([] if walk else lucky), key=predict)
     base = int(plan["first"].min())
     added = []
     spent, spent_s = runs_in(plan), float(costs["core_s"].sum())
@@ -531,7 +537,6 @@ def next_plan(
 
     for x in [*walk, *new]:
         add(x, base, search.realisations)
-    counts = dict(zip(table[search.over], table["realisations"]))
     for x in more:  # cheapest first: a doubling at small N costs little
         have = int(counts[x])
         if have < search.max_realisations:
