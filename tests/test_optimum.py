@@ -437,3 +437,8 @@ def test_a_lucky_new_point_is_replicated_before_it_wins():
     assert not out["done"].any()
     added = out[out["round"] == 1]
     assert [400, 4, 7] in added[["n", "first", "last"]].values.tolist()
+    # and its interval spans the rivals within noise, where the bootstrap alone trusts the lucky mean
+    from particle_entropy.optimum import evaluate
+
+    _, opt = evaluate(search, table)
+    assert opt["best"] == 400 and opt["ci_lo"] == 300 and opt["ci_hi"] == 533

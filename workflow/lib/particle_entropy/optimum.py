@@ -83,8 +83,8 @@ RESULT_COLUMN_DOCS = {
     "best": "the visited value (N or dt growth) with the lowest value of the search's convention",
     "optimum": "the fitted optimum: vertex of a quadratic in log N (log(dt_growth - 1)), weighted by "
     "realisations, through the visited values within two of `best` (`best` itself at an end of them)",
-    "ci_lo": "lower end of the 95 % bootstrap interval of the optimum (FD, deterministic: the visited value "
-    "below best)",
+    "ci_lo": "lower end of the 95 % bootstrap interval of the optimum, widened to every visited value whose mean "
+    "COMIC is within 2 combined standard errors of best's (FD, deterministic: the visited value below best)",
     "ci_hi": "its upper end (FD: the visited value above best)",
     "bracket_lo": "the largest visited value <= ci_lo (the lowest visited if none): the minimum lies above it",
     "bracket_hi": "the smallest visited value >= ci_hi (the highest visited if none): the minimum lies below it",
@@ -405,15 +405,19 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
         minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
     best = int(np.argmin(minimised))
     x_opt = search.x(float(fitted_minimum(u, minimised, counts)[0]))
-    if (counts > 1).any():
-        u_lo, u_hi = _fitted_interval(u, resampled, objective, counts)
-        ci_lo, ci_hi = search.x(u_lo), search.x(u_hi)
-    else:  # deterministic (FD): the minimum lies between the lowest point's neighbours
-        ci_lo, ci_hi = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
-    below, above = xs[u <= search.u(ci_lo) + 1e-12], xs[u >= search.u(ci_hi) - 1e-12]
     means = np.array([s.mean() for s in samples])
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])
     se = np.where(counts > 1, stds / np.sqrt(counts), 0.0)
+    if (counts > 1).any():
+        u_lo, u_hi = _fitted_interval(u, resampled, objective, counts)
+        # the bootstrap cannot see that a mean of few realisations is lucky: the interval also
+        # spans every visited value whose mean COMIC is within 2 combined standard errors of the lowest
+        noise = np.sqrt(se**2 + se[best] ** 2)
+        rival = ((np.abs(means - means[best]) <= 2 * noise) & (noise > 0)) | (np.arange(len(xs)) == best)
+        ci_lo, ci_hi = search.x(min(u_lo, u[rival].min())), search.x(max(u_hi, u[rival].max()))
+    else:  # deterministic (FD): the minimum lies between the lowest point's neighbours
+        ci_lo, ci_hi = xs[max(best - 1, 0)], xs[min(best + 1, len(xs) - 1)]
+    below, above = xs[u <= search.u(ci_lo) + 1e-12], xs[u >= search.u(ci_hi) - 1e-12]
     table = pd.DataFrame(
         {
             search.over: xs,
