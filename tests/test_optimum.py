@@ -17,7 +17,6 @@ from particle_entropy.optimum import (
     REASONS,
     RESULT_COLUMNS,
     Search,
-    grid,
     initial_plan,
     next_plan,
     result_table,
@@ -55,6 +54,12 @@ def run_search(search, noise, base_seed=0):
         plan = next_plan(search, plan, table, costs_of(table))
         assert (plan["last"] >= plan["first"]).all(), "an empty seed block"
     return plan
+
+
+def grid(lo, hi, count, fd=False):
+    """Search.grid of an N search over [lo, hi] (FD: even N)."""
+    model = Case("fd", "implicit", None) if fd else Case("mtpt", "collision", None)
+    return Search(name="g", model=model, time=1.0, lo=lo, hi=hi).grid(count)
 
 
 def mtpt(**kw):

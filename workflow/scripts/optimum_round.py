@@ -7,15 +7,14 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.aggregate import read_realisations  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.optimum import Search, initial_plan, next_plan, read_costs  # noqa: E402
+from particle_entropy.optimum import Search, initial_plan, next_plan, read_runs  # noqa: E402
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
 search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
 if "plan" in inp.keys():
-    realisations = read_realisations(list(inp.runs), [search.time])
-    plan = next_plan(search, pd.read_parquet(inp.plan), realisations, read_costs(list(inp.runs)))
+    realisations, costs = read_runs(list(inp.runs), search.time)
+    plan = next_plan(search, pd.read_parquet(inp.plan), realisations, costs)
 else:
     plan = initial_plan(search, int(par.base_seed))
 write_parquet(plan, out[0])

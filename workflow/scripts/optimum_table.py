@@ -7,14 +7,12 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.aggregate import read_realisations  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.optimum import Search, read_costs, result_table  # noqa: E402
+from particle_entropy.optimum import Search, read_runs, result_table  # noqa: E402
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
 search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
-runs = list(inp.runs)
-realisations = read_realisations(runs, [search.time])
-table = result_table(search, pd.read_parquet(inp.plan), realisations, read_costs(runs))
+realisations, costs = read_runs(list(inp.runs), search.time)
+table = result_table(search, pd.read_parquet(inp.plan), realisations, costs)
 write_parquet(table, out[0])
 print(table.to_string(), file=sys.stderr)

@@ -341,6 +341,30 @@ def argmin_bootstrap(
         shares[point] = 1.0
         return shares, point, point, 0
 
+    def argmin(stacked):
+        return np.argmin(value(stacked), axis=0).astype(np.float64)  # float: scipy casts its levels
+
+    res = bootstrap_of_means(samples, argmin, n_resamples, seed)
+    dist = np.asarray(res.bootstrap_distribution).astype(np.int64)
+    shares = np.bincount(dist, minlength=len(samples)) / len(dist)
+    lo, hi = res.confidence_interval.low, res.confidence_interval.high
+    return shares, int(math.floor(lo)), int(math.ceil(hi)), len(dist)
+
+
+def bootstrap_of_means(
+    samples: list[np.ndarray],
+    of_means: Callable[[np.ndarray], np.ndarray],
+    n_resamples: int = N_RESAMPLES,
+    seed: int = BOOTSTRAP_SEED,
+):
+    """scipy.stats.bootstrap (95 % percentile) of a statistic of the per-N sample means:
+    ``of_means`` maps the stacked means, shape (N count, *batch), to the statistic, shape
+    (batch). Each N with more than one realisation is resampled on its own (paired=False); a
+    single realisation is held fixed. At least one N must have two or more. The Generator is
+    seeded with ``seed``: equal inputs see equal resamples."""
+    means = np.array([np.mean(s) for s in samples])
+    free = [i for i, s in enumerate(samples) if len(s) > 1]
+
     def statistic(*resampled, axis=-1):
         batch = resampled[0].shape[:-1]  # scipy passes (resamples, realisations) per N
         stacked = np.empty((len(means), *batch))
@@ -348,9 +372,9 @@ def argmin_bootstrap(
         for i, r in zip(free, resampled):
             stacked[i] = r.mean(axis=axis)
         with np.errstate(divide="ignore", invalid="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
-            return np.argmin(value(stacked), axis=0).astype(np.float64)  # float: scipy casts its levels
+            return of_means(stacked)
 
-    res = stats.bootstrap(
+    return stats.bootstrap(
         [samples[i] for i in free],
         statistic,
         n_resamples=n_resamples,
@@ -360,10 +384,6 @@ def argmin_bootstrap(
         method="percentile",
         **{_RNG: np.random.default_rng(seed)},
     )
-    dist = np.asarray(res.bootstrap_distribution).astype(np.int64)
-    shares = np.bincount(dist, minlength=len(samples)) / len(dist)
-    lo, hi = res.confidence_interval.low, res.confidence_interval.high
-    return shares, int(math.floor(lo)), int(math.ceil(hi)), len(dist)
 
 
 def convention_samples(per_n: list[pd.DataFrame], convention: str) -> tuple[list[np.ndarray], Callable]:

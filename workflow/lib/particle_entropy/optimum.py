@@ -37,9 +37,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
-from .aggregate import _RNG, BOOTSTRAP_SEED, CONFIDENCE, CONVENTIONS, N_RESAMPLES, argmin_bootstrap, convention_samples
+from .aggregate import (
+    CONVENTIONS,
+    RUN_COLUMNS,
+    argmin_bootstrap,
+    bootstrap_of_means,
+    convention_samples,
+    realisations_table,
+)
 from .case import APPLIES, Case, SettingError
 from .registry import MEASUREMENT_POINTS, PAPER
 from .runconfig import first_step
@@ -258,12 +264,6 @@ class Search:
             )
 
 
-def grid(lo: int, hi: int, count: int, fd: bool = False) -> list[int]:
-    """``count`` N spaced evenly in log N from lo to hi (FD: even), each once."""
-    search = Search("grid", Case("fd" if fd else "mtpt", "implicit" if fd else "collision", None), 1.0, lo, hi)
-    return search.grid(count)
-
-
 def _block(search: Search, k: int, x, first: int, count: int) -> tuple:
     case = search.case_at(x)
     return (k, case.n, case.dt_growth, first, first + count - 1, False, "")
@@ -340,32 +340,14 @@ def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach
 
 def _fitted_interval(u, resampled, objective, counts) -> tuple[float, float]:
     """95 % percentile interval of the fitted minimum (in u) over bootstrap resamples of the
-    realisations (scipy.stats.bootstrap, each point on its own; single realisations held fixed)."""
-    free = [i for i, r in enumerate(resampled) if len(r) > 1]
-    means = np.array([r.mean() for r in resampled])
+    realisations (aggregate.bootstrap_of_means: each point on its own, single realisations fixed)."""
 
-    def statistic(*drawn, axis=-1):
-        batch = drawn[0].shape[:-1]
-        stacked = np.empty((len(means), *batch))
-        stacked[:] = means.reshape(-1, *[1] * len(batch))
-        for i, r in zip(free, drawn):
-            stacked[i] = r.mean(axis=axis)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            values = objective(stacked.reshape(len(means), -1))
-        return fitted_minimum(u, values, counts).reshape(batch)
+    def vertex(stacked):
+        return fitted_minimum(u, objective(stacked.reshape(len(u), -1)), counts).reshape(stacked.shape[1:])
 
     with warnings.catch_warnings():  # a degenerate distribution (every resample alike) is an answer here
         warnings.simplefilter("ignore")
-        res = stats.bootstrap(
-            [resampled[i] for i in free],
-            statistic,
-            n_resamples=N_RESAMPLES,
-            vectorized=True,
-            paired=False,
-            confidence_level=CONFIDENCE,
-            method="percentile",
-            **{_RNG: np.random.default_rng(BOOTSTRAP_SEED)},
-        )
+        res = bootstrap_of_means(resampled, vertex)
     return float(res.confidence_interval.low), float(res.confidence_interval.high)
 
 
@@ -551,13 +533,27 @@ def next_plan(
     return pd.concat([plan, pd.DataFrame(added, columns=PLAN_COLUMNS)], ignore_index=True)
 
 
-def read_costs(paths: list[str]) -> pd.DataFrame:
+COST_KEYS = ["n", "dt_growth", "seed"]
+
+
+def _costs(frames: list[pd.DataFrame]) -> pd.DataFrame:
     """Measured core-seconds of every run (n, dt_growth, seed, core_s: summed step wall times)."""
-    keys = ["n", "dt_growth", "seed"]
-    if not paths:
-        return pd.DataFrame(columns=[*keys, "core_s"])
-    steps = pd.concat([pd.read_parquet(p, columns=[*keys, "wall_s"]) for p in paths], ignore_index=True)
-    return steps.groupby(keys, as_index=False)["wall_s"].sum().rename(columns={"wall_s": "core_s"})
+    if not frames:
+        return pd.DataFrame(columns=[*COST_KEYS, "core_s"])
+    steps = pd.concat([f[[*COST_KEYS, "wall_s"]] for f in frames], ignore_index=True)
+    return steps.groupby(COST_KEYS, as_index=False)["wall_s"].sum().rename(columns={"wall_s": "core_s"})
+
+
+def read_costs(paths: list[str]) -> pd.DataFrame:
+    """Measured core-seconds of every run in the run tables at ``paths`` (_costs)."""
+    return _costs([pd.read_parquet(p, columns=[*COST_KEYS, "wall_s"]) for p in paths])
+
+
+def read_runs(paths: list[str], time: float) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """A search's inputs from its run tables, each read once: the per-realisation values at
+    ``time`` (aggregate.realisations_table) and the measured costs (_costs)."""
+    frames = [pd.read_parquet(p, columns=list(dict.fromkeys([*RUN_COLUMNS, "wall_s"]))) for p in paths]
+    return realisations_table(frames, [time]), _costs(frames)
 
 
 def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame) -> pd.DataFrame:
