@@ -57,7 +57,7 @@ def _value(v, growth: bool) -> str:
 
 def optimum_figure(table: pd.DataFrame):
     """The figure of one finished search (optimum.RESULT_COLUMNS, one row per visited N)."""
-    fig, (ax,) = _figure(1, width=7.0, height=4.6)
+    fig, (ax,) = _figure(1, width=9.0, height=4.6)
     first = table.iloc[0]
     over = str(first["over"])
     t = table.sort_values(over)
@@ -137,7 +137,8 @@ def optimum_figure(table: pd.DataFrame):
     title = f"{first['search']}: {first['label']}\n{judged}"  # two lines: long names are not clipped
     xlabel = "dt growth − 1 (numbers: realisations)" if growth else "$N$ (numbers: realisations)"
     _look(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel=xlabel, legend=None)
-    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    # beside the axes: a search's points crowd where the legend would go, around its minimum
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}" if growth else f"{v:,.0f}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
