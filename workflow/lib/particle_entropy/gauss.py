@@ -29,7 +29,9 @@ import functools
 import math
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 from .registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
 
@@ -46,21 +48,58 @@ DIRECT_MAX_NEIGHBOURS = 200.0
 
 
 # exp(-a) for the windowed sums, 0 <= a: inline arithmetic that compilers vectorise (a libm
-# call per pair does not). 2^-k from a table, e^r by a degree-13 Taylor polynomial on
-# |r| <= ln(2) / 2 (truncation < 5e-18 relative), ln 2 split in two for exact reduction.
+# call per pair does not). e^r by a degree-13 Taylor polynomial on |r| <= ln(2) / 2 (truncation
+# < 5e-18 relative), ln 2 split in two for exact reduction, then times 2^-k built from its bits
+# (a table lookup vectorises into gathers, which are slow on virtual machines).
 _LN2_HI = 0.693147180369123816490  # 32 significant bits: k * _LN2_HI is exact
 _LN2_LO = 1.90821492927058770002e-10
 _INV_LN2 = 1.4426950408889634
-_EXP_MAX_K = 1100  # beyond this exp(-a) is 0 in double precision
-_POW2_NEG = np.array([2.0**-k for k in range(_EXP_MAX_K + 1)])
+_EXP_MAX_K = 1100.0  # beyond this exp(-a) is 0 in double precision
+_EXP_MAX_A = 800.0  # exp(-a) is 0 for a > 745.2; clamped first so that k fits any integer type
+_POW2_ZERO_K = 1075  # 2^-k rounds to 0.0 from here on (2^-1074 is the least subnormal)
+EXP_NEAR_MAX = 700.0  # exp_neg_near's range: k <= 1010, so 2^-k is normal
+_SCALE_K = 1000  # 2^-k as 2^-min(k, 1000) 2^-(k - min(k, 1000)): both factors are normal numbers
+
+
+@intrinsic
+def _f64_from_bits(typingctx, bits):
+    """The float64 whose IEEE-754 bit pattern is the int64 ``bits`` (a reinterpretation)."""
+    if not isinstance(bits, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return types.float64(types.int64), codegen
 
 
 @njit(cache=True, inline="always")
-def _exp_neg(a):
+def pow2_neg(k):
+    """2^-k for an integer-valued float 0 <= k <= 1100, as two factors whose product with a p in
+    [0.5, 2] rounds once, as p 2^-k does (0.0 from k = 1075 on, where 2^-k rounds to zero)."""
+    k1 = min(k, _SCALE_K)
+    hi = _f64_from_bits(np.int64(1023 - np.int32(k1)) << np.int64(52))
+    lo_bits = np.int64(1023 - np.int32(k - k1)) << np.int64(52)
+    lo = _f64_from_bits(lo_bits if k < _POW2_ZERO_K else np.int64(0))  # bits 0: +0.0
+    return hi, lo
+
+
+@njit(cache=True, inline="always")
+def exp_neg(a):
     """exp(-a) for a >= 0, to about 1 ulp."""
-    k = min(int(a * _INV_LN2 + 0.5), _EXP_MAX_K)  # 2^-_EXP_MAX_K is 0.0: exp underflows
+    k = min(np.floor(min(a, _EXP_MAX_A) * _INV_LN2 + 0.5), _EXP_MAX_K)  # a float: no int64 lanes
     r = (k * _LN2_HI - a) + k * _LN2_LO  # -a + k ln 2, |r| <= ln(2) / 2
-    return _taylor_exp13(r) * _POW2_NEG[k]
+    hi, lo = pow2_neg(k)
+    return (_taylor_exp13(r) * hi) * lo  # p 2^-k1 is exact, so one rounding in all
+
+
+@njit(cache=True, inline="always")
+def exp_neg_near(a):
+    """exp(-a) for 0 <= a <= EXP_NEAR_MAX, equal to exp_neg bit for bit and cheaper: 2^-k is one
+    normal number there."""
+    k = np.floor(a * _INV_LN2 + 0.5)
+    r = (k * _LN2_HI - a) + k * _LN2_LO
+    return _taylor_exp13(r) * _f64_from_bits(np.int64(1023 - np.int32(k)) << np.int64(52))
 
 
 @njit(cache=True, inline="always")
@@ -133,7 +172,7 @@ def _direct(y, x, q, sigma, radius, skip_self):
             hi += 1
         for j in range(lo, hi):
             d = yi - x[j]
-            buf[j - lo] = _exp_neg(d * d * inv2s2)
+            buf[j - lo] = exp_neg(d * d * inv2s2)
         if skip_self and lo <= i < hi:
             buf[i - lo] = 0.0
         for k in range(nk):
@@ -162,7 +201,7 @@ def _direct_symmetric(x, q, sigma, radius):
         xi = x[i]
         for j in range(lo, hi):
             d = xi - x[j]
-            buf[j - lo] = _exp_neg(d * d * inv2s2)
+            buf[j - lo] = exp_neg(d * d * inv2s2)
         for k in range(nk):
             qi = q[k, i]
             acc = 0.0
@@ -370,7 +409,7 @@ def _fgt(y, x, q, sigma, width, terms):
                 for i in range(t_lo, t_hi):
                     for j in range(s_lo, s_hi):
                         d = (y[i] - x[j]) * scale
-                        g = _exp_neg(d * d)
+                        g = exp_neg(d * d)
                         for k in range(nk):
                             out[k, i] += g * q[k, j]
             else:

@@ -55,15 +55,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .gauss import _exp_neg
+from .gauss import EXP_NEAR_MAX, exp_neg, exp_neg_near
 
 DEFAULT_CUTOFF = 9.0  # kernel widths searched when the kernel is not truncated (exp(-40.5) ~ 2.6e-18)
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)  # SplitMix64's increment: its state after k outputs is s + k G
 
 
 @njit(cache=True, inline="always")
 def _splitmix(state):
     """Next state and 64-bit output of SplitMix64."""
-    state = state + np.uint64(0x9E3779B97F4A7C15)
+    state = state + _GOLDEN
     z = state
     z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
     z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
@@ -71,10 +72,15 @@ def _splitmix(state):
 
 
 @njit(cache=True, fastmath={"contract"})
-def _kernel(u, out, cnt):
-    """out[k] = exp(-u[k]) for k < cnt, by gauss._exp_neg (arithmetic that vectorises)."""
-    for k in range(cnt):
-        out[k] = _exp_neg(u[k])
+def _kernel(u, out, cnt, near=False):
+    """out[k] = exp(-u[k]) for k < cnt, by gauss.exp_neg (arithmetic that vectorises); ``near``:
+    every u[k] <= gauss.EXP_NEAR_MAX, so the cheaper gauss.exp_neg_near gives the same bits."""
+    if near:
+        for k in range(cnt):
+            out[k] = exp_neg_near(u[k])
+    else:
+        for k in range(cnt):
+            out[k] = exp_neg(u[k])
 
 
 @njit(cache=True)
@@ -95,15 +101,169 @@ def _row_sums(x, radius, inv2s2):
     return r
 
 
+@njit(cache=True, inline="always")
+def _partners(i, xp, xs, ls, rs, left, radius, inv2s2, near, part, u, w, c):
+    """The visit to i: its window [lo, hi) of the compact arrays, its partners (later in storage)
+    part[:cnt] and their W_ij c[:cnt] in window order, their W added to their row sums ->
+    (lo, hi, me, cnt, sum of the partners' W in window order).
+
+    W is evaluated over the whole window (a vectorised pass; the few visited particles not yet
+    compacted and i itself get a W that is then not used). A non-partner adds +0.0 to the sum and
+    to its row sum, which leaves both unchanged: the sums are those over partners alone."""
+    lo = np.searchsorted(xs[:left], xp - radius, side="left")
+    hi = np.searchsorted(xs[:left], xp + radius, side="right")
+    me = lo + np.searchsorted(xs[lo:hi], xp, side="left")  # i itself
+    while ls[me] != i:
+        me += 1
+    nw = hi - lo
+    for k in range(nw):
+        d = xp - xs[lo + k]
+        u[k] = d * d * inv2s2
+    _kernel(u, w, nw, near)
+    cnt = 0
+    s = 0.0
+    for k in range(nw):  # branch-free compaction, row sums in the same pass
+        later = ls[lo + k] > i
+        wk = w[k] if later else 0.0
+        s += wk
+        rs[lo + k] += wk
+        part[cnt] = lo + k
+        c[cnt] = wk
+        cnt += later
+    return lo, hi, me, cnt, s
+
+
+@njit(cache=True, inline="always")
+def _weights(c, part, cnt, inv_r, rf, beta, symnorm):
+    """c[:cnt] <- beta W_ij / r_i (symnorm: times the mean of 1/r_i and 1/r_j); returns max c."""
+    cmax = 0.0
+    if symnorm:
+        for k in range(cnt):
+            c[k] *= beta * 0.5 * (inv_r + 1.0 / rf[part[k]])
+            cmax = max(cmax, c[k])
+    else:
+        b = beta * inv_r
+        for k in range(cnt):
+            c[k] *= b
+            cmax = max(cmax, c[k])
+    return cmax
+
+
+@njit(cache=True, inline="always")
+def _draw(k, cnt, state, z):
+    """Fisher-Yates as we go: the k-th partner is uniform among the cnt - k left; 32 random bits a
+    draw, two draws from each 64-bit output -> (index, state, z)."""
+    if k % 2 == 0:
+        state, z = _splitmix(state)
+        bits = z >> np.uint64(32)
+    else:
+        bits = z & np.uint64(0xFFFFFFFF)
+    return k + np.int64((bits * np.uint64(cnt - k)) >> np.uint64(32)), state, z
+
+
+@njit(cache=True, inline="always")
+def _take(k, j, part, c):
+    """Swap the j-th partner into place k -> (its compact index, its weight)."""
+    q = part[j]
+    cj = c[j]
+    part[j] = part[k]
+    c[j] = c[k]
+    return q, cj
+
+
+@njit(cache=True, inline="always")
+def _exchange_clipped(mi, cnt, part, c, ms, state):
+    """The visit's exchanges in random order with the clipping m <- max(0, m) -> (m_i, state)."""
+    z = np.uint64(0)
+    for k in range(cnt):
+        j, state, z = _draw(k, cnt, state, z)
+        q, cj = _take(k, j, part, c)
+        mj = ms[q]
+        dm = cj * (mi - mj)  # beta (m_i - m_j) W_ij / r_i
+        mi = max(0.0, mi - dm)
+        ms[q] = max(0.0, mj + dm)
+    return mi, state
+
+
+@njit(cache=True, inline="always")
+def _exchange(mi, cnt, part, c, ms, state):
+    """The visit's exchanges in random order, unclipped -> (m_i, state)."""
+    z = np.uint64(0)
+    for k in range(cnt):
+        j, state, z = _draw(k, cnt, state, z)
+        q, cj = _take(k, j, part, c)
+        mj = ms[q]
+        dm = cj * (mi - mj)
+        mi = mi - dm
+        ms[q] = mj + dm
+    return mi, state
+
+
+@njit(cache=True, inline="always")
+def _exchange_two(ma, cna, pa, ca, mb, cnb, pb, cb, ms, state):
+    """Two visits with disjoint windows, unclipped, their exchanges interleaved: the same arithmetic
+    on the same masses as one after the other (they share no particle), with two independent chains
+    through m_i. The second visit's stream starts where the first's ends: SplitMix64's state after
+    k outputs is s + k G -> (m_a, m_b, state at the end of both)."""
+    sa = state
+    sb = state + np.uint64((cna + 1) // 2) * _GOLDEN
+    za = np.uint64(0)
+    zb = np.uint64(0)
+    both = min(cna, cnb)
+    for k in range(both):
+        ja, sa, za = _draw(k, cna, sa, za)
+        jb, sb, zb = _draw(k, cnb, sb, zb)
+        qa, cja = _take(k, ja, pa, ca)
+        qb, cjb = _take(k, jb, pb, cb)
+        mja = ms[qa]
+        mjb = ms[qb]
+        dma = cja * (ma - mja)
+        dmb = cjb * (mb - mjb)
+        ma = ma - dma
+        mb = mb - dmb
+        ms[qa] = mja + dma
+        ms[qb] = mjb + dmb
+    for k in range(both, cna):
+        ja, sa, za = _draw(k, cna, sa, za)
+        qa, cja = _take(k, ja, pa, ca)
+        mja = ms[qa]
+        dma = cja * (ma - mja)
+        ma = ma - dma
+        ms[qa] = mja + dma
+    for k in range(both, cnb):
+        jb, sb, zb = _draw(k, cnb, sb, zb)
+        qb, cjb = _take(k, jb, pb, cb)
+        mjb = ms[qb]
+        dmb = cjb * (mb - mjb)
+        mb = mb - dmb
+        ms[qb] = mjb + dmb
+    return ma, mb, sb
+
+
 @njit(cache=True, fastmath={"contract"})
 def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
-    """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each."""
+    """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each.
+
+    Visits are taken two at a time (i, i + 1) when their windows share no particle; the two are then
+    independent, and their row sums and exchanges run interleaved, the same operations in the same
+    order on each value as one visit after the other. Clipping can act only when some m_i - dm or
+    m_j + dm is negative; with all masses >= 0 and every c = beta W_ij / r_i <= 1 neither is (in
+    floating point too: fl(m_i - m_j) <= m_i, fl(c t) <= t and rounding is monotone), so such visits
+    skip it."""
     n = x.shape[0]
     inv2s2 = 0.5 / (sigma * sigma)
+    # |x_i - x_j| <= radius in a window (up to rounding in xp - radius: the margin covers it)
+    near = radius * radius * inv2s2 <= 0.99 * EXP_NEAR_MAX
     where = np.empty(n, np.int64)  # sorted index of the particle stored at i
     for p in range(n):
         where[label[p]] = p
     r_full = _row_sums(x, radius, inv2s2) if symnorm else np.zeros(n)
+    # Clipping can act only if a mass is negative (or not finite) at the start; once all are >= 0,
+    # every update keeps them so.
+    safe = True
+    for p in range(n):
+        if not (m[p] >= 0.0 and m[p] < np.inf):
+            safe = False
     # The particles not yet visited, in position order: positions, sorted indices, labels, masses,
     # row sums so far (and whole row sums). Only they exchange mass from here on: a visited
     # particle is final, written back when the arrays are compacted every `chunk` visits.
@@ -115,11 +275,15 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     rf = r_full.copy()
     left = n
     chunk = max(64, n // 32)
-    part = np.empty(n, np.int64)
+    pa = np.empty(n, np.int64)
+    pb = np.empty(n, np.int64)
     u = np.empty(n)
-    c = np.empty(n)
+    w = np.empty(n)
+    ca = np.empty(n)
+    cb = np.empty(n)
     state = np.uint64(seed)
-    for i in range(n):
+    i = 0
+    while i < n:
         if i % chunk == 0 and i > 0:
             k2 = 0
             for k in range(left):
@@ -134,60 +298,42 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
                 else:
                     m[ps[k]] = ms[k]
             left = k2
-        xp = x[where[i]]
-        lo = np.searchsorted(xs[:left], xp - radius, side="left")
-        hi = np.searchsorted(xs[:left], xp + radius, side="right")
-        me = np.searchsorted(xs[:left], xp, side="left")  # i itself
-        while ls[me] != i:
-            me += 1
-        cnt = 0
-        for k in range(lo, hi):  # partners: later in storage (branch-free compaction)
-            d = xp - xs[k]
-            part[cnt] = k
-            u[cnt] = d * d * inv2s2
-            cnt += ls[k] > i
-        if cnt == 0:
-            continue
-        _kernel(u, c, cnt)
-        s = 0.0
-        for k in range(cnt):
-            s += c[k]
-            rs[part[k]] += c[k]
-        inv_r = 1.0 / (rf[me] if symnorm else rs[me] + 1.0 + s)
-        if symnorm:  # c = beta W_ij / r_i (symnorm: the mean of 1/r_i and 1/r_j)
-            for k in range(cnt):
-                c[k] *= beta * 0.5 * (inv_r + 1.0 / rf[part[k]])
+        lo, hi, me, cna, sa = _partners(i, x[where[i]], xs, ls, rs, left, radius, inv2s2, near, pa, u, w, ca)
+        two = i + 1 < n and (i + 1) % chunk != 0  # no compaction between the two visits
+        if two:  # i + 1's weights and row sums need only positions and i's row sums: found now
+            lob, hib, meb, cnb, sb = _partners(i + 1, x[where[i + 1]], xs, ls, rs, left, radius, inv2s2, near, pb, u, w, cb)
         else:
-            b = beta * inv_r
-            for k in range(cnt):
-                c[k] *= b
-        mi = ms[me]
-        z = np.uint64(0)
-        for k in range(cnt):
-            # Fisher-Yates as we go: the k-th partner is uniform among those left; 32 random
-            # bits a draw, two draws from each 64-bit output
-            if k % 2 == 0:
-                state, z = _splitmix(state)
-                bits = z >> np.uint64(32)
-            else:
-                bits = z & np.uint64(0xFFFFFFFF)
-            j = k + np.int64((bits * np.uint64(cnt - k)) >> np.uint64(32))
-            q = part[j]
-            cj = c[j]
-            part[j] = part[k]
-            c[j] = c[k]
-            mj = ms[q]
-            dm = cj * (mi - mj)  # beta (m_i - m_j) W_ij / r_i
-            if clip:
-                mi = max(0.0, mi - dm)
-                ms[q] = max(0.0, mj + dm)
-            else:
-                mi = mi - dm
-                ms[q] = mj + dm
-        ms[me] = mi
+            lob = hib = meb = cnb = 0
+            sb = 0.0
+        clipa = clipb = False
+        if cna > 0:
+            ra = rf[me] if symnorm else rs[me] + 1.0 + sa
+            cmax = _weights(ca, pa, cna, 1.0 / ra, rf, beta, symnorm)
+            clipa = clip and (cmax > 1.0 or not safe)
+        if cnb > 0:
+            rb = rf[meb] if symnorm else rs[meb] + 1.0 + sb
+            cmax = _weights(cb, pb, cnb, 1.0 / rb, rf, beta, symnorm)
+            clipb = clip and (cmax > 1.0 or not safe)
+        if cna > 0 and cnb > 0 and not (clipa or clipb) and (hi <= lob or hib <= lo):
+            # disjoint windows: neither visit touches the other's particles, so both at once
+            ms[me], ms[meb], state = _exchange_two(ms[me], cna, pa, ca, ms[meb], cnb, pb, cb, ms, state)
+        else:  # one after the other
+            if cna > 0:
+                ms[me], state = _visit_mass(ms[me], cna, pa, ca, ms, state, clipa)
+            if cnb > 0:
+                ms[meb], state = _visit_mass(ms[meb], cnb, pb, cb, ms, state, clipb)
+        i += 2 if two else 1
     for k in range(left):
         m[ps[k]] = ms[k]
     return m
+
+
+@njit(cache=True, inline="always")
+def _visit_mass(mi, cnt, part, c, ms, state, clip):
+    """One visit's exchanges, clipped or not -> (m_i, state)."""
+    if clip:
+        return _exchange_clipped(mi, cnt, part, c, ms, state)
+    return _exchange(mi, cnt, part, c, ms, state)
 
 
 def sequential_transfer(
