@@ -201,5 +201,3 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     for k in range(left):
         m[ps[k]] = ms[k]
     return m
-
-

@@ -32,7 +32,12 @@ def _both(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     return a, b
 
 
-CASES = [(n, beta, sigma) for n in (1, 2, 3, 5, 64, 65, 300, 3000) for beta in (0.5, 1.0, 2.5) for sigma in (0.005, 0.05, 0.4)]
+CASES = [
+    (n, beta, sigma)
+    for n in (1, 2, 3, 5, 64, 65, 300, 3000)
+    for beta in (0.5, 1.0, 2.5)
+    for sigma in (0.005, 0.05, 0.4)
+]
 
 
 @pytest.mark.parametrize("n, beta, sigma", CASES)
@@ -48,7 +53,9 @@ def test_bit_identical_to_the_reference_loop(n, beta, sigma):
                 a, b = _both(x, m, label, sigma, truncation * sigma, beta, seed, symnorm, clip)
                 assert a.tobytes() == b.tobytes(), (trial, truncation, symnorm, clip)
                 if clip:
-                    noclip = ref._sweep(x, m.copy(), label, sigma, truncation * sigma, beta, np.uint64(seed), symnorm, False)
+                    noclip = ref._sweep(
+                        x, m.copy(), label, sigma, truncation * sigma, beta, np.uint64(seed), symnorm, False
+                    )
                     clipped += noclip.tobytes() != a.tobytes()
     if beta > 1.0 and sigma >= 0.05 and n >= 64:
         assert clipped > 0  # the clipping acted in some of these cases, so they test its path
@@ -65,17 +72,19 @@ def test_bit_identical_when_every_mass_is_clipped_or_none_is():
         assert a.tobytes() == b.tobytes()
 
 
-@pytest.mark.parametrize("scheme, kernel, eta", [
-    ("sequential", "collision", 1.0),
-    ("sequential", "sph", 1.0),
-    ("sequential", "collision", 0.5),
-    ("sequential_sorted", "collision", 1.0),
-    ("sequential_symnorm", "sph", 1.0),
-    ("sequential_noclip", "sph", 1.0),
-])
+@pytest.mark.parametrize(
+    "scheme, kernel, eta",
+    [
+        ("sequential", "collision", 1.0),
+        ("sequential", "sph", 1.0),
+        ("sequential", "collision", 0.5),
+        ("sequential_sorted", "collision", 1.0),
+        ("sequential_symnorm", "sph", 1.0),
+        ("sequential_noclip", "sph", 1.0),
+    ],
+)
 def test_whole_runs_bit_identical(monkeypatch, scheme, kernel, eta):
-    cfg = RunConfig(method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme,
-                    t_final=50.0, seed=3)
+    cfg = RunConfig(method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3)
     _, new = simulate.run(cfg, want_state=True)
     monkeypatch.setattr(sequential, "_sweep", ref._sweep)
     _, old = simulate.run(cfg, want_state=True)
@@ -97,14 +106,16 @@ def _exp_both(a):
 
 def test_exp_neg_bit_identical_to_the_table_form():
     rng = np.random.default_rng(11)
-    a = np.concatenate([
-        np.linspace(0.0, 50.0, 100001),
-        rng.uniform(0.0, 1200.0, 100000),
-        np.arange(0.0, 1200.0, 0.125),  # k and k + 1/2 multiples of ln 2 and their neighbours
-        np.arange(0, 1700) * np.log(2.0) / 2.0,
-        [0.0, 1e-300, 700.0, 744.4, 745.1, 745.2, 760.0, 762.5, 800.0, 1e6],  # (the table form read
-        # outside its table from a ~ 6.4e18 on, where int(a / ln 2) overflows)
-    ])
+    a = np.concatenate(
+        [
+            np.linspace(0.0, 50.0, 100001),
+            rng.uniform(0.0, 1200.0, 100000),
+            np.arange(0.0, 1200.0, 0.125),  # k and k + 1/2 multiples of ln 2 and their neighbours
+            np.arange(0, 1700) * np.log(2.0) / 2.0,
+            [0.0, 1e-300, 700.0, 744.4, 745.1, 745.2, 760.0, 762.5, 800.0, 1e6],  # (the table form read
+            # outside its table from a ~ 6.4e18 on, where int(a / ln 2) overflows)
+        ]
+    )
     new, near, old = _exp_both(a)
     assert new.tobytes() == old.tobytes()
     inside = a <= gauss.EXP_NEAR_MAX

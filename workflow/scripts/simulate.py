@@ -8,10 +8,10 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 from particle_entropy.case import Case  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 from particle_entropy.runconfig import RunConfig  # noqa: E402
-from particle_entropy.simulate import run_seeds  # noqa: E402
+from particle_entropy.simulate import run_seeds_arrow  # noqa: E402
 
 w = snakemake.wildcards  # noqa: F821
 cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()  # noqa: F821
 seeds = range(int(w.first), int(w.last) + 1)
-table = run_seeds(cfg, seeds, progress=lambda msg: print(msg, file=sys.stderr), state=w.kind == "snapshots")
+table = run_seeds_arrow(cfg, seeds, progress=lambda msg: print(msg, file=sys.stderr), state=w.kind == "snapshots")
 write_parquet(table, snakemake.output[0])  # noqa: F821

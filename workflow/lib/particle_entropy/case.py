@@ -14,8 +14,12 @@ import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .registry import KERNELS, METHODS, PAPER, SCHEME_DOCS, SCHEME_LABELS, SCHEMES, TRUNCATED_SCHEMES
 
@@ -264,6 +268,8 @@ class Case:
 # ---------------------------------------------------------------------- tables of cases
 def case_mask(df: pd.DataFrame, case: Case) -> pd.Series:
     """Rows of ``df`` belonging to ``case`` (a model matches every N)."""
+    import pandas as pd  # only tables need it: a simulation job never imports pandas
+
     mask = pd.Series(True, index=df.index)
     for col, value in case.columns().items():
         mask &= df[col] == value

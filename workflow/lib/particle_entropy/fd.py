@@ -104,6 +104,6 @@ def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -
     }
 
 
-def warm_up() -> None:
+def warm_up(cfg: RunConfig) -> None:
     """Load the compiled solver before the timed steps."""
     ImplicitSolver(8, 0.1).solve(np.ones(8))

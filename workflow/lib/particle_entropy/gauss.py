@@ -626,9 +626,12 @@ def gauss_transform(
     return out[0] if squeeze else out
 
 
-def warm_up() -> None:
-    """Load the compiled transforms (numba's on-disk cache) for transfers and reconstructions."""
+def warm_up(methods=("direct", "fgt"), transfer: bool = True, reconstruction: bool = True) -> None:
+    """Load the compiled transforms a run will call (numba's on-disk cache): for transfers (targets
+    = sources) and reconstructions (other targets), by the given methods."""
     x = np.linspace(-1.0, 1.0, 64)
-    for m in ("direct", "fgt"):
-        gauss_transform(x, x, np.ones((3, x.size)), 0.5, method=m)  # transfer: targets = sources
-        gauss_transform(x[::2], x, np.ones((1, x.size)), 0.5, method=m)  # reconstructions, near mass
+    for m in methods:
+        if transfer:
+            gauss_transform(x, x, np.ones((3, x.size)), 0.5, method=m)
+        if reconstruction:
+            gauss_transform(x[::2], x, np.ones((1, x.size)), 0.5, method=m)

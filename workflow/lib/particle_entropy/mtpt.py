@@ -7,12 +7,9 @@ import math
 
 import numpy as np
 
-from . import gauss
 from . import measures as M
 from .kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
-from .mass_transfer import mass_transfer
 from .runconfig import RunConfig
-from .sequential import sequential_transfer
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -48,6 +45,8 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
     if sigma == 0.0 or beta == 0.0:
         return x, m, label, sigma, 0.0, 1
     if cfg.scheme.startswith("sequential"):
+        from .sequential import sequential_transfer  # a job loads only its scheme's kernels
+
         m = sequential_transfer(
             x,
             m,
@@ -62,6 +61,8 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
         return x, m, label, sigma, beta, 1
     if cfg.scheme == "compensated":  # widen the cut kernel so that its variance is the whole one's
         sigma = sigma / math.sqrt(truncated_variance_fraction(cfg.truncation))
+    from .mass_transfer import mass_transfer
+
     res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method, cfg.transfer_tolerance)
     return x, res.mass, label, sigma, beta, res.substeps
 
@@ -96,6 +97,23 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
     }
 
 
-def warm_up() -> None:
-    """Load the compiled kernels of this method before the timed steps."""
-    gauss.warm_up()
+def warm_up(cfg: RunConfig) -> None:
+    """Load the compiled kernels this case's transfer calls before the timed steps: the authors'
+    loop, or the transforms of Eqs. 16-21 (both methods when ``auto`` may choose either)."""
+    if cfg.scheme.startswith("sequential"):
+        from . import sequential
+
+        sequential.warm_up()
+        return
+    from . import gauss
+    from .mass_transfer import mass_transfer
+
+    if cfg.transfer_method != "auto":
+        methods = (cfg.transfer_method,)
+    else:  # gauss.choose_method: a truncated kernel is always summed directly
+        methods = ("direct",) if cfg.truncation is not None else ("direct", "fgt")
+    gauss.warm_up(methods, transfer=True, reconstruction=False)
+    x = np.linspace(-1.0, 1.0, 64)
+    m = np.zeros(64)
+    m[30] = 1.0
+    mass_transfer(x, m, 0.1, 0.5, cfg.truncation, "direct", cfg.transfer_tolerance)  # its own kernels

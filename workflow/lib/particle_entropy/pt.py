@@ -117,6 +117,7 @@ def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     return {"x": x_sorted, "mass": np.full(x_sorted.size, 1.0 / cfg.n), "c": c}
 
 
-def warm_up() -> None:
-    """Load the compiled kernels of this method before the timed steps."""
-    gauss.warm_up()
+def warm_up(cfg: RunConfig) -> None:
+    """Load the compiled reconstruction of this case before the timed steps (bins need none)."""
+    if cfg.kernel != "bins":
+        gauss.warm_up(("direct", "fgt"), transfer=False, reconstruction=True)

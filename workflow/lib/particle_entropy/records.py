@@ -7,7 +7,7 @@ import sys
 import time
 from collections.abc import Callable
 
-import pandas as pd
+import pyarrow as pa
 
 COLUMNS = {
     "step": "time-step index, 0 = initial condition",
@@ -69,12 +69,30 @@ class Recorder:
             self._last_report = now
             self.progress(f"step {row['step']}/{self.n_steps} t={row['time']:.6g} elapsed={now - self._t0:.1f}s")
 
-    def table(self) -> pd.DataFrame:
-        df = pd.DataFrame(self.rows)
-        for k, v in self.case.items():
-            df[k] = v
-        ordered = [c for c in COLUMNS if c in df.columns]
-        return df[ordered + [c for c in df.columns if c not in COLUMNS]]
+    def table(self) -> pa.Table:
+        """The rows as a table: COLUMNS' columns in its order, then the case's (no pandas, so that a
+        simulation job need not import it)."""
+        names = list(dict.fromkeys(k for row in self.rows for k in row))
+        names += [k for k in self.case if k not in names]
+        return arrow_table(
+            {k: [row.get(k) for row in self.rows] if k not in self.case else None for k in names},
+            self.case,
+            len(self.rows),
+        )
+
+
+def arrow_table(columns: dict, constants: dict, length: int) -> pa.Table:
+    """A table of ``columns`` (name -> values; None where ``constants`` holds the value of every row),
+    COLUMNS' names first in its order, then the others as given."""
+    arrays = {}
+    for k, values in columns.items():
+        if k in constants:
+            v = constants[k]
+            arrays[k] = pa.nulls(length) if v is None else pa.array([v] * length)
+        else:
+            arrays[k] = pa.array(values)
+    ordered = [c for c in COLUMNS if c in arrays]
+    return pa.table({k: arrays[k] for k in ordered + [c for c in arrays if c not in COLUMNS]})
 
 
 def _peak_rss_mb() -> float:

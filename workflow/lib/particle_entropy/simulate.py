@@ -5,14 +5,18 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
-import numpy as np
-import pandas as pd
+from typing import TYPE_CHECKING
 
-from . import fd, mtpt, pt
+import numpy as np
+import pyarrow as pa
+
 from . import measures as M
-from .records import Recorder
+from .records import Recorder, arrow_table
 from .runconfig import RunConfig
 from .timegrid import time_steps, times
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
@@ -23,34 +27,48 @@ def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
     }
 
 
-def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
-    """Simulate ``cfg`` (defaults resolved and checked) -> (per-step table, final state or None)."""
+def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
+    """Simulate ``cfg`` (defaults resolved and checked) -> (per-step Arrow table, final state or None)."""
     cfg = cfg.resolved()
     grid = "exact" if cfg.method == "fd" else cfg.time_grid
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid)
     runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
-    warm_up(cfg.method)
+    warm_up(cfg)
     size = cfg.n + 1 if cfg.method == "fd" else cfg.n
     rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
     state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rec)
     table = rec.table()
     if not want_state:
         return table, None
-    state_df = pd.DataFrame(state)
-    for k, v in cfg.case_columns().items():
-        state_df[k] = v
-    return table, state_df
+    case = cfg.case_columns()
+    length = len(next(iter(state.values())))
+    columns = {**{k: np.asarray(v) for k, v in state.items()}, **{k: None for k in case if k not in state}}
+    return table, arrow_table(columns, {k: v for k, v in case.items() if k not in state}, length)
+
+
+def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
+    """run_arrow as pandas tables: (per-step table, final state or None)."""
+    table, state = run_arrow(cfg, progress, want_state)
+    return table.to_pandas(), None if state is None else state.to_pandas()
 
 
 _WARM: set = set()
 
 
-def warm_up(method: str) -> None:
-    """Load the compiled kernels a method uses (numba's on-disk cache, ~0.1-0.4 s once per
+def _model(method: str):
+    """The module of a method, imported when a run needs it (a job loads only its own kernels)."""
+    import importlib
+
+    return importlib.import_module(f".{method}", __package__)
+
+
+def warm_up(cfg: RunConfig) -> None:
+    """Load the compiled kernels this case calls (numba's on-disk cache, ~0.05-0.4 s once per
     process) before the timed steps, so that step 1's wall time is the step's own."""
-    if method not in _WARM:
-        {"pt": pt, "mtpt": mtpt, "fd": fd}[method].warm_up()
-        _WARM.add(method)
+    key = (cfg.method, cfg.kernel, cfg.scheme, cfg.transfer_method, cfg.truncation is None)
+    if key not in _WARM:
+        _model(cfg.method).warm_up(cfg)
+        _WARM.add(key)
 
 
 def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:
@@ -58,6 +76,7 @@ def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: di
 
 
 def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    pt = _model("pt")
     rng = cfg.rng()
     x = pt.initial_positions(cfg)
     _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
@@ -69,6 +88,7 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
 
 
 def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    mtpt = _model("mtpt")
     rng, order_rng = cfg.rng(), cfg.rng(stream=1)
     x, m, label = mtpt.initial_state(cfg, rng)
     _row(rec, cfg, 0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
@@ -81,6 +101,7 @@ def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) ->
 
 
 def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+    fd = _model("fd")
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
     extra = {"beta": 0.0, "h": dx, "substeps": 1}
@@ -96,14 +117,21 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
     return {"x": x, "c": c}
 
 
-def run_seeds(
+def run_seeds_arrow(
     cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False
-) -> pd.DataFrame:
+) -> pa.Table:
     """Run ``cfg`` for each seed and concatenate the per-step tables (or final states)."""
     parts = []
     for seed in seeds:
         if progress:
             progress(f"seed {seed}")
-        table, final = run(replace(cfg, seed=int(seed)), progress=progress, want_state=state)
+        table, final = run_arrow(replace(cfg, seed=int(seed)), progress=progress, want_state=state)
         parts.append(final if state else table)
-    return pd.concat(parts, ignore_index=True)
+    return pa.concat_tables(parts, promote_options="default")
+
+
+def run_seeds(
+    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False
+) -> pd.DataFrame:
+    """run_seeds_arrow as a pandas table."""
+    return run_seeds_arrow(cfg, seeds, progress, state).to_pandas()
