@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import sequential_reference as ref
 from numba import njit
 
-import sequential_reference as ref
 from particle_entropy import gauss, sequential, simulate
 from particle_entropy.runconfig import RunConfig
 

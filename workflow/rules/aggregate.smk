@@ -37,6 +37,8 @@ rule comic_tables:
         minima_html=report("results/tables/comic_minima.html", caption="../report/comic_minima.rst", category="COMIC"),
     log:
         "logs/comic_tables.log",
+    benchmark:
+        "results/benchmarks/comic_tables/all.tsv"
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
@@ -60,6 +62,8 @@ rule comic_tables_section:
         argmin="results/tables/{section}/comic_argmin.parquet",
     log:
         "logs/comic_tables_{section}.log",
+    benchmark:
+        "results/benchmarks/comic_tables/{section}.tsv"
     wildcard_constraints:
         section="fig9|mechanism",
     localrule: True
@@ -84,6 +88,8 @@ rule paper_claims:
         html=report("results/paper_claims.html", caption="../report/paper_claims.rst", category="Claims"),
     log:
         "logs/paper_claims.log",
+    benchmark:
+        "results/benchmarks/paper_claims/all.tsv"
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
@@ -102,6 +108,8 @@ rule tradeoff_table:
         "results/tables/tradeoff.parquet",
     log:
         "logs/tradeoff_table.log",
+    benchmark:
+        "results/benchmarks/tradeoff_table/all.tsv"
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"

@@ -18,6 +18,8 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             data=FIGURE_DATA_PATTERN.format(fig=_fig),
         log:
             f"logs/plot/{_fig}.log",
+        benchmark:
+            f"results/benchmarks/plot/{_fig}.tsv"
         localrule: True
         conda:
             "../../envs/particle-entropy.yaml"

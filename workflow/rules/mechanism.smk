@@ -10,6 +10,8 @@ if "mechanism" in config:
             "results/tables/mechanism/fd_domain.parquet",
         log:
             "logs/fd_domain.log",
+        benchmark:
+            "results/benchmarks/fd_domain/all.tsv"
         conda:
             "../../envs/particle-entropy.yaml"
         params:
@@ -35,6 +37,8 @@ if "mechanism" in config:
             data=FIGURE_DATA_PATTERN.format(fig="fig9_mechanism"),
         log:
             "logs/plot/fig9_mechanism.log",
+        benchmark:
+            "results/benchmarks/plot/fig9_mechanism.tsv"
         localrule: True
         conda:
             "../../envs/particle-entropy.yaml"
@@ -55,6 +59,8 @@ if "mechanism" in config:
             "results/tables/mechanism/floors.parquet",
         log:
             "logs/mechanism_floors.log",
+        benchmark:
+            "results/benchmarks/mechanism_floors/all.tsv"
         conda:
             "../../envs/particle-entropy.yaml"
         params:

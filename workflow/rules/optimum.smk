@@ -11,6 +11,8 @@ checkpoint optimum_round:
         "results/optimum/{name}/round~{k}.parquet",
     log:
         "logs/optimum/{name}/round~{k}.log",
+    benchmark:
+        "results/benchmarks/optimum_round/{name}/round~{k}.tsv"
     wildcard_constraints:
         name=r"[A-Za-z0-9_]+",
         k=r"\d+",
@@ -34,6 +36,8 @@ rule optimum_table:
         "results/optimum/{name}.parquet",
     log:
         "logs/optimum/{name}.log",
+    benchmark:
+        "results/benchmarks/optimum_table/{name}.tsv"
     wildcard_constraints:
         name=r"[A-Za-z0-9_]+",
     localrule: True
@@ -55,6 +59,8 @@ rule plot_optimum:
         pdf="figures/optimum_{name}.pdf",
     log:
         "logs/plot/optimum_{name}.log",
+    benchmark:
+        "results/benchmarks/plot/optimum_{name}.tsv"
     wildcard_constraints:
         name=r"[A-Za-z0-9_]+",
     localrule: True

@@ -35,6 +35,8 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
             data=FIGURE_DATA_PATTERN.format(fig="fig10"),
         log:
             "logs/plot/fig10.log",
+        benchmark:
+            "results/benchmarks/plot/fig10.tsv"
         localrule: True
         conda:
             "../../envs/particle-entropy.yaml"
