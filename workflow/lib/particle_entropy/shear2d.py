@@ -347,6 +347,6 @@ def run_shear(
         else:
             x, y = random_walk_step(x, y, cfg, rng, drift=cfg.case == "rw_drift")
             record(step)
-    steps = rec.table()
+    steps = rec.table().to_pandas()
     state = pd.DataFrame({"x": x, "y": y, "mass": m, "case": cfg.case, "seed": int(cfg.seed)})
     return steps, state
