@@ -72,25 +72,17 @@ class Recorder:
     def table(self) -> pa.Table:
         """The rows as a table: COLUMNS' columns in its order, then the case's (no pandas, so that a
         simulation job need not import it)."""
-        names = list(dict.fromkeys(k for row in self.rows for k in row))
-        names += [k for k in self.case if k not in names]
-        return arrow_table(
-            {k: [row.get(k) for row in self.rows] if k not in self.case else None for k in names},
-            self.case,
-            len(self.rows),
-        )
+        names = dict.fromkeys(k for row in self.rows for k in row)
+        return arrow_table({k: [row.get(k) for row in self.rows] for k in names}, self.case, len(self.rows))
 
 
 def arrow_table(columns: dict, constants: dict, length: int) -> pa.Table:
-    """A table of ``columns`` (name -> values; None where ``constants`` holds the value of every row),
-    COLUMNS' names first in its order, then the others as given."""
-    arrays = {}
-    for k, values in columns.items():
-        if k in constants:
-            v = constants[k]
-            arrays[k] = pa.nulls(length) if v is None else pa.array([v] * length)
-        else:
-            arrays[k] = pa.array(values)
+    """A table of ``columns`` (name -> values) and ``constants`` (name -> the value of every row,
+    replacing a column of that name in place, else added after them), COLUMNS' names first in its
+    order, then the others as given."""
+    arrays = {k: pa.array(v) for k, v in columns.items()}
+    for k, v in constants.items():
+        arrays[k] = pa.nulls(length) if v is None else pa.array([v] * length)
     ordered = [c for c in COLUMNS if c in arrays]
     return pa.table({k: arrays[k] for k in ordered + [c for c in arrays if c not in COLUMNS]})
 

@@ -186,17 +186,17 @@ def _exchange_clipped(mi, cnt, part, c, ms, state):
 
 
 @njit(cache=True, inline="always")
-def _exchange(mi, cnt, part, c, ms, state):
-    """The visit's exchanges in random order, unclipped -> (m_i, state)."""
-    z = np.uint64(0)
-    for k in range(cnt):
+def _exchange(mi, k0, cnt, part, c, ms, state, z):
+    """The visit's exchanges k0 .. cnt - 1 in random order, unclipped, from the stream's state and
+    its last output z -> (m_i, state, z)."""
+    for k in range(k0, cnt):
         j, state, z = _draw(k, cnt, state, z)
         q, cj = _take(k, j, part, c)
         mj = ms[q]
         dm = cj * (mi - mj)
         mi = mi - dm
         ms[q] = mj + dm
-    return mi, state
+    return mi, state, z
 
 
 @njit(cache=True, inline="always")
@@ -223,20 +223,8 @@ def _exchange_two(ma, cna, pa, ca, mb, cnb, pb, cb, ms, state):
         mb = mb - dmb
         ms[qa] = mja + dma
         ms[qb] = mjb + dmb
-    for k in range(both, cna):
-        ja, sa, za = _draw(k, cna, sa, za)
-        qa, cja = _take(k, ja, pa, ca)
-        mja = ms[qa]
-        dma = cja * (ma - mja)
-        ma = ma - dma
-        ms[qa] = mja + dma
-    for k in range(both, cnb):
-        jb, sb, zb = _draw(k, cnb, sb, zb)
-        qb, cjb = _take(k, jb, pb, cb)
-        mjb = ms[qb]
-        dmb = cjb * (mb - mjb)
-        mb = mb - dmb
-        ms[qb] = mjb + dmb
+    ma, sa, za = _exchange(ma, both, cna, pa, ca, ms, sa, za)  # the longer visit's rest
+    mb, sb, zb = _exchange(mb, both, cnb, pb, cb, ms, sb, zb)
     return ma, mb, sb
 
 
@@ -244,9 +232,10 @@ def _exchange_two(ma, cna, pa, ca, mb, cnb, pb, cb, ms, state):
 def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each.
 
-    Visits are taken two at a time (i, i + 1) when their windows share no particle; the two are then
-    independent, and their row sums and exchanges run interleaved, the same operations in the same
-    order on each value as one visit after the other. Clipping can act only when some m_i - dm or
+    Visits are found two at a time (i, i + 1): their windows, weights and row sums need only
+    positions and the row sums so far. When the windows share no particle the two visits are
+    independent and their exchanges run interleaved, the same operations in the same order on each
+    value as one visit after the other. Clipping can act only when some m_i - dm or
     m_j + dm is negative; with all masses >= 0 and every c = beta W_ij / r_i <= 1 neither is (in
     floating point too: fl(m_i - m_j) <= m_i, fl(c t) <= t and rounding is monotone), so such visits
     skip it."""
@@ -335,7 +324,8 @@ def _visit_mass(mi, cnt, part, c, ms, state, clip):
     """One visit's exchanges, clipped or not -> (m_i, state)."""
     if clip:
         return _exchange_clipped(mi, cnt, part, c, ms, state)
-    return _exchange(mi, cnt, part, c, ms, state)
+    mi, state, _ = _exchange(mi, 0, cnt, part, c, ms, state, np.uint64(0))
+    return mi, state
 
 
 def sequential_transfer(

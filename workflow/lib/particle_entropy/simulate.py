@@ -39,10 +39,8 @@ def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, wan
     table = rec.table()
     if not want_state:
         return table, None
-    case = cfg.case_columns()
     length = len(next(iter(state.values())))
-    columns = {**{k: np.asarray(v) for k, v in state.items()}, **{k: None for k in case if k not in state}}
-    return table, arrow_table(columns, {k: v for k, v in case.items() if k not in state}, length)
+    return table, arrow_table({k: np.asarray(v) for k, v in state.items()}, cfg.case_columns(), length)
 
 
 def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
