@@ -65,7 +65,9 @@ def test_one_seed_per_job_above_max_n():
 
 def test_case_run_paths_written_by_hand():
     ens = Ensemble(Case("mtpt", "collision", 30), 80)
-    assert case_run_paths(ens, SHIPPED) == [f"results/runs/{PAPER_DIR}/seeds~0-79.parquet"]  # small N: one job
+    assert case_run_paths(ens, SHIPPED) == [
+        f"results/runs/{PAPER_DIR}/seeds~{a}-{a + 19}.parquet" for a in (0, 20, 40, 60)
+    ]
     big = Ensemble(Case("mtpt", "collision", 30000), 4)  # 30000 <= max_n: one block of 4
     assert case_run_paths(big, SHIPPED) == [f"results/runs/{PAPER_DIR.replace('n~30/', 'n~30000/')}/seeds~0-3.parquet"]
     assert (
@@ -156,14 +158,13 @@ def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
     fig9 = set(figure_ensembles(SHIPPED, "fig9"))
     shared = mech & fig9
     # from N = 3,000 the same ensembles (same summaries); below, the mechanism's 20 seeds are the
-    # first blocks of Fig. 9's larger ensemble up to seed_blocks.small_n, where whole ensembles run
-    # in one job and the mechanism's own 20 seeds are a (cheap) job of their own
+    # first blocks of Fig. 9's larger ensemble: no run of the equations or the authors' loop is extra
     assert {(e.case.scheme, e.case.n) for e in shared} == {
         (s, n) for s in ("symmetric", "sequential") for n in (3000, 10000, 30000)
     }
     fig9_runs = {p for e in fig9 for p in case_run_paths(e, SHIPPED)}
     for e in mech:
-        if e.case.model in {f.case.model for f in fig9} and SHIPPED["seed_blocks"]["small_n"] < e.case.n <= 30000:
+        if e.case.model in {f.case.model for f in fig9} and e.case.n <= 30000:
             assert set(case_run_paths(e, SHIPPED)) <= fig9_runs, e
     assert {e.case.n for e in mech - fig9} >= {100000, 300000}
 
@@ -342,14 +343,3 @@ def test_check_sweeps_refuses_a_claims_range_written_high_to_low():
     config["claims"]["collision_eta1_optimum"] = [10000, 1000]
     msg = _refused(config)
     assert msg.startswith("claims.collision_eta1_optimum=[10000, 1000]") and "low <= high" in msg
-
-
-def test_small_cases_run_in_fuller_blocks():
-    """N <= small_n: small_size seeds a job (aligned to it); larger N keep the ordinary blocks."""
-    config = {"base_seed": 0, "seed_blocks": {"size": 20, "max_n": 30000, "small_n": 1000, "small_size": 80}}
-    assert seed_blocks(Ensemble(Case("mtpt", "collision", 300), 80), config) == [(0, 79)]
-    assert seed_blocks(Ensemble(Case("mtpt", "collision", 1000), 100), config) == [(0, 79), (80, 99)]
-    assert seed_blocks(Ensemble(Case("mtpt", "collision", 3000), 40), config) == [(0, 19), (20, 39)]
-    assert seed_blocks(Ensemble(Case("mtpt", "collision", 100000), 2), config) == [(0, 0), (1, 1)]
-    plain = {"base_seed": 0, "seed_blocks": {"size": 20, "max_n": 30000}}  # no small_n: as before
-    assert seed_blocks(Ensemble(Case("mtpt", "collision", 300), 80), plain) == [(0, 19), (20, 39), (40, 59), (60, 79)]

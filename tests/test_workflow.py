@@ -122,9 +122,8 @@ def test_full_dry_run_plans_every_figure(tmp_path):
         assert f"figures/fig{k}.png" in out
     assert "figures/tradeoff.png" in out and "results/paper_claims.md" in out
     fig9 = planned_outputs(snakemake(tmp_path, "-n", "figures/fig9.png", configfile=ROOT / "config.yaml"))
-    # 3 models x 2 schemes x (80 + 80 + 60 + 50 seeds in one job each, N <= 1,000; 20 + 6 + 4 in
-    # blocks of 20, N <= 30,000)
-    assert len(fig9) == 6 * (1 + 1 + 1 + 1 + 1 + 1 + 1)
+    # 3 models x 2 schemes x (80 + 80 + 60 + 50 + 20 + 6 + 4 seeds in blocks of 20, N <= 30,000)
+    assert len(fig9) == 6 * (4 + 4 + 3 + 3 + 1 + 1 + 1)
     assert "figures/fig9_mechanism.png" not in out  # its own target, not part of the paper's run
 
 

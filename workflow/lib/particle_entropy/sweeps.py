@@ -137,14 +137,9 @@ def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
 
 def seed_blocks(ens: Ensemble, config: Mapping) -> list[tuple[int, int]]:
     """Inclusive seed ranges of the jobs behind an ensemble: blocks aligned to multiples of the
-    block size (seed_blocks.small_size for N <= seed_blocks.small_n, where a seed is far cheaper
-    than a job's start-up; seed_blocks.size for N <= seed_blocks.max_n; else one seed a job)."""
+    block size (config seed_blocks.size, for N <= seed_blocks.max_n; else one seed a job)."""
     blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
-    n = ens.case.n
-    if n <= int(blocks.get("small_n", 0)):
-        size = int(blocks["small_size"])
-    else:
-        size = int(blocks["size"]) if n <= int(blocks["max_n"]) else 1
+    size = int(blocks["size"]) if ens.case.n <= int(blocks["max_n"]) else 1
     base, count = int(config["base_seed"]), ens.realisations
     return [(base + r, base + min(r + size, count) - 1) for r in range(0, count, size)]
 
