@@ -4,13 +4,14 @@
 
 glibc serves arrays above 128 kB (16,000 doubles) by mmap, so every fresh work array of a step
 at N = 30,000 arrives as new pages, each a page fault, which virtual machines make dear. This
-benchmark times one step of a late state in two child processes that differ only in
-MALLOC_MMAP_THRESHOLD_: the default, and 1 GiB, where freed arrays return to the heap and the
-next step reuses their pages (what reusing work buffers would give, at most). The difference
-between the two is the whole cost of allocation in the step. Steps: MTPT with the equations
-(collision kernel, whole Gaussian: the fast Gauss transform), the authors' loop (collision, cut
-at 3 widths) and the FD step (implicit, N intervals) with its measurement. Each figure is the
-median of ``repeats`` steps after two untimed ones.
+benchmark times one step of a late state in child processes that differ only in how freed
+memory is kept: glibc's defaults; MALLOC_MMAP_THRESHOLD_ at 1 GiB, where freed arrays return
+to the heap and the next step reuses their pages (what reusing work buffers would give, at
+most); and a call of heap.keep_freed_pages(), what simulation jobs do. "saved" compares the
+first and the last. Steps: MTPT with the equations (collision kernel, whole Gaussian: the fast
+Gauss transform), the authors' loop (collision, cut at 3 widths) and the FD step (implicit, N
+intervals) with its measurement. Each figure is the median of ``repeats`` steps after two
+untimed ones.
 """
 
 from __future__ import annotations
@@ -27,6 +28,9 @@ import numpy as np
 from particle_entropy import fd, mtpt
 from particle_entropy.runconfig import RunConfig
 n, repeats = int(sys.argv[1]), int(sys.argv[2])
+if sys.argv[3] == "keep":
+    from particle_entropy.heap import keep_freed_pages
+    assert keep_freed_pages()
 out = {}
 D, dt, t = 1e-3, 0.01 * 1.05**174, 1000.0
 rng = np.random.default_rng(0)
@@ -59,8 +63,10 @@ print(json.dumps(out))
 """
 
 
-def child(n: int, repeats: int, env: dict) -> dict:
-    res = subprocess.run([sys.executable, "-c", CHILD, str(n), str(repeats)], env=env, capture_output=True, text=True)
+def child(n: int, repeats: int, env: dict, mode: str = "default") -> dict:
+    res = subprocess.run(
+        [sys.executable, "-c", CHILD, str(n), str(repeats), mode], env=env, capture_output=True, text=True
+    )
     if res.returncode != 0:
         raise SystemExit(res.stderr[-2000:])
     return json.loads(res.stdout)
@@ -74,16 +80,16 @@ def main() -> None:
     fresh = dict(os.environ)
     fresh.pop("MALLOC_MMAP_THRESHOLD_", None)
     reuse = {**fresh, "MALLOC_MMAP_THRESHOLD_": str(2**30), "MALLOC_TRIM_THRESHOLD_": str(2**31)}
-    runs = {"fresh": [], "reuse": []}
-    for _ in range(3):  # alternate, so drifts in the machine hit both alike
+    runs = {"fresh": [], "reuse": [], "keep": []}
+    for _ in range(3):  # alternate, so drifts in the machine hit all alike
         runs["fresh"].append(child(a.n, a.repeats, fresh))
         runs["reuse"].append(child(a.n, a.repeats, reuse))
+        runs["keep"].append(child(a.n, a.repeats, fresh, "keep"))
     print(f"N = {a.n:,}: ms per step, best of 3 processes (median of {a.repeats} steps each)")
-    print(f"{'step':<20} {'fresh pages':>12} {'pages reused':>13} {'saved':>7}")
+    print(f"{'step':<20} {'fresh pages':>12} {'pages reused':>13} {'keep_freed_pages':>17} {'saved':>7}")
     for name in runs["fresh"][0]:
-        f = min(r[name] for r in runs["fresh"]) * 1e3
-        u = min(r[name] for r in runs["reuse"]) * 1e3
-        print(f"{name:<20} {f:>12.2f} {u:>13.2f} {100 * (f - u) / f:>6.1f}%")
+        f, u, k = (min(r[name] for r in runs[v]) * 1e3 for v in ("fresh", "reuse", "keep"))
+        print(f"{name:<20} {f:>12.2f} {u:>13.2f} {k:>17.2f} {100 * (f - k) / f:>6.1f}%")
 
 
 if __name__ == "__main__":

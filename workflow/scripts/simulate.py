@@ -6,10 +6,12 @@ import sys
 sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from particle_entropy.case import Case  # noqa: E402
+from particle_entropy.heap import keep_freed_pages  # noqa: E402
 from particle_entropy.io import write_parquet  # noqa: E402
 from particle_entropy.runconfig import RunConfig  # noqa: E402
 from particle_entropy.simulate import run_seeds_arrow  # noqa: E402
 
+keep_freed_pages()  # steps reuse the pages of the last step's arrays
 w = snakemake.wildcards  # noqa: F821
 cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()  # noqa: F821
 seeds = range(int(w.first), int(w.last) + 1)

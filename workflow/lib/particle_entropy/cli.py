@@ -198,9 +198,11 @@ def main(argv=None) -> int:
             f"one table row per step), more than the {have / 1e9:.2f} GB available on this machine: "
             "lower --n or take fewer, longer steps (--dt0, --dt-growth)"
         )
+    from .heap import keep_freed_pages
     from .io import write_parquet
     from .simulate import run
 
+    keep_freed_pages()  # steps reuse the pages of the last step's arrays
     progress = None if a.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))
     table, state = run(cfg, progress=progress, want_state=a.state_out is not None)
     write_parquet(table, a.out)
