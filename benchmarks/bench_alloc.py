@@ -25,11 +25,11 @@ import sys
 CHILD = r"""
 import json, math, statistics, sys, time
 import numpy as np
-from particle_entropy import fd, mtpt
-from particle_entropy.runconfig import RunConfig
+from particle_entropy.models import fd, mtpt
+from particle_entropy.core.runconfig import RunConfig
 n, repeats = int(sys.argv[1]), int(sys.argv[2])
 if sys.argv[3] == "keep":
-    from particle_entropy.heap import keep_freed_pages
+    from particle_entropy.core.heap import keep_freed_pages
     assert keep_freed_pages()
 out = {}
 D, dt, t = 1e-3, 0.01 * 1.05**174, 1000.0

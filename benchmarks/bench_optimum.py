@@ -32,10 +32,10 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from particle_entropy.case import Case, rows_of
-from particle_entropy.configcheck import load_yaml
-from particle_entropy.optimum import read_costs
-from particle_entropy.sweeps import case_run_paths, figure_ensembles, optimum_searches
+from particle_entropy.analysis.optimum import read_costs
+from particle_entropy.core.case import Case, rows_of
+from particle_entropy.pipeline.configcheck import load_yaml
+from particle_entropy.pipeline.sweeps import case_run_paths, figure_ensembles, optimum_searches
 
 VARIANTS = {  # suffix -> what it changes in the search
     "points": {"measure": "points"},

@@ -16,9 +16,9 @@ import time
 
 CHILD = """
 import json, resource, sys, time
-from particle_entropy.runconfig import RunConfig
-from particle_entropy.simulate import run
-from particle_entropy.gauss import gauss_transform
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.models.simulate import run
+from particle_entropy.numerics.gauss import gauss_transform
 import numpy as np
 gauss_transform(np.zeros(2), np.zeros(2), np.ones(2), 1.0, method='direct')  # JIT/cache load
 gauss_transform(np.zeros(2), np.zeros(2), np.ones(2), 1.0, method='taylor')

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from particle_entropy import sequential
-from particle_entropy.kernels import collision_sigma
+from particle_entropy.numerics import sequential
+from particle_entropy.numerics.kernels import collision_sigma
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import sequential_reference  # noqa: E402  (the loop before issue 20, kept as the tests' reference)

@@ -31,13 +31,13 @@ CASES = {
 }
 JOB = """
 import sys
-from particle_entropy.case import Case
-from particle_entropy.io import write_parquet
-from particle_entropy.runconfig import RunConfig
+from particle_entropy.core.case import Case
+from particle_entropy.core.io import write_parquet
+from particle_entropy.core.runconfig import RunConfig
 try:
-    from particle_entropy.simulate import run_seeds_arrow as run_seeds
+    from particle_entropy.models.simulate import run_seeds_arrow as run_seeds
 except ImportError:  # an earlier checkout
-    from particle_entropy.simulate import run_seeds
+    from particle_entropy.models.simulate import run_seeds
 cfg = RunConfig({case}, n=30, t_final=0.0551, dt0=0.01, seed=0).resolved()
 write_parquet(run_seeds(cfg, range(1)), sys.argv[1])
 """

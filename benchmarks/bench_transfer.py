@@ -5,7 +5,7 @@
     python benchmarks/bench_transfer.py --boxes          # FGT box width and direct/FGT crossover
 
 Methods (all on the same particles and masses):
-  shipped     particle_entropy.mass_transfer.mass_transfer, method auto (windowed sum or FGT)
+  shipped     particle_entropy.numerics.mass_transfer.mass_transfer, method auto (windowed sum or FGT)
   windowed    the same update with the exact windowed sum forced (O(N x neighbours))
   kdtree      scipy cKDTree.sparse_distance_matrix + scipy.sparse symmetric P (the usual approach)
   authors     a pure-Python port of the authors' sequential pairwise loop (N <= 3,000)
@@ -27,12 +27,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from particle_entropy import gauss, mtpt
-from particle_entropy.gauss import CUTOFF_SIGMAS, gauss_transform, neighbour_count
-from particle_entropy.mass_transfer import mass_transfer
-from particle_entropy.runconfig import RunConfig
-from particle_entropy.timegrid import time_steps
-from particle_entropy.timegrid import times as step_times
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.core.timegrid import time_steps
+from particle_entropy.core.timegrid import times as step_times
+from particle_entropy.models import mtpt
+from particle_entropy.numerics import gauss
+from particle_entropy.numerics.gauss import CUTOFF_SIGMAS, gauss_transform, neighbour_count
+from particle_entropy.numerics.mass_transfer import mass_transfer
 
 D = 1e-3
 WIDTHS = {"early": math.sqrt(4 * D * 0.01), "late": math.sqrt(4 * D * 0.01 * 1.05**174)}

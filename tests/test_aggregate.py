@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from particle_entropy.aggregate import (
+from particle_entropy.analysis.aggregate import (
     ARGMIN_COLUMN_DOCS,
     BOOTSTRAP_SEED,
     METRICS,
@@ -32,10 +32,10 @@ from particle_entropy.aggregate import (
     summarise_runs,
     tradeoff_table,
 )
-from particle_entropy.case import Case
-from particle_entropy.io import write_parquet
-from particle_entropy.runconfig import RunConfig
-from particle_entropy.simulate import run
+from particle_entropy.core.case import Case
+from particle_entropy.core.io import write_parquet
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.models.simulate import run
 
 SEEDS = (3, 4, 5)
 

@@ -10,7 +10,7 @@ import math
 import pandas as pd
 import pytest
 
-from particle_entropy.case import Case, SettingError, by_model, case_mask, case_of_table, models_in, rows_of, text
+from particle_entropy.core.case import Case, SettingError, by_model, case_mask, case_of_table, models_in, rows_of, text
 
 
 def _grid() -> list[Case]:

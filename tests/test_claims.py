@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from particle_entropy.case import Case
-from particle_entropy.claims import comic_claims, ensemble_claims, flatness, single_run_claims, to_markdown
+from particle_entropy.analysis.claims import comic_claims, ensemble_claims, flatness, single_run_claims, to_markdown
+from particle_entropy.core.case import Case
 
 TOL = {
     "fd_optimum_nodes": [1000, 10000],
@@ -271,7 +271,7 @@ def test_markdown_counts_passes():
 
 
 def test_no_comic_models_give_no_comic_claims():
-    from particle_entropy.aggregate import comic_minima, comic_table
+    from particle_entropy.analysis.aggregate import comic_minima, comic_table
 
     comic = comic_table([], [250.0])  # a config without fig8 and fig9
     tol = {
@@ -284,8 +284,8 @@ def test_no_comic_models_give_no_comic_claims():
 
 
 def test_single_run_claims_without_the_mtpt_case_skip_it():
-    from particle_entropy.runconfig import RunConfig
-    from particle_entropy.simulate import run
+    from particle_entropy.core.runconfig import RunConfig
+    from particle_entropy.models.simulate import run
 
     runs = [run(RunConfig(method="pt", kernel=k, n=n, t_final=2.0))[0] for n in (30, 60) for k in ("bins", "fixed")]
     claims = single_run_claims(runs, {})

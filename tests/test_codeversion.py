@@ -8,7 +8,7 @@ import os
 
 import pytest
 
-from particle_entropy.codeversion import closure, code_version, imports
+from particle_entropy.pipeline.codeversion import closure, code_version, imports, modules
 
 MODULES = {
     "a": "from .b import f\n\n\ndef g():\n    return f()\n",
@@ -26,13 +26,16 @@ def pkg(tmp_path):
     for name, src in MODULES.items():
         (root / f"{name}.py").write_text(src)
     imports.cache_clear()
+    modules.cache_clear()
     yield root
     imports.cache_clear()
+    modules.cache_clear()
 
 
 def _rewrite(path, text):
     path.write_text(text)
     imports.cache_clear()
+    modules.cache_clear()
 
 
 def test_imports_reads_relative_imports(pkg):
@@ -127,7 +130,7 @@ def test_mtpt_simulation_closure_holds_mass_transfer():
 def test_library_path_is_exported_first_and_once(monkeypatch, tmp_path):
     import os
 
-    from particle_entropy.codeversion import export_library_path
+    from particle_entropy.pipeline.codeversion import export_library_path
 
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(["/elsewhere", str(tmp_path)]))
     export_library_path(tmp_path)

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from particle_entropy.case import SettingError
 from particle_entropy.cli import main
-from particle_entropy.configcheck import ConfigFileError, check_config, load_yaml
+from particle_entropy.core.case import SettingError
+from particle_entropy.pipeline.configcheck import ConfigFileError, check_config, load_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = yaml.safe_load((ROOT / "config.yaml").read_text())

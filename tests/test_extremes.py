@@ -10,10 +10,10 @@ import warnings
 import numpy as np
 import pytest
 
-from particle_entropy import measures as M
-from particle_entropy.mass_transfer import mass_transfer
-from particle_entropy.runconfig import RunConfig, SettingError
-from particle_entropy.simulate import run
+from particle_entropy.core import measures as M
+from particle_entropy.core.runconfig import RunConfig, SettingError
+from particle_entropy.models.simulate import run
+from particle_entropy.numerics.mass_transfer import mass_transfer
 
 
 def finite_after_start(table):
@@ -157,8 +157,8 @@ def test_cli_refuses_explicit_fd_past_limit(tmp_path):
 def test_implicit_fd_with_a_million_nodes_in_bounded_memory():
     code = (
         "import resource\n"
-        "from particle_entropy.simulate import run\n"
-        "from particle_entropy.runconfig import RunConfig\n"
+        "from particle_entropy.models.simulate import run\n"
+        "from particle_entropy.core.runconfig import RunConfig\n"
         "t = run(RunConfig(method='fd', n=1_200_000, t_final=0.15))[0]\n"  # dx = 1e-5
         "print(t['mass_total'].iloc[-1], t['mass_min'].min(), t['H_C'].iloc[-1], t['H_C_analytic'].iloc[-1],"
         " resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)\n"

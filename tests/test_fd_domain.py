@@ -1,4 +1,4 @@
-"""Fig. 8's late error rise is the zero-concentration ends of [-6, 6] (particle_entropy.fd_domain).
+"""Fig. 8's late error rise is the zero-concentration ends of [-6, 6] (particle_entropy.experiments.fd_domain).
 
 Each test changes one setting of the paper's run (domain length at the same dx, time step, or the
 reference of the SSE) and checks what the boundary explanation predicts; the tests fail if the rise
@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from conftest import gaussian
 
-from particle_entropy import fd_domain as F
-from particle_entropy.runconfig import RunConfig
-from particle_entropy.simulate import run
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.experiments import fd_domain as F
+from particle_entropy.models.simulate import run
 
 D = 1e-3
 TIMES = (250.0, 800.0, 1000.0)

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import dense_kernel
 
-from particle_entropy import gauss
-from particle_entropy.gauss import CUTOFF_SIGMAS, gauss_transform
+from particle_entropy.numerics import gauss
+from particle_entropy.numerics.gauss import CUTOFF_SIGMAS, gauss_transform
 
 # Both methods drop pairs farther apart than CUTOFF_SIGMAS sigma (documented); each dropped
 # term is below exp(-CUTOFF_SIGMAS^2 / 2) |q_j|. The error bound used below is therefore

@@ -8,7 +8,7 @@ import pytest
 CHILD = r"""
 import resource, sys
 import numpy as np
-from particle_entropy.heap import keep_freed_pages
+from particle_entropy.core.heap import keep_freed_pages
 if sys.argv[1] == "keep":
     assert keep_freed_pages()
 def step():  # a step's work arrays at N = 30,000: twelve of 240 kB, freed at its end

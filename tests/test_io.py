@@ -10,7 +10,7 @@ import stat
 import pandas as pd
 import pytest
 
-from particle_entropy.io import (
+from particle_entropy.core.io import (
     OutputError,
     check_output_path,
     checksum_path,
@@ -112,7 +112,7 @@ def test_a_folder_or_pipe_with_a_table_name_is_set_aside_without_reading_it(tmp_
 def test_a_nearly_full_disk_is_named(tmp_path, monkeypatch):
     from collections import namedtuple
 
-    import particle_entropy.io as io
+    import particle_entropy.core.io as io
 
     usage = namedtuple("usage", "total used free")
     monkeypatch.setattr(io.shutil, "disk_usage", lambda path: usage(10 * 2**30, 10 * 2**30 - 50 * 2**20, 50 * 2**20))

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.kernels import (
+from particle_entropy.numerics.kernels import (
     beta_sph,
     collision_sigma,
     gaussian_pdf,

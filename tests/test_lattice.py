@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from particle_entropy.lattice import lattice_run, lattice_state
-from particle_entropy.runconfig import RunConfig
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.experiments.lattice import lattice_run, lattice_state
 
 
 def floor(n=1001, **kw) -> float:

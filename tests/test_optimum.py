@@ -11,8 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from particle_entropy.case import Case, SettingError
-from particle_entropy.optimum import (
+from particle_entropy.analysis.optimum import (
     PLAN_COLUMNS,
     REASONS,
     RESULT_COLUMNS,
@@ -22,6 +21,7 @@ from particle_entropy.optimum import (
     result_table,
     runs_in,
 )
+from particle_entropy.core.case import Case, SettingError
 
 N_STAR = 1000.0  # the synthetic curve's minimum
 
@@ -175,7 +175,7 @@ def test_bad_searches_are_refused_naming_the_key(spec, key):
 def test_the_error_convention_can_move_the_optimum():
     """Mean of per-run COMIC (a mean of logs) against COMIC of the mean SSE (the log of a mean):
     rare large errors weigh little in the first and much in the second."""
-    from particle_entropy.optimum import evaluate
+    from particle_entropy.analysis.optimum import evaluate
 
     sse = {100: [1.0, 1.0, 1.0, 1.0], 300: [0.01, 0.01, 0.01, 10.0], 1000: [2.0, 2.0, 2.0, 2.0]}
     rows = [
@@ -194,7 +194,7 @@ def test_a_minimum_at_the_end_of_the_range_is_said_so():
 
 
 def test_fitted_minimum_recovers_the_vertex_of_a_quadratic_in_log_n():
-    from particle_entropy.optimum import fitted_minimum
+    from particle_entropy.analysis.optimum import fitted_minimum
 
     u = np.log([100.0, 300.0, 1000.0, 3000.0, 10000.0])
     values = 2.0 * (u - math.log(1500.0)) ** 2  # vertex between grid points
@@ -210,7 +210,7 @@ def test_fitted_minimum_recovers_the_vertex_of_a_quadratic_in_log_n():
 def test_the_fit_beats_the_lowest_mean_on_noisy_curves():
     """Winner's curse: on a flat noisy minimum the visited N with the lowest mean is often a
     lucky neighbour; the weighted quadratic through its neighbours lands nearer the truth."""
-    from particle_entropy.optimum import evaluate
+    from particle_entropy.analysis.optimum import evaluate
 
     ns = [300, 450, 700, 1000, 1500, 2200, 3300]
     err_fit, err_best = [], []
@@ -247,7 +247,7 @@ def test_a_minimum_high_in_the_range_is_reached_by_walking():
 
 
 def test_cost_model_is_exact_for_a_power_law_and_extrapolates_its_slope():
-    from particle_entropy.optimum import cost_model
+    from particle_entropy.analysis.optimum import cost_model
 
     costs = pd.DataFrame({"n": [100, 1000, 10000], "seed": 0, "core_s": [1e-3 * n**1.5 for n in (100, 1000, 10000)]})
     predict = cost_model(costs)
@@ -287,7 +287,7 @@ def test_replication_goes_to_the_cheapest_unresolved_n_first():
 def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
     """Section 6, point 3: with dt in the sampling volume COMIC drops by ln(mean dt); every N of a
     model shares its time grid, so the curve shifts by a constant and the optimum stays put."""
-    from particle_entropy.optimum import evaluate
+    from particle_entropy.analysis.optimum import evaluate
 
     config = {"physics": {"t_final": 1000}, "time": {"dt0": 0.01, "fd_dt": 0.05, "fixed_dt": 1.0}}
     spec = {"case": {"method": "mtpt", "kernel": "collision", "dt_growth": 1.05}, "time": 1000, "n_range": [30, 30000]}
@@ -309,7 +309,7 @@ def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
 
 def test_the_common_measurement_points_replace_the_models_own():
     """measure: points judges SSE and COMIC at the 15 common points (columns SSE_points, COMIC_points)."""
-    from particle_entropy.optimum import evaluate
+    from particle_entropy.analysis.optimum import evaluate
 
     rows = [
         (n, s, comic(n, s, 0.1), comic(n * 10, s, 0.1), 1.0) for n in (100, 300, 1000, 3000, 10000) for s in range(6)
@@ -385,7 +385,7 @@ def test_bad_growth_searches_are_refused_naming_the_key(spec, key):
 def test_the_figure_names_the_options_it_was_judged_with(measure, time_volume):
     import matplotlib.pyplot as plt
 
-    from particle_entropy.plots_optimum import optimum_figure
+    from particle_entropy.figures.plots_optimum import optimum_figure
 
     search = fd(width=1.5, budget_runs=40)
     plan = run_search(search, noise=0.0)
@@ -443,7 +443,7 @@ def test_a_lucky_new_point_is_replicated_before_it_wins():
     added = out[out["round"] == 1]
     assert [400, 4, 7] in added[["n", "first", "last"]].values.tolist()
     # and its interval spans the rivals within noise, where the bootstrap alone trusts the lucky mean
-    from particle_entropy.optimum import evaluate
+    from particle_entropy.analysis.optimum import evaluate
 
     _, opt = evaluate(search, table)
     assert opt["best"] == 400 and opt["ci_lo"] == 300 and opt["ci_hi"] == 533

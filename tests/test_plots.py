@@ -18,11 +18,11 @@ import yaml
 
 matplotlib.use("Agg")
 
-from particle_entropy import plots, plots_shear  # noqa: E402
-from particle_entropy.aggregate import METRICS  # noqa: E402
-from particle_entropy.case import CASE_COLUMNS, Case, rows_of  # noqa: E402
-from particle_entropy.runconfig import RunConfig  # noqa: E402
-from particle_entropy.simulate import run  # noqa: E402
+from particle_entropy.analysis.aggregate import METRICS  # noqa: E402
+from particle_entropy.core.case import CASE_COLUMNS, Case, rows_of  # noqa: E402
+from particle_entropy.core.runconfig import RunConfig  # noqa: E402
+from particle_entropy.figures import plots, plots_shear  # noqa: E402
+from particle_entropy.models.simulate import run  # noqa: E402
 
 CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config.yaml").read_text())
 NS = (30, 100)

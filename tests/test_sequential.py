@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.sequential import sequential_transfer
+from particle_entropy.numerics.sequential import sequential_transfer
 
 
 def W(d: float, sigma: float) -> float:

@@ -11,8 +11,9 @@ import pytest
 import sequential_reference as ref
 from numba import njit
 
-from particle_entropy import gauss, sequential, simulate
-from particle_entropy.runconfig import RunConfig
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.models import simulate
+from particle_entropy.numerics import gauss, sequential
 
 
 def _state(rng, n, ties, negative, sorted_storage):

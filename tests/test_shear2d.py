@@ -17,8 +17,8 @@ import pandas as pd
 import pytest
 from conftest import no_runtime_warnings
 
-from particle_entropy.runconfig import SettingError
-from particle_entropy.shear2d import (
+from particle_entropy.core.runconfig import SettingError
+from particle_entropy.experiments.shear2d import (
     ShearConfig,
     kernel_cutoff,
     run_shear,

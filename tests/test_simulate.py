@@ -1,4 +1,4 @@
-"""Whole runs through particle_entropy.simulate.run: conservation, entropies, convergence."""
+"""Whole runs through particle_entropy.models.simulate.run: conservation, entropies, convergence."""
 
 from __future__ import annotations
 
@@ -10,11 +10,11 @@ import pandas as pd
 import pytest
 from conftest import ensemble_stats, gaussian, no_runtime_warnings
 
-from particle_entropy.io import write_parquet
-from particle_entropy.kernels import h_de
-from particle_entropy.records import TIMING_COLUMNS
-from particle_entropy.runconfig import RunConfig
-from particle_entropy.simulate import run
+from particle_entropy.core.io import write_parquet
+from particle_entropy.core.records import TIMING_COLUMNS
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.models.simulate import run
+from particle_entropy.numerics.kernels import h_de
 
 D = 1e-3
 T = 1000.0
@@ -371,8 +371,8 @@ def test_kernels_and_eta_share_the_random_stream():
 
 def test_seed_blocks_do_not_change_results():
     """A block of seeds run in one job equals the seeds run one by one (streams keyed by seed)."""
-    from particle_entropy.records import TIMING_COLUMNS
-    from particle_entropy.simulate import run_seeds
+    from particle_entropy.core.records import TIMING_COLUMNS
+    from particle_entropy.models.simulate import run_seeds
 
     cfg = RunConfig(method="mtpt", kernel="collision", n=200, eta=0.5, t_final=50.0)
     block = run_seeds(cfg, [3, 4, 5]).drop(columns=TIMING_COLUMNS)
@@ -401,7 +401,7 @@ def test_sequential_collision_runs_conserve_mass(scheme):
 
 
 def test_compensated_scheme_widens_the_cut_kernel():
-    from particle_entropy.kernels import collision_sigma, truncated_variance_fraction
+    from particle_entropy.numerics.kernels import collision_sigma, truncated_variance_fraction
 
     cfg = dict(method="mtpt", kernel="collision", n=100, t_final=1.0, truncation=3.0)
     cut, _ = run(RunConfig(**cfg))
@@ -433,8 +433,8 @@ POINT_RUNS = [
 def test_every_run_measures_at_the_same_points_and_comic_points_is_eq43(monkeypatch):
     """Section 6, point 1: every case and seed is sampled at the same 15 points (those of the
     registry, whatever the run's own domain); COMIC_points = 2 ln(SSE_points / 15) - ln dV."""
-    import particle_entropy.measures as M
-    from particle_entropy.registry import MEASUREMENT_SEED
+    import particle_entropy.core.measures as M
+    from particle_entropy.core.registry import MEASUREMENT_SEED
 
     seen = []
     at_points = M.at_points
@@ -459,7 +459,7 @@ def test_every_run_measures_at_the_same_points_and_comic_points_is_eq43(monkeypa
 def test_fd_sse_points_by_hand_at_three_points(monkeypatch):
     """A six-interval FD run measured at three points: the final row's SSE_points and
     COMIC_points from the final nodal state, with interpolation weights written out."""
-    import particle_entropy.measures as M
+    import particle_entropy.core.measures as M
 
     monkeypatch.setattr(M, "measurement_points", lambda fd_length=12.0: np.array([-3.0, 0.5, 5.5]))
     tab, st = run(RunConfig(method="fd", n=6, D=0.01, dt0=5.0, t_final=100.0), want_state=True)
@@ -489,7 +489,7 @@ def test_fd_sse_points_falls_with_n_as_the_leading_error_predicts():
     sum (D^2 dt t g'''' / 2)^2: by ~10^3 from N = 100 to 1000, by little from 1000 to 10000.
     Next-order terms are O(dx^2 / s^2) <= 3 % of the error at N = 100, so each measured
     SSE_points is within 10 % of the prediction."""
-    import particle_entropy.measures as M
+    import particle_entropy.core.measures as M
 
     t, dt = 250.0, 0.05
     p = M.measurement_points()

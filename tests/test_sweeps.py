@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from particle_entropy.case import Case, SettingError
-from particle_entropy.sweeps import (
+from particle_entropy.core.case import Case, SettingError
+from particle_entropy.pipeline.sweeps import (
     Ensemble,
     case_run_paths,
     case_sections,
@@ -152,7 +152,7 @@ def test_case_sections_of_the_shipped_config():
 
 
 def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
-    from particle_entropy.sweeps import mechanism_ensembles
+    from particle_entropy.pipeline.sweeps import mechanism_ensembles
 
     mech = set(mechanism_ensembles(SHIPPED))
     fig9 = set(figure_ensembles(SHIPPED, "fig9"))
@@ -296,7 +296,7 @@ def test_a_case_listed_twice_is_one_ensemble():
 
 
 def test_lattice_cases_and_their_checks():
-    from particle_entropy.sweeps import lattice_cases
+    from particle_entropy.pipeline.sweeps import lattice_cases
 
     cases = lattice_cases(SHIPPED)
     assert {c.n for c in cases} == {3001} and all(c.eta == 1.0 and c.method == "mtpt" for c in cases)

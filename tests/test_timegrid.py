@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.timegrid import MAX_STEPS, time_steps, times
+from particle_entropy.core.timegrid import MAX_STEPS, time_steps, times
 
 
 def test_paper_grid():

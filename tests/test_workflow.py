@@ -16,9 +16,16 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-from particle_entropy.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
-from particle_entropy.records import TIMING_COLUMNS
-from particle_entropy.sweeps import FIGURE_READS, Ensemble, case_run_paths, figure_ensembles, run_path, spec_ensembles
+from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
+from particle_entropy.core.records import TIMING_COLUMNS
+from particle_entropy.pipeline.sweeps import (
+    FIGURE_READS,
+    Ensemble,
+    case_run_paths,
+    figure_ensembles,
+    run_path,
+    spec_ensembles,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -442,7 +449,10 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
 
     assert plan()[0] == set()  # the same code in another place: nothing to do
     lib = src / "workflow/lib/particle_entropy"
-    for module, expected in [("plots.py", lambda r: r.startswith("plot_")), ("mass_transfer.py", None)]:
+    for module, expected in [
+        ("figures/plots.py", lambda r: r.startswith("plot_")),
+        ("numerics/mass_transfer.py", None),
+    ]:
         original = (lib / module).read_text()
         (lib / module).write_text(original + "\n# an edit\n")
         rules, proc = plan()
@@ -644,7 +654,7 @@ def test_every_derived_table_column_is_documented(tiny_run):
 
 
 def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
-    from particle_entropy.optimum import REASONS, RESULT_COLUMNS, Search
+    from particle_entropy.analysis.optimum import REASONS, RESULT_COLUMNS, Search
 
     cfg = load(TINY)
     snakemake(tiny_run, "optimum", configfile=TINY)

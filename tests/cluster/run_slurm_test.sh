@@ -227,7 +227,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from particle_entropy.records import TIMING_COLUMNS
+from particle_entropy.core.records import TIMING_COLUMNS
 
 local, slurm = (Path(d) for d in sys.argv[1:3])
 names = {p.relative_to(local) for p in (local / "results").rglob("*.parquet")}

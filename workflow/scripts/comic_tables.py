@@ -11,16 +11,16 @@ from pathlib import Path  # noqa: E402
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.aggregate import (  # noqa: E402
+from particle_entropy.analysis.aggregate import (  # noqa: E402
     MINIMA_COLUMN_DOCS,
     comic_argmin,
     comic_minima,
     comic_table,
     read_realisations,
 )
-from particle_entropy.case import MODEL_COLUMNS  # noqa: E402
-from particle_entropy.htmlpage import page  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.core.case import MODEL_COLUMNS  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.pipeline.htmlpage import page  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
 times = [float(t) for t in snakemake.params.times]  # noqa: F821

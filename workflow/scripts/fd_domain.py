@@ -4,8 +4,8 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from particle_entropy.fd_domain import comic_optimum, domain_experiment  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.experiments.fd_domain import comic_optimum, domain_experiment  # noqa: E402
 
 par = snakemake.params  # noqa: F821
 table = domain_experiment(

@@ -6,11 +6,11 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.case import Case  # noqa: E402
-from particle_entropy.heap import keep_freed_pages  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.lattice import lattice_run  # noqa: E402
-from particle_entropy.runconfig import RunConfig  # noqa: E402
+from particle_entropy.core.case import Case  # noqa: E402
+from particle_entropy.core.heap import keep_freed_pages  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.core.runconfig import RunConfig  # noqa: E402
+from particle_entropy.experiments.lattice import lattice_run  # noqa: E402
 
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
 

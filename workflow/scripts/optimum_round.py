@@ -7,8 +7,8 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.optimum import Search, initial_plan, next_plan, read_runs  # noqa: E402
+from particle_entropy.analysis.optimum import Search, initial_plan, next_plan, read_runs  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
 search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821

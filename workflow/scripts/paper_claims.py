@@ -10,9 +10,9 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from particle_entropy import claims as C  # noqa: E402
-from particle_entropy.htmlpage import page  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.analysis import claims as C  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.pipeline.htmlpage import page  # noqa: E402
 
 inp, par = snakemake.input, snakemake.params  # noqa: F821
 tol, defaults = par.claims, par.case_defaults

@@ -11,8 +11,8 @@ matplotlib.use("Agg")
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy import plots_shear  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.figures import plots_shear  # noqa: E402
 
 out = snakemake.output  # noqa: F821
 states = [pd.read_parquet(p) for p in snakemake.input]  # noqa: F821

@@ -10,10 +10,10 @@ matplotlib.use("Agg")
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.case import Case  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.plots import save_figure  # noqa: E402
-from particle_entropy.plots_mechanism import fig9_mechanism  # noqa: E402
+from particle_entropy.core.case import Case  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.figures.plots import save_figure  # noqa: E402
+from particle_entropy.figures.plots_mechanism import fig9_mechanism  # noqa: E402
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
 cases = [Case.from_wildcards(c) for c in par.cases]

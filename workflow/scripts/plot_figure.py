@@ -10,9 +10,9 @@ matplotlib.use("Agg")
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy import plots  # noqa: E402
-from particle_entropy.case import Case  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
+from particle_entropy.core.case import Case  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.figures import plots  # noqa: E402
 
 par, out = snakemake.params, snakemake.output  # noqa: F821
 tables = [pd.read_parquet(p) for p in snakemake.input]  # noqa: F821

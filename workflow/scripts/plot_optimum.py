@@ -10,8 +10,8 @@ matplotlib.use("Agg")
 
 import pandas as pd  # noqa: E402
 
-from particle_entropy.plots import save_figure  # noqa: E402
-from particle_entropy.plots_optimum import optimum_figure  # noqa: E402
+from particle_entropy.figures.plots import save_figure  # noqa: E402
+from particle_entropy.figures.plots_optimum import optimum_figure  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
 table = pd.read_parquet(inp[0])

@@ -10,9 +10,9 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from dataclasses import fields  # noqa: E402
 
-from particle_entropy.heap import keep_freed_pages  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.shear2d import ShearConfig, run_shear  # noqa: E402
+from particle_entropy.core.heap import keep_freed_pages  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.experiments.shear2d import ShearConfig, run_shear  # noqa: E402
 
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
 

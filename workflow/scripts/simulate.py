@@ -5,11 +5,11 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from particle_entropy.case import Case  # noqa: E402
-from particle_entropy.heap import keep_freed_pages  # noqa: E402
-from particle_entropy.io import write_parquet  # noqa: E402
-from particle_entropy.runconfig import RunConfig  # noqa: E402
-from particle_entropy.simulate import run_seeds_arrow  # noqa: E402
+from particle_entropy.core.case import Case  # noqa: E402
+from particle_entropy.core.heap import keep_freed_pages  # noqa: E402
+from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.core.runconfig import RunConfig  # noqa: E402
+from particle_entropy.models.simulate import run_seeds_arrow  # noqa: E402
 
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
 w = snakemake.wildcards  # noqa: F821

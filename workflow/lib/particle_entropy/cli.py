@@ -7,7 +7,7 @@ import math
 import os
 import sys
 
-from .registry import (
+from .core.registry import (
     ALL_KERNELS,
     DEFAULT_KERNEL,
     KERNELS,
@@ -18,7 +18,7 @@ from .registry import (
     TIME_GRIDS,
     TRANSFER_METHODS,
 )
-from .runconfig import RunConfig, SettingError
+from .core.runconfig import RunConfig, SettingError
 
 
 def _truncation(text: str):
@@ -132,7 +132,7 @@ def check_config_files(files: list[str]) -> int:
     """The check-config command: merge the files, check them, print one line."""
     from snakemake.utils import update_config
 
-    from .configcheck import ConfigFileError, check_config, load_yaml
+    from .pipeline.configcheck import ConfigFileError, check_config, load_yaml
 
     config: dict = {}
     try:
@@ -177,7 +177,7 @@ def main(argv=None) -> int:
         cfg = config_from_args(a)
     except SettingError as e:
         parser.error(f"--{e.name.replace('_', '-')}: {e}")
-    from .io import OutputError, check_output_path
+    from .core.io import OutputError, check_output_path
 
     if a.state_out is not None and os.path.abspath(a.state_out) == os.path.abspath(a.out):
         parser.error(f"--state-out: {a.state_out!r} is also --out; the final state would replace the per-step table")
@@ -187,8 +187,8 @@ def main(argv=None) -> int:
                 check_output_path(target)
             except OutputError as e:
                 parser.error(f"{flag}: {e}")
-    from .memory import available_bytes, estimate_bytes
-    from .timegrid import step_count
+    from .core.memory import available_bytes, estimate_bytes
+    from .core.timegrid import step_count
 
     need, have = estimate_bytes(cfg), available_bytes()
     if have is not None and need > have:
@@ -198,9 +198,9 @@ def main(argv=None) -> int:
             f"one table row per step), more than the {have / 1e9:.2f} GB available on this machine: "
             "lower --n or take fewer, longer steps (--dt0, --dt-growth)"
         )
-    from .heap import keep_freed_pages
-    from .io import write_parquet
-    from .simulate import run
+    from .core.heap import keep_freed_pages
+    from .core.io import write_parquet
+    from .models.simulate import run
 
     keep_freed_pages()  # steps reuse the pages of the last step's arrays
     progress = None if a.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))

@@ -14,7 +14,7 @@ from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
 from .plots import save_figure  # noqa: F401  (re-exported for the Fig. 10 script)
-from .shear2d import CASES, WALL_BAND
+from ..experiments.shear2d import CASES, WALL_BAND
 
 TITLES = {
     "rw_nodrift": "random walk, no drift correction",

@@ -31,8 +31,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from .case import CASE_COLUMNS, COLUMN_DOCS, Case, case_of_table, rows_of
-from .measures import analytic_h_i, settling_time
+from ..core.case import CASE_COLUMNS, COLUMN_DOCS, Case, case_of_table, rows_of
+from ..core.measures import analytic_h_i, settling_time
 
 # Okabe-Ito colour-blind-safe palette (and the paper's grey for Fig. 4's collision kernel)
 BLACK, ORANGE, SKY, GREEN, YELLOW, BLUE, VERMILLION, PURPLE = (
@@ -153,7 +153,7 @@ def _triple(case: Case) -> tuple:
     return case.method, case.kernel, round(case.eta, 9)
 
 
-def _models(cases: list[Case]) -> list[Case]:
+def distinct_models(cases: list[Case]) -> list[Case]:
     """The distinct models of ``cases`` in the order given."""
     return list(dict.fromkeys(c.model for c in cases))
 
@@ -174,7 +174,7 @@ def _auto_styles(count: int, used: list[dict]) -> list[dict]:
 
 def styles(figure: str, cases: list[Case]) -> dict[Case, dict]:
     """Style of every model of ``cases``: the paper's where it draws the model, else an automatic one."""
-    paper, models = PAPER_STYLES.get(figure, {}), _models(cases)
+    paper, models = PAPER_STYLES.get(figure, {}), distinct_models(cases)
     out = {}
     for triple, style in paper.items():
         matching = [m for m in models if _triple(m) == triple]
@@ -189,7 +189,7 @@ def styles(figure: str, cases: list[Case]) -> dict[Case, dict]:
 
 def tradeoff_styles(cases: list[Case]) -> dict[Case, dict]:
     """Trade-off styles: family colour and marker, line style by the dimensions varied from the paper."""
-    models = _models(cases)
+    models = distinct_models(cases)
     unknown = list(dict.fromkeys(_triple(m) for m in models if _triple(m) not in TRADEOFF_FAMILY))
     auto = _auto_styles(len(unknown), list(TRADEOFF_FAMILY.values()))
     family = {**TRADEOFF_FAMILY, **dict(zip(unknown, auto, strict=True))}
@@ -409,13 +409,13 @@ def save_figure(fig: Figure, png_path, pdf_path) -> None:
     plt.close(fig)
 
 
-def _figure(ncols: int, width: float = 5.2, height: float = 4.0, nrows: int = 1):
+def new_figure(ncols: int, width: float = 5.2, height: float = 4.0, nrows: int = 1):
     """A constrained-layout figure with a flat list of axes."""
     fig = Figure(figsize=(width * max(ncols, 1), height * nrows), layout="constrained")
     return fig, list(fig.subplots(nrows, max(ncols, 1), squeeze=False).ravel())
 
 
-def _look(
+def style_axes(
     ax,
     letter: str | None,
     title: str,
@@ -439,7 +439,7 @@ def _look(
         ax.legend(loc=legend, fontsize=8, framealpha=0.9)
 
 
-def _no_data(ax, what: str) -> None:
+def mark_no_data(ax, what: str) -> None:
     ax.text(0.5, 0.5, f"no data:\n{what}", transform=ax.transAxes, ha="center", va="center", color="0.4")
     ax.set_xticks([])
     ax.set_yticks([])
@@ -451,7 +451,7 @@ def _missing(ax, cases: list[Case], drawn: bool) -> None:
         return
     names = "\n".join(c.label() for c in cases)
     if not drawn:
-        _no_data(ax, names)
+        mark_no_data(ax, names)
     else:
         ax.text(
             0.99, 0.01, f"no data: {names}", transform=ax.transAxes, ha="right", va="bottom", fontsize=7, color="0.4"
@@ -466,7 +466,7 @@ def _runs(series: list[Series]) -> str:
     return f"{counts[0]} runs" if len(counts) == 1 else f"{counts[0]}–{counts[-1]} runs"
 
 
-def _n_ticks(ax, ns) -> None:
+def n_ticks(ax, ns) -> None:
     """Ticks at the N drawn, labelled 30, 1,000, ... (no crowded minor labels on a log axis)."""
     ns = sorted({int(n) for n in ns})
     ax.set_xticks(ns, [f"{n:,}" for n in ns], fontsize=8)
@@ -484,7 +484,7 @@ def fig1(tables, cases, *, D: float, t_final: float):
     """Fig. 1: single-realisation H_C of each case, H (= H_D) of PT and the analytic H_C; one panel per N."""
     found, style, out = by_case(tables), styles("fig1", cases), []
     panels = panels_by_n(cases)
-    fig, axes = _figure(len(panels))
+    fig, axes = new_figure(len(panels))
     for ax, (letter, n, at_n) in zip(axes, panels, strict=True):
         have = [c for c in at_n if c in found]
         series = [curve(letter, c, found[c], "H_C", style[c.model], label=f"$H_C$, {c.label()}") for c in have]
@@ -525,7 +525,7 @@ def fig1(tables, cases, *, D: float, t_final: float):
         _missing(ax, [c for c in at_n if c not in found], bool(series))
         if series:
             ax.set_ylim(bottom=max(ax.get_ylim()[0], -3.0))
-        _look(ax, letter, f"N = {n:,}", "entropy $H$, $H_C$ [nats]", legend="lower right")
+        style_axes(ax, letter, f"N = {n:,}", "entropy $H$, $H_C$ [nats]", legend="lower right")
         out += series
     return fig, source_table("fig1", out)
 
@@ -534,7 +534,7 @@ def _dilution(figure: str, tables, cases, ensemble: bool):
     """Dilution index E against time (log-log), one panel per N (descending), with the analytic E."""
     found, style, out = by_case(tables), styles(figure, cases), []
     panels = panels_by_n(cases, descending=True)
-    fig, axes = _figure(len(panels))
+    fig, axes = new_figure(len(panels))
     for ax, (letter, n, at_n) in zip(axes, panels, strict=True):
         have = [c for c in at_n if c in found]
         series = [curve(letter, c, found[c], "E", style[c.model], logy=True) for c in have]
@@ -544,7 +544,7 @@ def _dilution(figure: str, tables, cases, ensemble: bool):
             draw(ax, s, logy=True)
         _missing(ax, [c for c in at_n if c not in found], bool(series))
         title = f"N = {n:,}" + (f" (ensemble mean ± 1 std, {_runs(series)})" if ensemble else "")
-        _look(ax, letter, title, "dilution index $E$ [L]", logy=True, legend="upper left")
+        style_axes(ax, letter, title, "dilution index $E$ [L]", logy=True, legend="upper left")
         out += series
     return fig, source_table(figure, out)
 
@@ -557,7 +557,7 @@ def fig2(tables, cases, *, D: float, t_final: float):
 def fig3(tables, cases, *, D: float, t_final: float):
     """Fig. 3: ensemble-mean H_C against time, every case and N on one axes (hollow markers: smaller N)."""
     found, style, series = by_case(tables), styles("fig3", cases), []
-    fig, (ax,) = _figure(1, width=7.0, height=4.8)
+    fig, (ax,) = new_figure(1, width=7.0, height=4.8)
     for i, (_, n, at_n) in enumerate(panels_by_n(cases, descending=True)):
         have = [c for c in at_n if c in found]
         series += [
@@ -570,7 +570,7 @@ def fig3(tables, cases, *, D: float, t_final: float):
     _missing(ax, [c for c in cases if c not in found], bool(series))
     if series:
         ax.set_ylim(bottom=max(ax.get_ylim()[0], -3.0))
-    _look(ax, None, f"ensemble means ± 1 std, {_runs(series)}", "consistent entropy $H_C$ [nats]", legend="lower right")
+    style_axes(ax, None, f"ensemble means ± 1 std, {_runs(series)}", "consistent entropy $H_C$ [nats]", legend="lower right")
     return fig, source_table("fig3", series)
 
 
@@ -596,11 +596,11 @@ def fig6(tables, cases, *, D: float, t_final: float):
         series.append(
             Series("", r"analytic $H_I=\ln\sqrt{4\pi D t}+1/2$", None, "time", t, "H_I", h_i, style=ANALYTIC, time=t)
         )
-    fig, (ax,) = _figure(1, width=7.0, height=4.8)
+    fig, (ax,) = new_figure(1, width=7.0, height=4.8)
     for s in series:
         draw(ax, s)
     _missing(ax, [c for c in cases if c not in found], bool(series))
-    _look(
+    style_axes(
         ax,
         None,
         f"PMF entropy, ensemble means ({_runs(series)})",
@@ -625,7 +625,7 @@ def fig7(tables, cases, *, D: float, t_final: float):
     var = 2 * D * t_final
     gauss = lambda x: np.exp(-(x**2) / (2 * var)) / np.sqrt(2 * np.pi * var)  # noqa: E731
     panels = panels_by_n(cases, descending=True)
-    fig, axes = _figure(len(panels), width=5.6, height=5.2)
+    fig, axes = new_figure(len(panels), width=5.6, height=5.2)
     for ax, (letter, n, at_n) in zip(axes, panels, strict=True):
         have = [c for c in at_n if c in found]
         dot = 2 if n >= 10000 else 8  # dense clouds need small dots
@@ -666,7 +666,7 @@ def fig7(tables, cases, *, D: float, t_final: float):
             )
             draw(ax, series[-1])
         _missing(ax, [c for c in at_n if c not in found], bool(series))
-        _look(
+        style_axes(
             ax,
             letter,
             f"N = {n:,}, t = {t_final:g}",
@@ -684,7 +684,7 @@ def fig7(tables, cases, *, D: float, t_final: float):
     return fig, source_table("fig7", out)
 
 
-def _nearest(df: pd.DataFrame, time: float, column: str = "time") -> pd.DataFrame:
+def rows_nearest(df: pd.DataFrame, time: float, column: str = "time") -> pd.DataFrame:
     """Rows at the time nearest ``time``."""
     t = df[column].to_numpy(float)
     return df[t == t[np.argmin(np.abs(t - time))]]
@@ -695,7 +695,7 @@ def _fig8_measures(model: Case, multi: bool, style: dict, cases, found) -> list[
     have = sorted((c for c in cases if c.model == model and c in found), key=lambda c: c.n)
     if not have:
         return []
-    rows = pd.DataFrame([_nearest(found[c], FIG8_TIME).iloc[0] for c in have])
+    rows = pd.DataFrame([rows_nearest(found[c], FIG8_TIME).iloc[0] for c in have])
     comic = _column(rows, "COMIC")[0]
     common = dict(
         case=model,
@@ -729,7 +729,7 @@ def _fig8_measures(model: Case, multi: bool, style: dict, cases, found) -> list[
 
 def fig8(tables, cases, *, D: float, t_final: float):
     """Fig. 8: FD fitness, (a) ln(SSE/N) and (b) COMIC against time per grid, (c) both against dx."""
-    found, style, models = by_case(tables), styles("fig8", cases), _models(cases)
+    found, style, models = by_case(tables), styles("fig8", cases), distinct_models(cases)
     have = sorted((c for c in cases if c in found), key=lambda c: (c.n, models.index(c.model)))
     colour, multi, series = _colour_by_n(c.n for c in have), len(models) > 1, []
     for c in have:
@@ -741,13 +741,13 @@ def fig8(tables, cases, *, D: float, t_final: float):
         series.append(curve("b", c, found[c], "COMIC", st, label=label, band=False))
     for model in models:
         series += _fig8_measures(model, multi, style[model], cases, found)
-    fig, axes = _figure(3, width=4.6, height=4.0)
+    fig, axes = new_figure(3, width=4.6, height=4.0)
     for ax, letter in zip(axes, "abc", strict=True):
         for s in (s for s in series if s.panel == letter):
             draw(ax, s)
         _missing(ax, [c for c in cases if c not in found], any(s.panel == letter for s in series))
-    _look(axes[0], "a", "log-likelihood", r"$\ln(SSE/N)$ = AIC/2", legend="lower left")
-    _look(
+    style_axes(axes[0], "a", "log-likelihood", r"$\ln(SSE/N)$ = AIC/2", legend="lower left")
+    style_axes(
         axes[1], "b", "computational information criterion", r"COMIC $= 2\ln(SSE/N) - \ln\Delta x$", legend="lower left"
     )
     for s in (s for s in series if s.panel == "c" and s.y_name == "COMIC"):
@@ -762,7 +762,7 @@ def fig8(tables, cases, *, D: float, t_final: float):
             label=f"min COMIC: Δx = {s.x[k]:.2g} (N = {s.n[k]:,})",
         )
     tc = next((s.time[0] for s in series if s.panel == "c"), FIG8_TIME)
-    _look(
+    style_axes(
         axes[2],
         "c",
         f"both measures at t = {tc:g}",
@@ -860,7 +860,7 @@ def fig9(tables, cases, *, D: float, t_final: float):
     argmin when the realisations are resampled (bootstrap), with the minimum's 95% interval."""
     empty = pd.DataFrame()
     comic, minima, argmin = (list(tables) + [empty] * 3)[:3]
-    style, models = styles("fig9", cases), _models(cases)
+    style, models = styles("fig9", cases), distinct_models(cases)
     families = list(dict.fromkeys(_family(m) for m in models))
     ncols = min(max(len(families), 1), 3)
     rows = max(math.ceil(len(families) / 3), 1)
@@ -879,7 +879,7 @@ def fig9(tables, cases, *, D: float, t_final: float):
             _missing(ax, [c for c in cases if c.model == model and (g.empty or c.n not in set(g["n"]))], drawn=True)
             if g.empty:
                 continue
-            g = _nearest(g, t_final).sort_values("n")
+            g = rows_nearest(g, t_final).sort_values("n")
             dodge = 1.0 + 0.1 * (k - (len(mine) - 1) / 2)
             series = _fig9_panel(letter, model, g, style[model], dodge)
             for s in series:
@@ -924,14 +924,14 @@ def fig9(tables, cases, *, D: float, t_final: float):
                 draw(bar_ax, bar)
                 out.append(bar)
         if not drawn:
-            _look(ax, letter, title, "COMIC", xlabel="number of particles $N$", legend=None)
-            _no_data(ax, title)
+            style_axes(ax, letter, title, "COMIC", xlabel="number of particles $N$", legend=None)
+            mark_no_data(ax, title)
             bar_ax.set_visible(False)
             continue
         ax.plot([], [], "*", color="0.5", markeredgecolor="black", markersize=11, label="minimum of mean COMIC")
         ax.plot([], [], " ", label="numbers: realisations")
         ax.margins(x=0.08, y=0.12)
-        _look(
+        style_axes(
             ax,
             letter,
             f"{title}, t = {drawn[0].time[0]:g}",
@@ -939,12 +939,12 @@ def fig9(tables, cases, *, D: float, t_final: float):
             xlabel="",
             legend=None,
         )
-        _n_ticks(ax, np.concatenate([s.x for s in drawn]))
+        n_ticks(ax, np.concatenate([s.x for s in drawn]))
         ax.legend(loc="best", fontsize=7)
         if bar_letter is None:
             bar_ax.set_visible(False)
             continue
-        _look(
+        style_axes(
             bar_ax,
             bar_letter,
             "argmin over N, realisations resampled",
@@ -954,7 +954,7 @@ def fig9(tables, cases, *, D: float, t_final: float):
         )
         bar_ax.set_xlim(ax.get_xlim())
         bar_ax.set_ylim(0, 1.35)
-        _n_ticks(bar_ax, np.concatenate([s.x for s in drawn]))
+        n_ticks(bar_ax, np.concatenate([s.x for s in drawn]))
         for j, (text, colour) in enumerate(notes):
             bar_ax.text(
                 0.02, 0.95 - 0.16 * j, text, transform=bar_ax.transAxes, ha="left", va="top", fontsize=7, color=colour
@@ -968,7 +968,7 @@ def fig9(tables, cases, *, D: float, t_final: float):
 def _tradeoff_series(at: pd.DataFrame, letters: tuple[str, str], cases, style) -> list[Series]:
     """Trade-off series at one time: RMSE against wall time (left) and N (right) of each model."""
     out = []
-    for model in _models(cases):
+    for model in distinct_models(cases):
         g = pd.concat([rows_of(at, c) for c in cases if c.model == model]).sort_values("n")
         g = g[np.isfinite(g["rmse"]) & np.isfinite(g["wall_s"]) & (g["rmse"] > 0) & (g["wall_s"] > 0)]
         common = dict(
@@ -996,7 +996,7 @@ def _one_two_five(axis) -> None:
 
 
 def _tradeoff_axes(ax, letter: str, time: float, xlabel: str) -> None:
-    _look(ax, letter, f"t = {time:g}", "concentration RMSE sqrt(SSE/n) [1/L]", xlabel=xlabel, logy=True, legend=None)
+    style_axes(ax, letter, f"t = {time:g}", "concentration RMSE sqrt(SSE/n) [1/L]", xlabel=xlabel, logy=True, legend=None)
     # labelled 1-2-5 error levels with light horizontal lines: read off the cheapest model per error
     _one_two_five(ax.yaxis)
     ax.grid(True, which="minor", axis="y", color="0.95", linewidth=0.6)
@@ -1017,8 +1017,8 @@ def tradeoff(tables, cases, *, D: float, t_final: float):
     xlabels = ("wall time per realisation [s]", "number of particles or FD intervals N")
     if not times:
         for ax, xlabel in zip(axes[0], xlabels, strict=True):
-            _look(ax, None, "speed-accuracy trade-off", "RMSE", xlabel=xlabel, logx=False, legend=None)
-            _no_data(ax, "trade-off table rows of these cases")
+            style_axes(ax, None, "speed-accuracy trade-off", "RMSE", xlabel=xlabel, logx=False, legend=None)
+            mark_no_data(ax, "trade-off table rows of these cases")
         return fig, source_table("tradeoff", [])
     series, handles = [], {}
     for i, (row, time) in enumerate(zip(axes, times, strict=True)):
@@ -1046,7 +1046,7 @@ def tradeoff(tables, cases, *, D: float, t_final: float):
             _tradeoff_axes(ax, letter, time, xlabel)
         row[1].set_ylabel("")
         _one_two_five(row[0].xaxis)
-        _n_ticks(row[1], [n for s in at for n in np.atleast_1d(s.n)])
+        n_ticks(row[1], [n for s in at for n in np.atleast_1d(s.n)])
     star = Line2D(
         [],
         [],
@@ -1058,7 +1058,7 @@ def tradeoff(tables, cases, *, D: float, t_final: float):
         markeredgewidth=0.8,
         label="COMIC optimum (lowest mean COMIC)",
     )
-    keys = dict.fromkeys(tuple(m.variant()) for m in _models(cases))
+    keys = dict.fromkeys(tuple(m.variant()) for m in distinct_models(cases))
     key = [
         Line2D(
             [],

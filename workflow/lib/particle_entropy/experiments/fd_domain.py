@@ -16,10 +16,10 @@ from collections.abc import Iterable
 import numpy as np
 import pandas as pd
 
-from . import fd
-from . import measures as M
-from .registry import PAPER
-from .runconfig import RunConfig
+from ..core import measures as M
+from ..core.registry import PAPER
+from ..core.runconfig import RunConfig
+from ..models import fd
 
 REFERENCES = ("unit", "exact", "fd_mass", "images")
 DEFAULT_TIMES = tuple(float(t) for t in range(100, 1001, 50))

@@ -7,9 +7,9 @@ import math
 
 import numpy as np
 
-from . import measures as M
-from .kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
-from .runconfig import RunConfig
+from ..core import measures as M
+from ..core.runconfig import RunConfig
+from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -45,7 +45,7 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
     if sigma == 0.0 or beta == 0.0:
         return x, m, label, sigma, 0.0, 1
     if cfg.scheme.startswith("sequential"):
-        from .sequential import sequential_transfer  # a job loads only its scheme's kernels
+        from ..numerics.sequential import sequential_transfer  # a job loads only its scheme's kernels
 
         m = sequential_transfer(
             x,
@@ -61,7 +61,7 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
         return x, m, label, sigma, beta, 1
     if cfg.scheme == "compensated":  # widen the cut kernel so that its variance is the whole one's
         sigma = sigma / math.sqrt(truncated_variance_fraction(cfg.truncation))
-    from .mass_transfer import mass_transfer
+    from ..numerics.mass_transfer import mass_transfer
 
     res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method, cfg.transfer_tolerance)
     return x, res.mass, label, sigma, beta, res.substeps
@@ -101,12 +101,12 @@ def warm_up(cfg: RunConfig) -> None:
     """Load the compiled kernels this case's transfer calls before the timed steps: the authors'
     loop, or the transforms of Eqs. 16-21 (both methods when ``auto`` may choose either)."""
     if cfg.scheme.startswith("sequential"):
-        from . import sequential
+        from ..numerics import sequential
 
         sequential.warm_up()
         return
-    from . import gauss
-    from .mass_transfer import mass_transfer
+    from ..numerics import gauss
+    from ..numerics.mass_transfer import mass_transfer
 
     if cfg.transfer_method != "auto":
         methods = (cfg.transfer_method,)

@@ -1,6 +1,6 @@
 """Content hashes of the library code a task runs, so a workflow reruns exactly what an edit changes.
 
-``code_version("plots")`` hashes plots.py and every package module it imports, directly or
+``code_version("plots")`` hashes figures/plots.py and every package module it imports, directly or
 not (found by reading the import statements, so a new import is followed without a list to
 keep up to date). A rule that passes this hash as a parameter reruns when, and only when, the
 content of that code changes: restoring a file's old content, or touching it, reruns nothing.
@@ -16,21 +16,38 @@ import hashlib
 import os
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parent
+PACKAGE = Path(__file__).resolve().parents[1]  # particle_entropy/, above this subpackage
+
+
+@functools.cache
+def modules(package: Path = PACKAGE) -> dict[str, Path]:
+    """Every module of the package and its subpackages by its name (``gauss``, not
+    ``numerics.gauss``): the names are unique across subpackages, so a name is a module."""
+    found: dict[str, Path] = {}
+    for path in sorted(package.rglob("*.py")):
+        if path.name == "__init__.py" or "__pycache__" in path.parts:
+            continue
+        if path.stem in found:
+            raise ValueError(f"two modules named {path.stem!r}: {found[path.stem]} and {path}")
+        found[path.stem] = path
+    return found
 
 
 @functools.cache
 def imports(module: str, package: Path = PACKAGE) -> frozenset[str]:
-    """Package modules that ``module`` imports (``from . import x``, ``from .x import y``)."""
-    tree = ast.parse((package / f"{module}.py").read_text())
+    """Package modules that ``module`` imports by relative imports (``from . import x``,
+    ``from .x import y``, ``from ..sub.x import y``, ``from ..sub import x``)."""
+    known = modules(package)
+    tree = ast.parse(known[module].read_text())
     found = set()
     for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.level == 1:
-            if node.module:
-                found.add(node.module.split(".")[0])
-            else:
-                found.update(a.name for a in node.names)
-    return frozenset(m for m in found if (package / f"{m}.py").exists())
+        if isinstance(node, ast.ImportFrom) and node.level >= 1:
+            last = node.module.split(".")[-1] if node.module else None
+            if last in known:
+                found.add(last)
+            else:  # from a (sub)package: the names may be modules
+                found.update(a.name for a in node.names if a.name in known)
+    return frozenset(found)
 
 
 def closure(entries, exclude=(), package: Path = PACKAGE) -> list[str]:
@@ -50,7 +67,7 @@ def code_version(*entries: str, exclude=(), files=(), package: Path = PACKAGE) -
     """A short hash of the content of the modules in ``closure(entries, exclude)`` and of ``files``
     (a rule's script, say)."""
     h = hashlib.sha256()
-    parts = [(m, package / f"{m}.py") for m in closure(entries, exclude, package)]
+    parts = [(m, modules(package)[m]) for m in closure(entries, exclude, package)]
     for name, path in parts + [(Path(f).name, Path(f)) for f in files]:
         h.update(name.encode() + b"\0" + Path(path).read_bytes() + b"\0")
     return h.hexdigest()[:16]

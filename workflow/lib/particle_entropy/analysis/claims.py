@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from .case import Case, by_model, case_of_table
-from .registry import SCHEME_DOCS
+from ..core.case import Case, by_model, case_of_table
+from ..core.registry import SCHEME_DOCS
 
 
 def _near(df: pd.DataFrame, t: float) -> pd.Series:

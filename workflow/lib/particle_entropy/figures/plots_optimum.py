@@ -17,7 +17,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from .plots import BLACK, GREY, VERMILLION, _figure, _look
+from .plots import BLACK, GREY, VERMILLION, new_figure, style_axes
 
 BRACKET, INTERVAL = "#DCE9F5", "#9DC3E6"  # light and dark blue bands
 
@@ -57,7 +57,7 @@ def _value(v, growth: bool) -> str:
 
 def optimum_figure(table: pd.DataFrame):
     """The figure of one finished search (optimum.RESULT_COLUMNS, one row per visited N)."""
-    fig, (ax,) = _figure(1, width=9.0, height=4.6)
+    fig, (ax,) = new_figure(1, width=9.0, height=4.6)
     first = table.iloc[0]
     over = str(first["over"])
     t = table.sort_values(over)
@@ -136,7 +136,7 @@ def optimum_figure(table: pd.DataFrame):
     judged = f"COMIC at t = {float(first['time']):g}" + "".join(f"; {o}" for o in options)
     title = f"{first['search']}: {first['label']}\n{judged}"  # two lines: long names are not clipped
     xlabel = "dt growth − 1 (numbers: realisations)" if growth else "$N$ (numbers: realisations)"
-    _look(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel=xlabel, legend=None)
+    style_axes(ax, None, title, "COMIC (mean ± 1 s.e.) [nats]", xlabel=xlabel, legend=None)
     # beside the axes: a search's points crowd where the legend would go, around its minimum
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))

@@ -33,7 +33,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-from .registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
+from ..core.registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
 
 CUTOFF_SIGMAS = 9.0
 P_TERMS = 24

@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 
-from . import gauss
-from . import measures as M
-from .gauss import gauss_transform
-from .kernels import h_de
-from .runconfig import RunConfig
+from ..core import measures as M
+from ..core.runconfig import RunConfig
+from ..numerics import gauss
+from ..numerics.gauss import gauss_transform
+from ..numerics.kernels import h_de
 
 
 def reconstruction_width(cfg: RunConfig, t: float) -> float:

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import mtpt
-from .runconfig import RunConfig
-from .timegrid import time_steps, times
+from ..core.runconfig import RunConfig
+from ..core.timegrid import time_steps, times
+from ..models import mtpt
 
 
 def lattice_state(cfg: RunConfig, rng: np.random.Generator):

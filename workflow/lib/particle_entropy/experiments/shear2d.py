@@ -31,9 +31,9 @@ import pandas as pd
 from numba import njit
 from scipy.spatial import cKDTree
 
-from .records import Recorder
-from .runconfig import MAX_SEED, SettingError, check_range
-from .timegrid import MAX_STEPS
+from ..core.records import Recorder
+from ..core.runconfig import MAX_SEED, SettingError, check_range
+from ..core.timegrid import MAX_STEPS
 
 CASES = ("rw_nodrift", "rw_drift", "mt")
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]

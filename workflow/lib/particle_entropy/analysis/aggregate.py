@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from .case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
-from .measures import comic
+from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
+from ..core.measures import comic
 
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
 SUMMARY_COLUMNS = {
@@ -31,7 +31,7 @@ SUMMARY_COLUMNS = {
 def summarise_files(paths: list[str], out: str) -> int:
     """Summarise the run tables ``paths`` (blocks of seeds of one case) into ``out``; returns
     the number of realisations."""
-    from .io import write_parquet
+    from ..core.io import write_parquet
 
     blocks = pd.concat([pd.read_parquet(p) for p in paths], ignore_index=True)
     runs = [g for _, g in blocks.groupby("seed", sort=True)]

@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from .case import Case, rows_of
-from .kernels import truncated_variance_fraction
+from ..core.case import Case, rows_of
+from ..numerics.kernels import truncated_variance_fraction
 from .plots import (
     BLACK,
     BLUE,
@@ -31,11 +31,11 @@ from .plots import (
     SKY,
     VERMILLION,
     Series,
-    _look,
-    _models,
-    _n_ticks,
-    _nearest,
-    _no_data,
+    style_axes,
+    distinct_models,
+    n_ticks,
+    rows_nearest,
+    mark_no_data,
     draw,
     source_table,
     styles,
@@ -69,7 +69,7 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
         g = pd.concat([rows_of(comic, c) for c in cases if c.model == model])
         if g.empty:
             continue
-        g = _nearest(g, t_final).sort_values("n")
+        g = rows_nearest(g, t_final).sort_values("n")
         n = g["n"].to_numpy(float)
         r = g["n_realisations"].to_numpy(int)
         common = dict(
@@ -119,14 +119,14 @@ def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, styl
     error behaves as a / N; below, the kernel is not resolved and it falls faster)."""
     if floors.empty or not len(ns):
         return []
-    at = _nearest(floors, t_final)
+    at = rows_nearest(floors, t_final)
     out = []
     lattice_models = list(dict.fromkeys(Case.from_row(r).model for _, r in at.iterrows()))
     for model in lattice_models:
         f = float(rows_of(at, model)["SSE_over_N"].iloc[0])
         text = f"{_label(model, equations)}: floor {f:.2g}"
         if model in models and not comic.empty:
-            g = _nearest(pd.concat([rows_of(comic, c) for c in cases if c.model == model]), t_final)
+            g = rows_nearest(pd.concat([rows_of(comic, c) for c in cases if c.model == model]), t_final)
             small = g[(g["n"] >= 1000) & (g["n"] <= 10000)]
             if len(small):
                 a = float(np.median((small["SSE_mean"] / small["n"] - f) * small["n"]))
@@ -159,7 +159,7 @@ def _paired_series(realisations: pd.DataFrame, models, style, equations, t_final
     """Panel (c): COMIC(model) - COMIC(equations) per seed and N, mean +-1 standard error."""
     if equations is None or realisations.empty:
         return []
-    at = _nearest(realisations, t_final)
+    at = rows_nearest(realisations, t_final)
     base = rows_of(at, equations).set_index(["n", "seed"])["COMIC"]
     out = []
     for model in models:
@@ -227,7 +227,7 @@ def _fd_series(fd: pd.DataFrame) -> list[Series]:
 
 def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float, floors=None):
     """The four panels (module docstring) -> (Figure, source data)."""
-    models = _models(cases)
+    models = distinct_models(cases)
     style = {m: {**st, "color": PALETTE[k % len(PALETTE)]} for k, (m, st) in enumerate(styles("fig9", cases).items())}
     # the reference of panel (c): the first model with the paper's symmetric matrix and whole kernel
     equations = next((m for m in models if m.scheme == "symmetric" and m.truncation is None), None)
@@ -236,7 +236,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
     out = []
     if comic.empty:
         for ax in axes[:3]:
-            _no_data(ax, "mechanism COMIC table")
+            mark_no_data(ax, "mechanism COMIC table")
     else:
         main = _comic_series(comic, models, cases, style, equations, t_final)
         paired = _paired_series(realisations, models, style, equations, t_final)
@@ -245,7 +245,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
         out += main + paired
         ns = np.concatenate([s.x for s in main]) if main else []
         time = main[0].time[0] if main else t_final
-        _look(
+        style_axes(
             axes[0],
             "a",
             f"COMIC at t = {time:g}, same seeds, one change at a time",
@@ -253,7 +253,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
             xlabel="number of particles $N$",
             legend=None,
         )
-        _look(
+        style_axes(
             axes[1],
             "b",
             "SSE/N falls to each scheme's floor (dashed: even spacing)",
@@ -292,7 +292,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
                     style={"color": GREY, "linestyle": ":"},
                 )
             )
-        _look(
+        style_axes(
             axes[2],
             "c",
             "the same seeds: each change's own effect",
@@ -303,7 +303,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
         axes[2].axhline(0.0, color="black", linewidth=0.8)
         for ax in axes[:3]:
             if len(ns):
-                _n_ticks(ax, ns)
+                n_ticks(ax, ns)
             if ax.get_legend_handles_labels()[0]:
                 ax.legend(loc="lower left" if ax is axes[1] else "best", fontsize=6.5 if ax is axes[1] else 7)
     fd_series = _fd_series(fd)
@@ -311,7 +311,7 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
         draw(axes[3], s)
     out += fd_series
     if fd_series:
-        _look(
+        style_axes(
             axes[3],
             "d",
             "Fig. 8: FD error against time; zero ends at the domain edge",
@@ -325,5 +325,5 @@ def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, 
             axes[3].plot([], [], color="0.3", linestyle="--" if k == 1 else ":", label=f"domain length {length:g}")
         axes[3].legend(loc="best", fontsize=7, ncol=2)
     else:
-        _no_data(axes[3], "FD domain experiment")
+        mark_no_data(axes[3], "FD domain experiment")
     return fig, source_table(FIGURE, out)

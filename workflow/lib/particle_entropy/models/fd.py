@@ -8,8 +8,8 @@ import math
 import numpy as np
 from numba import njit
 
-from . import measures as M
-from .runconfig import RunConfig
+from ..core import measures as M
+from ..core.runconfig import RunConfig
 
 
 def grid(cfg: RunConfig) -> tuple[np.ndarray, float]:

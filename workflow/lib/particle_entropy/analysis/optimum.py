@@ -38,6 +38,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
+from ..core.case import APPLIES, Case, SettingError
+from ..core.registry import MEASUREMENT_POINTS, PAPER
+from ..core.runconfig import first_step
+from ..core.timegrid import step_count
 from .aggregate import (
     CONVENTIONS,
     RUN_COLUMNS,
@@ -46,10 +50,6 @@ from .aggregate import (
     convention_samples,
     realisations_table,
 )
-from .case import APPLIES, Case, SettingError
-from .registry import MEASUREMENT_POINTS, PAPER
-from .runconfig import first_step
-from .timegrid import step_count
 
 MEASURES = {
     "own": "SSE at the model's own points: particles or nodes (Eq. 44)",

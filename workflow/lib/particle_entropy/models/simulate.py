@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pyarrow as pa
 
-from . import measures as M
-from .records import Recorder, arrow_table
-from .runconfig import RunConfig
-from .timegrid import time_steps, times
+from ..core import measures as M
+from ..core.records import Recorder, arrow_table
+from ..core.runconfig import RunConfig
+from ..core.timegrid import time_steps, times
 
 if TYPE_CHECKING:
     import pandas as pd

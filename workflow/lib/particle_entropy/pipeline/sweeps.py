@@ -14,9 +14,9 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from .case import CASE_DIR, Case, SettingError
-from .registry import PAPER
-from .runconfig import MAX_SEED, RunConfig, first_step
+from ..core.case import CASE_DIR, Case, SettingError
+from ..core.registry import PAPER
+from ..core.runconfig import MAX_SEED, RunConfig, first_step
 
 RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
@@ -211,7 +211,7 @@ def check_shear(config: Mapping) -> None:
     """Every shear case must build a valid ShearConfig (strip inside the domain, whole steps, ...)."""
     if "shear" not in config:
         return
-    from .shear2d import ShearConfig
+    from ..experiments.shear2d import ShearConfig
 
     settings = {k: v for k, v in config["shear"].items() if k != "cases"}
     for case in config["shear"]["cases"]:
@@ -223,7 +223,7 @@ def check_shear(config: Mapping) -> None:
 
 def optimum_searches(config: Mapping) -> dict:
     """The adaptive COMIC searches of config `optimum` (optimum.Search), by name."""
-    from .optimum import Search
+    from ..analysis.optimum import Search
 
     return {name: Search.from_config(name, spec, config) for name, spec in config.get("optimum", {}).items()}
 
@@ -242,7 +242,7 @@ def optimum_largest_jobs(config: Mapping) -> list[tuple[str, Ensemble]]:
 
 def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job must fit in ``available`` bytes (memory.estimate_mb of its seed block)."""
-    from .memory import estimate_mb
+    from ..core.memory import estimate_mb
 
     jobs = [
         (f"{name}.n", ens, max(b - a + 1 for a, b in seed_blocks(ens, config)))

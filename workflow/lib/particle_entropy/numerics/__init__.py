@@ -1,0 +1,3 @@
+"""Kernels and sums that the models call: kernel widths and weights (Eqs. 17, 20, 23, 26), exact
+windowed and fast Gauss transforms without an N x N matrix, the symmetric mass transfer
+(Eqs. 16-21) and the authors' sequential pairwise loop. Imports only from `core`."""

@@ -1,0 +1,3 @@
+"""What joins the library to the workflow: config sections to cases and paths (`sweeps`), the
+config's checks (`configcheck`), content hashes of the code each rule runs (`codeversion`) and
+the report's table pages (`htmlpage`). The top of the stack with `cli`."""
