@@ -497,6 +497,21 @@ def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
+def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run):
+    cfg = load(TINY)
+    run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[-1], cfg)[-1]
+    good = run.read_bytes()
+    run.write_bytes(good[:100])
+    files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
+    snakemake(tiny_run, "-n", configfile=TINY)
+    assert run.read_bytes() == good[:100]  # not moved, not repaired
+    assert not (run.parent / (run.name + ".corrupt")).exists()
+    assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
+    proc = snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
+    assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
+    assert pd.read_parquet(run).shape[0] > 0
+
+
 # --- two runs, a failing job, a full disk ---------------------------------------------------
 
 

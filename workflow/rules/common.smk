@@ -52,15 +52,18 @@ if workflow.is_main_process and workflow.local_exec:  # jobs run here: each must
     check_memory(config, available_bytes())
 
 
-def set_aside_corrupt_tables(root="results"):
+def set_aside_corrupt_tables(root="results", look_only=False):
     """Tables whose bytes no longer match their checksum (truncated, a flipped bit, empty) are
     moved to <name>.corrupt before the DAG is built. The default target rebuilds every table set
-    aside and not yet rebuilt, so a dry run in between loses nothing."""
-    for path, problem in corrupt_tables(root).items():
-        moved = set_aside(path)
-        print(
-            f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it", file=sys.stderr
-        )
+    aside and not yet rebuilt, so a dry run in between loses nothing. ``look_only`` (a dry run):
+    read no table and move none, only name those set aside before."""
+    if not look_only:
+        for path, problem in corrupt_tables(root).items():
+            moved = set_aside(path)
+            print(
+                f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it",
+                file=sys.stderr,
+            )
     aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     missing = [m for m in missing if not Path(m).exists()]
@@ -71,8 +74,10 @@ def set_aside_corrupt_tables(root="results"):
 
 
 # Only the main Snakemake process checks: a job re-parsing this file on a cluster node must not
-# judge tables that other jobs are writing at that moment.
-CORRUPT = set_aside_corrupt_tables() if workflow.is_main_process else []
+# judge tables that other jobs are writing at that moment. A dry run only looks: it changes no
+# file (the run that follows checks the tables before it plans).
+DRY_RUN = bool(getattr(workflow.output_settings, "dryrun", False))
+CORRUPT = set_aside_corrupt_tables(look_only=DRY_RUN) if workflow.is_main_process else []
 FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 

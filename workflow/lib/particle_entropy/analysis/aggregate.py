@@ -9,7 +9,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
 from ..core.measures import comic
@@ -305,7 +304,6 @@ ARGMIN_COLUMN_DOCS = {
     "ci_hi": "its upper end",
 }
 ARGMIN_COLUMNS = list(ARGMIN_COLUMN_DOCS)
-_RNG = "rng" if "rng" in inspect.signature(stats.bootstrap).parameters else "random_state"  # scipy < 1.15
 
 
 def argmin_bootstrap(
@@ -374,6 +372,9 @@ def bootstrap_of_means(
         with np.errstate(divide="ignore", invalid="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
             return of_means(stacked)
 
+    from scipy import stats  # 1 s to import: only the jobs that resample pay it, not the workflow's parse
+
+    rng = "rng" if "rng" in inspect.signature(stats.bootstrap).parameters else "random_state"  # scipy < 1.15
     return stats.bootstrap(
         [samples[i] for i in free],
         statistic,
@@ -382,7 +383,7 @@ def bootstrap_of_means(
         paired=False,
         confidence_level=CONFIDENCE,
         method="percentile",
-        **{_RNG: np.random.default_rng(seed)},
+        **{rng: np.random.default_rng(seed)},
     )
 
 

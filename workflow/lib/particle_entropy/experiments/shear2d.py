@@ -28,8 +28,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import pandas as pd
-from numba import njit
-from scipy.spatial import cKDTree
 
 from ..core.records import Recorder
 from ..core.runconfig import MAX_SEED, SettingError, check_range
@@ -198,6 +196,8 @@ def neighbour_pairs(x, y, cfg: ShearConfig, cutoff: float) -> np.ndarray:
         box = [cfg.length * sx]
     # round-off may put a point exactly on the box edge; cKDTree needs [0, box)
     pts[:, 0] = np.where(pts[:, 0] >= box[0], 0.0, pts[:, 0])
+    from scipy.spatial import cKDTree
+
     pairs = cKDTree(pts, boxsize=box).query_pairs(cutoff, output_type="ndarray")
     return pairs.reshape(-1, 2).astype(np.int64, copy=False)
 
@@ -212,60 +212,9 @@ def pair_kernel(x, y, pairs, cfg: ShearConfig) -> np.ndarray:
     on a wall, D_ij = 0) get W_ij = 0, the kernel's limit for r != 0; with alpha_T = 0 so do
     pairs with dy != 0.
     """
-    return _pair_kernel(x, y, velocity(y), pairs, cfg.length, cfg.alpha_L, cfg.alpha_T, cfg.dt)
+    from .shear_kernels import pair_weights  # numba: loaded by the jobs that step, not by plots
 
-
-@njit(cache=True)
-def _pair_kernel(x, y, v, pairs, length, alpha_L, alpha_T, dt):
-    w = np.zeros(pairs.shape[0])
-    for k in range(pairs.shape[0]):
-        i, j = pairs[k, 0], pairs[k, 1]
-        vbar = 0.5 * (v[i] + v[j])
-        if vbar <= 0.0:
-            continue
-        dx = abs(x[i] - x[j])
-        dx = min(dx, length - dx)
-        dy = y[i] - y[j]
-        q = dx * dx / alpha_L
-        if alpha_T > 0.0:
-            q += dy * dy / alpha_T
-        elif dy != 0.0:
-            continue
-        w[k] = math.exp(-q / (8.0 * vbar * dt)) / vbar
-    return w
-
-
-@njit(cache=True)
-def _transfer(pairs, w, v, m, beta):
-    """Eqs. 16-18 on a pair list: returns (new masses, substeps, beta * max_i sum_{j != i} P_ij)."""
-    n = m.size
-    off = np.zeros(n)
-    for k in range(pairs.shape[0]):
-        off[pairs[k, 0]] += w[k]
-        off[pairs[k, 1]] += w[k]
-    inv_r = np.zeros(n)  # 1 / r_i, r_i = W_ii + sum_{j != i} W_ij, W_ii = 1 / v_i (infinite at v_i = 0)
-    for i in range(n):
-        if v[i] > 0.0:
-            inv_r[i] = 1.0 / (1.0 / v[i] + off[i])
-    p = np.empty(pairs.shape[0])
-    offdiag = np.zeros(n)
-    for k in range(pairs.shape[0]):
-        i, j = pairs[k, 0], pairs[k, 1]
-        p[k] = 0.5 * w[k] * (inv_r[i] + inv_r[j])  # P_ij = P_ji
-        offdiag[i] += p[k]
-        offdiag[j] += p[k]
-    c_max = beta * offdiag.max() if n > 0 else 0.0
-    # split so that b * offdiag stays a hair below 1 (round-off margin)
-    substeps = max(1, math.ceil(c_max / (1.0 - 1e-9)))
-    b = beta / substeps
-    for _ in range(substeps):
-        gain = np.zeros(n)
-        for k in range(pairs.shape[0]):
-            i, j = pairs[k, 0], pairs[k, 1]
-            gain[i] += p[k] * m[j]
-            gain[j] += p[k] * m[i]
-        m = m * (1.0 - b * offdiag) + b * gain  # non-negative terms only
-    return m, substeps, c_max
+    return pair_weights(x, y, velocity(y), pairs, cfg.length, cfg.alpha_L, cfg.alpha_T, cfg.dt)
 
 
 def transfer_step(x, y, m, cfg: ShearConfig, cutoff: float | None = None):
@@ -282,7 +231,9 @@ def transfer_step(x, y, m, cfg: ShearConfig, cutoff: float | None = None):
         cutoff = kernel_cutoff(cfg)
     pairs = neighbour_pairs(x, y, cfg, cutoff)
     w = pair_kernel(x, y, pairs, cfg)
-    m, substeps, c_max = _transfer(pairs, w, velocity(y), np.asarray(m, dtype=np.float64), float(cfg.beta))
+    from .shear_kernels import pair_transfer
+
+    m, substeps, c_max = pair_transfer(pairs, w, velocity(y), np.asarray(m, dtype=np.float64), float(cfg.beta))
     return m, int(substeps), float(c_max), int(pairs.shape[0])
 
 

@@ -10,10 +10,10 @@ profile leaves it out and hashes the script here instead.)
 
 from __future__ import annotations
 
-import ast
 import functools
 import hashlib
 import os
+import re
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1]  # particle_entropy/, above this subpackage
@@ -33,20 +33,25 @@ def modules(package: Path = PACKAGE) -> dict[str, Path]:
     return found
 
 
+# a relative import: its dots, its module path and the names up to the end of the line or of the
+# parenthesised list (comments and strings that look like one only add a module: never fewer)
+_RELATIVE = re.compile(r"^[ \t]*from[ \t]+(\.+)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)", re.M)
+
+
 @functools.cache
 def imports(module: str, package: Path = PACKAGE) -> frozenset[str]:
     """Package modules that ``module`` imports by relative imports (``from . import x``,
-    ``from .x import y``, ``from ..sub.x import y``, ``from ..sub import x``)."""
+    ``from .x import y``, ``from ..sub.x import y``, ``from ..sub import x``), lazy ones
+    included. Read by a pattern, not a parse: the workflow hashes its code at every start."""
     known = modules(package)
-    tree = ast.parse(known[module].read_text())
     found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.level >= 1:
-            last = node.module.split(".")[-1] if node.module else None
-            if last in known:
-                found.add(last)
-            else:  # from a (sub)package: the names may be modules
-                found.update(a.name for a in node.names if a.name in known)
+    for _, path, names in _RELATIVE.findall(known[module].read_text()):
+        last = path.split(".")[-1] if path else None
+        if last in known:
+            found.add(last)
+        else:  # from a (sub)package: the names may be modules
+            words = re.findall(r"\w+", names.split("#")[0] if not names.startswith("(") else names)
+            found.update(w for w in words if w in known)
     return frozenset(found)
 
 

@@ -22,6 +22,9 @@ SCHEMA_PATH = Path(__file__).resolve().parents[3] / "schemas" / "config.schema.y
 _NUMBER_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
+SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, where PyYAML has it: 10x faster
+
+
 class ConfigFileError(ValueError):
     """A config file that cannot be read as YAML; the message names the file, line and column."""
 
@@ -30,7 +33,7 @@ def load_yaml(path: str | Path) -> Mapping:
     """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error."""
     try:
         with open(path, encoding="utf-8") as f:
-            data = yaml.safe_load(f)
+            data = yaml.load(f, Loader=SAFE_LOADER)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark is not None else "somewhere"
@@ -108,7 +111,7 @@ def check_schema(config: Mapping, schema: Mapping) -> None:
 
 def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
     with open(path, encoding="utf-8") as f:
-        return yaml.safe_load(f)
+        return yaml.load(f, Loader=SAFE_LOADER)
 
 
 def check_config(config: Mapping, schema: Mapping | None = None) -> None:
