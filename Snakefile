@@ -7,7 +7,7 @@ from snakemake.utils import min_version
 
 min_version("8.0")
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
-from particle_entropy.pipeline.configcheck import load_yaml  # noqa: E402
+from particle_entropy.pipeline.configcheck import load_yaml
 
 if Path("config.yaml").exists():  # Snakemake's loader does not say where a YAML error is
     load_yaml("config.yaml")

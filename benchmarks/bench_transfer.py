@@ -182,7 +182,7 @@ def box_widths(min_time, n=30000, ratios=(0.5, 1.0, 1.5, 2.5, 3.5)):
                 cells = []
                 for r in ratios + (None,):
                     gauss.FGT_BOX_RATIOS = default if r is None else (r,)
-                    fgt = lambda q=q, sigma=sigma: gauss_transform(x, x, q, sigma, method="fgt")  # noqa: E731
+                    fgt = lambda q=q, sigma=sigma: gauss_transform(x, x, q, sigma, method="fgt")
                     cells.append(timed(fgt, min_time))
                 direct = (
                     timed(lambda q=q, sigma=sigma: gauss_transform(x, x, q, sigma, method="direct"), min_time)

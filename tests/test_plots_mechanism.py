@@ -25,7 +25,7 @@ NS = (100, 300)
 @pytest.mark.parametrize(("t", "fraction"), [(1000.0, truncated_variance_fraction(3.0)), (50.0, 0.8)])
 def test_floor_is_the_integrated_squared_difference_of_the_two_gaussians(t, fraction):
     D, omega = 1e-3, 10.0
-    g = lambda x, var: math.exp(-0.5 * x * x / var) / math.sqrt(2 * math.pi * var)  # noqa: E731
+    g = lambda x, var: math.exp(-0.5 * x * x / var) / math.sqrt(2 * math.pi * var)
     integral, _ = quad(lambda x: (g(x, 2 * D * t) - g(x, 2 * fraction * D * t)) ** 2, -50, 50, limit=200)
     assert truncation_floor(D, t, fraction, omega) == pytest.approx(integral / omega, rel=1e-8)
     assert truncation_floor(D, t, 1.0, omega) == pytest.approx(0.0, abs=1e-15)

@@ -378,7 +378,7 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
         assert sum(map(len, parts)) == len(pd.concat(parts).drop_duplicates()), name  # no row in two models
         assert len({p["label" if "label" in p else "series"].iloc[0] for p in parts}) == 3, name
     comic = tables["comic"]
-    at = lambda m: rows_of(comic, m).sort_values(["time", "n"])["COMIC_mean"].to_numpy()  # noqa: E731
+    at = lambda m: rows_of(comic, m).sort_values(["time", "n"])["COMIC_mean"].to_numpy()
     assert not np.array_equal(at(truncated), at(sequential))  # the scheme changes the numbers
     claims = pd.read_parquet(tiny_run / "results/tables/paper_claims.parquet")
     for m in models:  # each model gets its own Fig. 9 claims

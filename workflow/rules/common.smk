@@ -9,23 +9,23 @@ from snakemake.utils import validate
 
 LIB = str(Path(workflow.basedir) / "workflow" / "lib")
 sys.path.insert(0, LIB)
-from particle_entropy.pipeline.codeversion import export_library_path  # noqa: E402
+from particle_entropy.pipeline.codeversion import export_library_path
 
 export_library_path(LIB)  # jobs import this checkout's library in any software environment
-from particle_entropy.pipeline.configcheck import check_schema, load_schema  # noqa: E402
+from particle_entropy.pipeline.configcheck import check_schema, load_schema
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
-from particle_entropy.analysis.aggregate import summarise_files  # noqa: E402
-from particle_entropy.core.case import Case  # noqa: E402
-from particle_entropy.pipeline.codeversion import code_version  # noqa: E402
-from particle_entropy.core.io import CORRUPT_SUFFIX, corrupt_tables, set_aside  # noqa: E402
-from particle_entropy.core.memory import available_bytes, estimate_mb  # noqa: E402
-from particle_entropy.analysis.optimum import MAX_ROUNDS  # noqa: E402
-from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES  # noqa: E402
-from particle_entropy.pipeline.sweeps import (  # noqa: E402
+from particle_entropy.analysis.aggregate import summarise_files
+from particle_entropy.core.case import Case
+from particle_entropy.pipeline.codeversion import code_version
+from particle_entropy.core.io import CORRUPT_SUFFIX, corrupt_tables, set_aside
+from particle_entropy.core.memory import available_bytes, estimate_mb
+from particle_entropy.analysis.optimum import MAX_ROUNDS
+from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES
+from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,
     FIGURE_READS,

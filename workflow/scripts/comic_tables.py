@@ -4,26 +4,26 @@ asks for them, HTML copies of the COMIC table and the minima for `snakemake --re
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import html  # noqa: E402
-from pathlib import Path  # noqa: E402
+import html
+from pathlib import Path
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.analysis.aggregate import (  # noqa: E402
+from particle_entropy.analysis.aggregate import (
     MINIMA_COLUMN_DOCS,
     comic_argmin,
     comic_minima,
     comic_table,
     read_realisations,
 )
-from particle_entropy.core.case import MODEL_COLUMNS  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.pipeline.htmlpage import page  # noqa: E402
+from particle_entropy.core.case import MODEL_COLUMNS
+from particle_entropy.core.io import write_parquet
+from particle_entropy.pipeline.htmlpage import page
 
-inp, out = snakemake.input, snakemake.output  # noqa: F821
-times = [float(t) for t in snakemake.params.times]  # noqa: F821
+inp, out = snakemake.input, snakemake.output
+times = [float(t) for t in snakemake.params.times]
 comic = comic_table([pd.read_parquet(p) for p in inp.summaries], times)
 realisations = read_realisations(list(inp.runs), times)
 argmin = comic_argmin(realisations)

@@ -2,14 +2,14 @@
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.experiments.fd_domain import comic_optimum, domain_experiment  # noqa: E402
+from particle_entropy.core.io import write_parquet
+from particle_entropy.experiments.fd_domain import comic_optimum, domain_experiment
 
-par = snakemake.params  # noqa: F821
+par = snakemake.params
 table = domain_experiment(
     n_list=par.n, fd_lengths=par.lengths, fd_dts=(par.fd_dt,), times=par.times, D=par.D, ref_length=par.ref_length
 )
-write_parquet(table, snakemake.output[0])  # noqa: F821
+write_parquet(table, snakemake.output[0])
 print(comic_optimum(table).to_string(), file=sys.stderr)

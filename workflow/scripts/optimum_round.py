@@ -3,15 +3,15 @@ every run of plan k-1 at the search's time and writes the next plan (or plan k-1
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.analysis.optimum import Search, initial_plan, next_plan, read_runs  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.analysis.optimum import Search, initial_plan, next_plan, read_runs
+from particle_entropy.core.io import write_parquet
 
-inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
-search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
+inp, par, out = snakemake.input, snakemake.params, snakemake.output
+search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)
 if "plan" in inp.keys():
     realisations, costs = read_runs(list(inp.runs), search.time)
     plan = next_plan(search, pd.read_parquet(inp.plan), realisations, costs)

@@ -3,15 +3,15 @@ the runs and core-seconds spent, and the estimated cost of a full sweep."""
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.analysis.optimum import Search, read_runs, result_table  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
+from particle_entropy.analysis.optimum import Search, read_runs, result_table
+from particle_entropy.core.io import write_parquet
 
-inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
-search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)  # noqa: F821
+inp, par, out = snakemake.input, snakemake.params, snakemake.output
+search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)
 realisations, costs = read_runs(list(inp.runs), search.time)
 table = result_table(search, pd.read_parquet(inp.plan), realisations, costs)
 write_parquet(table, out[0])

@@ -3,25 +3,25 @@ Markdown and an HTML page for `snakemake --report` (which renders HTML tables, n
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from pathlib import Path  # noqa: E402
+from pathlib import Path
 
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+import numpy as np
+import pandas as pd
 
-from particle_entropy.analysis import claims as C  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.pipeline.htmlpage import page  # noqa: E402
+from particle_entropy.analysis import claims as C
+from particle_entropy.core.io import write_parquet
+from particle_entropy.pipeline.htmlpage import page
 
-inp, par = snakemake.input, snakemake.params  # noqa: F821
+inp, par = snakemake.input, snakemake.params
 tol, defaults = par.claims, par.case_defaults
 rows = C.single_run_claims([pd.read_parquet(p) for p in inp.runs], defaults)
 rows += C.ensemble_claims([pd.read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]), defaults)
 rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), tol)
 claims = C.claims_table(rows)
-write_parquet(claims, snakemake.output.table)  # noqa: F821
-Path(snakemake.output.md).write_text(C.to_markdown(claims))  # noqa: F821
+write_parquet(claims, snakemake.output.table)
+Path(snakemake.output.md).write_text(C.to_markdown(claims))
 
 # The report's copy: the Markdown table's columns, result cells classed for colour; no timestamp.
 STYLE = (
@@ -34,5 +34,5 @@ table = shown.to_html(index=False, border=0, classes="claims")
 for verdict in ("pass", "FAIL"):
     table = table.replace(f"<td>{verdict}</td>", f'<td class="{verdict.lower()}">{verdict}</td>')
 body = f"<p>{summary}</p>\n{table}\n"
-Path(snakemake.output.html).write_text(page("Paper claims", body, STYLE, "Paper claims: reproduced values"))  # noqa: F821
+Path(snakemake.output.html).write_text(page("Paper claims", body, STYLE, "Paper claims: reproduced values"))
 print(claims.to_string(), file=sys.stderr)

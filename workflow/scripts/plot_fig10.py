@@ -3,19 +3,19 @@ the figure and the data it plots (source data)."""
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import matplotlib  # noqa: E402
+import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.figures import plots_shear  # noqa: E402
+from particle_entropy.core.io import write_parquet
+from particle_entropy.figures import plots_shear
 
-out = snakemake.output  # noqa: F821
-states = [pd.read_parquet(p) for p in snakemake.input]  # noqa: F821
+out = snakemake.output
+states = [pd.read_parquet(p) for p in snakemake.input]
 figure, data = plots_shear.fig10(states)
 plots_shear.save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)

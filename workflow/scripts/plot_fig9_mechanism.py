@@ -2,20 +2,20 @@
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import matplotlib  # noqa: E402
+import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.core.case import Case  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.figures.plots import save_figure  # noqa: E402
-from particle_entropy.figures.plots_mechanism import fig9_mechanism  # noqa: E402
+from particle_entropy.core.case import Case
+from particle_entropy.core.io import write_parquet
+from particle_entropy.figures.plots import save_figure
+from particle_entropy.figures.plots_mechanism import fig9_mechanism
 
-inp, par, out = snakemake.input, snakemake.params, snakemake.output  # noqa: F821
+inp, par, out = snakemake.input, snakemake.params, snakemake.output
 cases = [Case.from_wildcards(c) for c in par.cases]
 figure, data = fig9_mechanism(
     pd.read_parquet(inp.comic),

@@ -2,18 +2,18 @@
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import matplotlib  # noqa: E402
+import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
-from particle_entropy.figures.plots import save_figure  # noqa: E402
-from particle_entropy.figures.plots_optimum import optimum_figure  # noqa: E402
+from particle_entropy.figures.plots import save_figure
+from particle_entropy.figures.plots_optimum import optimum_figure
 
-inp, out = snakemake.input, snakemake.output  # noqa: F821
+inp, out = snakemake.input, snakemake.output
 table = pd.read_parquet(inp[0])
 save_figure(optimum_figure(table), out.png, out.pdf)
-print(f"drew {len(table)} visited N of search {snakemake.wildcards.name}", file=sys.stderr)  # noqa: F821
+print(f"drew {len(table)} visited N of search {snakemake.wildcards.name}", file=sys.stderr)

@@ -3,17 +3,17 @@
 
 import sys
 
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from particle_entropy.core.case import Case  # noqa: E402
-from particle_entropy.core.heap import keep_freed_pages  # noqa: E402
-from particle_entropy.core.io import write_parquet  # noqa: E402
-from particle_entropy.core.runconfig import RunConfig  # noqa: E402
-from particle_entropy.models.simulate import run_seeds_arrow  # noqa: E402
+from particle_entropy.core.case import Case
+from particle_entropy.core.heap import keep_freed_pages
+from particle_entropy.core.io import write_parquet
+from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.models.simulate import run_seeds_arrow
 
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
-w = snakemake.wildcards  # noqa: F821
-cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()  # noqa: F821
+w = snakemake.wildcards
+cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()
 seeds = range(int(w.first), int(w.last) + 1)
 table = run_seeds_arrow(cfg, seeds, progress=lambda msg: print(msg, file=sys.stderr), state=w.kind == "snapshots")
-write_parquet(table, snakemake.output[0])  # noqa: F821
+write_parquet(table, snakemake.output[0])

@@ -48,7 +48,7 @@ def single_run_claims(runs: list[pd.DataFrame], defaults: dict | None = None) ->
     """Claims read off the single realisations of Figs. 1-2 (the paper's cases, unset
     dimensions from ``defaults``, config case_defaults)."""
     out = []
-    paper = lambda method, kernel, n: Case.from_spec({"method": method, "kernel": kernel}, n, defaults)  # noqa: E731
+    paper = lambda method, kernel, n: Case.from_spec({"method": method, "kernel": kernel}, n, defaults)
     for n in sorted({int(r["n"].iloc[0]) for r in runs}):
         try:
             pt, mt, fx = (

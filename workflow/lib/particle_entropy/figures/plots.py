@@ -623,7 +623,7 @@ def fig7(tables, cases, *, D: float, t_final: float):
     """Fig. 7: final concentrations at the particles against x and the analytic Gaussian; one panel per N."""
     found, style, out = by_case(tables), styles("fig7", cases), []
     var = 2 * D * t_final
-    gauss = lambda x: np.exp(-(x**2) / (2 * var)) / np.sqrt(2 * np.pi * var)  # noqa: E731
+    gauss = lambda x: np.exp(-(x**2) / (2 * var)) / np.sqrt(2 * np.pi * var)
     panels = panels_by_n(cases, descending=True)
     fig, axes = new_figure(len(panels), width=5.6, height=5.2)
     for ax, (letter, n, at_n) in zip(axes, panels, strict=True):
