@@ -156,6 +156,23 @@ def test_out_and_state_out_on_one_path_are_refused_before_the_run(tmp_path):
     assert "Traceback" not in res.stderr and list(tmp_path.iterdir()) == []
 
 
+def test_out_and_state_out_through_a_symlinked_folder_are_refused(tmp_path):
+    (tmp_path / "d").mkdir()
+    (tmp_path / "dlink").symlink_to(tmp_path / "d")
+    res = _small_run("--out", str(tmp_path / "d" / "x.parquet"), "--state-out", str(tmp_path / "dlink" / "x.parquet"))
+    assert res.returncode == 2 and "also --out" in res.stderr
+    assert list((tmp_path / "d").iterdir()) == []  # nothing written, nothing replaced
+
+
+def test_out_and_state_out_as_hard_links_of_one_file_are_refused(tmp_path):
+    out = tmp_path / "x.parquet"
+    out.write_bytes(b"kept")
+    os.link(out, tmp_path / "y.parquet")
+    res = _small_run("--out", str(out), "--state-out", str(tmp_path / "y.parquet"))
+    assert res.returncode == 2 and "also --out" in res.stderr
+    assert out.read_bytes() == b"kept"
+
+
 def test_a_device_or_directory_out_is_refused_and_left_alone(tmp_path):
     fifo = tmp_path / "pipe"
     os.mkfifo(fifo)  # a non-regular file anyone can make (a character device needs root)

@@ -168,6 +168,17 @@ def config_from_args(a: argparse.Namespace) -> RunConfig:
     ).resolved()
 
 
+def _same_file(a: str, b: str) -> bool:
+    """Whether two paths name one file: the same path once links are resolved (a symlinked
+    folder, a file not yet made), or an existing file reached twice (a hard link)."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist yet: different files
+        return False
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     a = parser.parse_args(argv)
@@ -179,7 +190,7 @@ def main(argv=None) -> int:
         parser.error(f"--{e.name.replace('_', '-')}: {e}")
     from .core.io import OutputError, check_output_path
 
-    if a.state_out is not None and os.path.abspath(a.state_out) == os.path.abspath(a.out):
+    if a.state_out is not None and _same_file(a.state_out, a.out):
         parser.error(f"--state-out: {a.state_out!r} is also --out; the final state would replace the per-step table")
     for flag, target in (("--out", a.out), ("--state-out", a.state_out)):
         if target is not None:
