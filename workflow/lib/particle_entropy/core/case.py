@@ -1,5 +1,5 @@
-"""The one identity of a simulated model: a ``Case`` builds its path, its table columns, its
-legend label, and is rebuilt from a config spec, from wildcards or from a table row.
+"""The one identity of a simulated model: a ``Case`` builds its path and its table columns, and
+is rebuilt from a config spec, from wildcards or from a table row (its legend text: labels.py).
 
 A case is every dimension a user may sweep: method, kernel, N, eta, truncation, dt growth and
 scheme. With ``n=None`` it is a *model* (the same case at every N), the key COMIC tables,
@@ -20,7 +20,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-from .registry import KERNELS, METHODS, PAPER, SCHEME_DOCS, SCHEME_LABELS, SCHEMES, TRUNCATED_SCHEMES
+from .registry import KERNELS, METHODS, PAPER, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES
 
 # Case field -> (wildcard name, path segment); the path of a case is these segments in order.
 PATH_SEGMENTS = {
@@ -43,15 +43,6 @@ COLUMN_DOCS = {
     "truncation": "transfer kernel cut at this many kernel widths; inf = whole Gaussian",
     "dt_growth": "time-step growth factor dt_{k+1} / dt_k (1: fixed step)",
     "scheme": "; ".join(f"{k}: {v}" for k, v in SCHEME_DOCS.items()),
-}
-KERNEL_NAMES = {
-    "bins": "binned",
-    "fixed": "fixed kernel",
-    "adaptive": "adaptive kernel",
-    "collision": "collision",
-    "sph": "SPH",
-    "implicit": "implicit",
-    "explicit": "explicit",
 }
 # Which dimensions apply to which method; the others hold NEUTRAL values.
 APPLIES = {
@@ -127,7 +118,7 @@ class Case:
         object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, 1.0, math.inf))
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
-        if self.scheme in TRUNCATED_SCHEMES and self.truncation is None:
+        if SCHEME_RECORDS[self.scheme].compensated and self.truncation is None:
             raise SettingError("scheme", self.scheme, "needs a truncation (a number of kernel widths), not none")
         for dim, methods in APPLIES.items():
             if self.method not in methods and getattr(self, dim) != NEUTRAL[dim]:
@@ -191,7 +182,7 @@ class Case:
     def wildcards(self) -> dict[str, str]:
         """Path text of every dimension, keyed by wildcard name."""
         if self.n is None:
-            raise SettingError("n", None, f"an integer: {self.label()} is a model, which has no path")
+            raise SettingError("n", None, f"an integer: {self} is a model, which has no path")
         return {w: text(getattr(self, f)) for f, (w, _) in PATH_SEGMENTS.items()}
 
     def path(self) -> str:
@@ -229,27 +220,15 @@ class Case:
                 out[dim] = getattr(self, dim)
         return out
 
-    def variant_parts(self) -> list[str]:
-        """Legend words for the dimensions that differ from the paper's defaults, e.g.
-        ['truncation 3', 'sequential loop']."""
-        v, parts = self.variant(), []
-        if "truncation" in v:
-            parts.append(f"truncation {v['truncation']:g}")
-        if "dt_growth" in v:
-            parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
-        if "scheme" in v:
-            parts.append(SCHEME_LABELS[v["scheme"]])
-        return parts
+    def label(self, n: bool = True) -> str:  # TEMPORARY shim, removed once callers use labels.case_label
+        from .labels import case_label
 
-    def label(self, n: bool = True) -> str:
-        """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
-        parts = [f"{self.method.upper()} {KERNEL_NAMES[self.kernel]}"]
-        if self.method == "mtpt":
-            parts.append(f"η={self.eta:g}")
-        parts += self.variant_parts()
-        if n and self.n is not None:
-            parts.append(f"N={self.n:,}")
-        return ", ".join(parts)
+        return case_label(self, n)
+
+    def variant_parts(self) -> list[str]:  # TEMPORARY shim
+        from .labels import variant_parts
+
+        return variant_parts(self)
 
     def sort_key(self) -> tuple:
         return (

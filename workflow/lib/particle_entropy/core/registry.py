@@ -6,6 +6,8 @@ enums (a test holds them equal) all come from here; config.yaml holds the same d
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 METHODS = ("pt", "mtpt", "fd")
 KERNELS = {
     "pt": ("bins", "fixed", "adaptive"),  # reconstruction of the density from particles
@@ -14,25 +16,58 @@ KERNELS = {
 }
 ALL_KERNELS = tuple(k for m in METHODS for k in KERNELS[m])
 DEFAULT_KERNEL = {m: KERNELS[m][0] for m in METHODS}  # bins, collision, implicit
-# How the mass transfer is computed (sequential.py states the authors' loop fact by fact). The
-# variants after the first two change one detail each, for the controlled experiments of Fig. 9.
-SCHEME_DOCS = {
-    "symmetric": "the symmetric transfer matrix of Eqs. 16-21",
-    "sequential": "the authors' sequential pairwise loop",
-    "compensated": "Eqs. 16-21 with the truncated kernel widened to keep the whole Gaussian's variance",
-    "sequential_sorted": "the authors' loop visiting particles left to right, partners to the right",
-    "sequential_symnorm": "the authors' loop with the pair weight W_ij (1/r_i + 1/r_j)/2 of Eq. 18",
-    "sequential_noclip": "the authors' loop without clipping negative masses",
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """How MTPT transfers mass: the flags the step reads (models/mtpt.py) and what they mean.
+
+    ``sequential``: the authors' pairwise loop (numerics/sequential.py), else the symmetric
+    transfer matrix of Eqs. 16-21; the loop's details ``by_label`` (visit particles in storage
+    order, else left to right with partners to the right), ``symnorm`` (pair weight
+    (1/r_i + 1/r_j)/2 of Eq. 18, else the authors' 1/r_i) and ``clip`` (set negative masses to 0);
+    ``compensated``: widen a truncated kernel to the whole Gaussian's variance (needs a
+    truncation). Legend text lives in core/labels.py, outside what a simulation hashes.
+    """
+
+    name: str
+    description: str
+    sequential: bool = False
+    by_label: bool = True
+    symnorm: bool = False
+    clip: bool = True
+    compensated: bool = False
+
+
+# The first two are the paper's equations and the authors' code; each later one changes one
+# detail, for the controlled experiments of Fig. 9 (sequential.py states the loop fact by fact).
+SCHEME_RECORDS = {
+    s.name: s
+    for s in (
+        Scheme("symmetric", "the symmetric transfer matrix of Eqs. 16-21"),
+        Scheme("sequential", "the authors' sequential pairwise loop", sequential=True),
+        Scheme(
+            "compensated",
+            "Eqs. 16-21 with the truncated kernel widened to keep the whole Gaussian's variance",
+            compensated=True,
+        ),
+        Scheme(
+            "sequential_sorted",
+            "the authors' loop visiting particles left to right, partners to the right",
+            sequential=True,
+            by_label=False,
+        ),
+        Scheme(
+            "sequential_symnorm",
+            "the authors' loop with the pair weight W_ij (1/r_i + 1/r_j)/2 of Eq. 18",
+            sequential=True,
+            symnorm=True,
+        ),
+        Scheme("sequential_noclip", "the authors' loop without clipping negative masses", sequential=True, clip=False),
+    )
 }
-SCHEMES = tuple(SCHEME_DOCS)
-SCHEME_LABELS = {  # legend text of a non-default scheme
-    "sequential": "sequential loop",
-    "compensated": "compensated width",
-    "sequential_sorted": "sequential loop in position order",
-    "sequential_symnorm": "sequential loop, symmetric weights",
-    "sequential_noclip": "sequential loop, no clipping",
-}
-TRUNCATED_SCHEMES = ("compensated",)  # schemes that need a truncation
+SCHEMES = tuple(SCHEME_RECORDS)
+SCHEME_DOCS = {name: s.description for name, s in SCHEME_RECORDS.items()}
 TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or whole steps while t < t_final
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")

@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from ..core import measures as M
+from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 
@@ -44,7 +45,8 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
     sigma, beta = kernel_for_step(cfg, dt, t_end)  # (0, 0) when eta D = 0
     if sigma == 0.0 or beta == 0.0:
         return x, m, label, sigma, 0.0, 1
-    if cfg.scheme.startswith("sequential"):
+    scheme = SCHEME_RECORDS[cfg.scheme]
+    if scheme.sequential:
         from ..numerics.sequential import sequential_transfer  # a job loads only its scheme's kernels
 
         m = sequential_transfer(
@@ -54,12 +56,12 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
             beta,
             cfg.truncation,
             order_rng if order_rng is not None else rng,
-            label=None if cfg.scheme == "sequential_sorted" else label,
-            symnorm=cfg.scheme == "sequential_symnorm",
-            clip=cfg.scheme != "sequential_noclip",
+            label=label if scheme.by_label else None,
+            symnorm=scheme.symnorm,
+            clip=scheme.clip,
         )
         return x, m, label, sigma, beta, 1
-    if cfg.scheme == "compensated":  # widen the cut kernel so that its variance is the whole one's
+    if scheme.compensated:  # widen the cut kernel so that its variance is the whole one's
         sigma = sigma / math.sqrt(truncated_variance_fraction(cfg.truncation))
     from ..numerics.mass_transfer import mass_transfer
 
@@ -100,7 +102,7 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
 def warm_up(cfg: RunConfig) -> None:
     """Load the compiled kernels this case's transfer calls before the timed steps: the authors'
     loop, or the transforms of Eqs. 16-21 (both methods when ``auto`` may choose either)."""
-    if cfg.scheme.startswith("sequential"):
+    if SCHEME_RECORDS[cfg.scheme].sequential:
         from ..numerics import sequential
 
         sequential.warm_up()

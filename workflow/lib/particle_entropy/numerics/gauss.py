@@ -35,7 +35,14 @@ from numba.extending import intrinsic
 
 from ..core.registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
 
-CUTOFF_SIGMAS = 9.0
+CUTOFF_SIGMAS = 9.0  # kernel widths searched when the kernel is not truncated
+
+
+def cutoff_radius(sigma: float, truncation: float | None) -> float:
+    """Distance beyond which a kernel of width ``sigma`` is dropped: ``truncation`` widths (the
+    authors' cut), or CUTOFF_SIGMAS for the whole Gaussian (below round-off of the self term)."""
+    return (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
+
 P_TERMS = 24
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
 # mean fewer translations (each p^2) but more terms p. A translation's term pair costs about
@@ -558,7 +565,7 @@ def choose_method(y, x, sigma, truncation) -> str:
     """Pick ``direct`` or ``fgt`` for this transform (see module docstring)."""
     if truncation is not None:
         return "direct"
-    if neighbour_count(y, x, CUTOFF_SIGMAS * sigma, samples=512) <= DIRECT_MAX_NEIGHBOURS:
+    if neighbour_count(y, x, cutoff_radius(sigma, None), samples=512) <= DIRECT_MAX_NEIGHBOURS:
         return "direct"
     return "fgt"
 
@@ -596,7 +603,7 @@ def gauss_transform(
         )
     if method == "auto":
         method = choose_method(y, x, sigma, truncation)
-    radius = (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
+    radius = cutoff_radius(sigma, truncation)
     if method == "direct" and same and not skip_self:
         out = _direct_symmetric(x, q2, float(sigma), float(radius))
     elif method == "direct":

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .gauss import CUTOFF_SIGMAS, FGT_TOLERANCE, choose_method, gauss_transform
+from .gauss import FGT_TOLERANCE, choose_method, cutoff_radius, gauss_transform
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ def mass_transfer(
         return TransferResult(m.copy(), 1, 0.0)
     if method == "auto":  # one choice for all transforms of this step
         method = choose_method(x, x, sigma, truncation)
-    reach = (CUTOFF_SIGMAS if truncation is None else truncation) * sigma
+    reach = cutoff_radius(sigma, truncation)
     active = _reach_of_mass(x, m, reach)
     if active is not None:
         res = _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance)

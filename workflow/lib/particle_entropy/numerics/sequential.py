@@ -55,9 +55,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .gauss import EXP_NEAR_MAX, exp_neg, exp_neg_near
+from .gauss import EXP_NEAR_MAX, cutoff_radius, exp_neg, exp_neg_near
 
-DEFAULT_CUTOFF = 9.0  # kernel widths searched when the kernel is not truncated (exp(-40.5) ~ 2.6e-18)
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)  # SplitMix64's increment: its state after k outputs is s + k G
 
 
@@ -342,7 +341,7 @@ def sequential_transfer(
     """One step of the authors' loop on sorted positions ``x``; ``label`` is the storage index of
     each particle (None: storage order = position order, the ``sorted`` variant). ``rng`` seeds
     the partner permutations of this step. The input masses are not changed."""
-    radius = (DEFAULT_CUTOFF if truncation is None else float(truncation)) * sigma
+    radius = cutoff_radius(sigma, truncation)
     if label is None:
         label = np.arange(x.size, dtype=np.int64)
     seed = int(rng.integers(0, 2**63))

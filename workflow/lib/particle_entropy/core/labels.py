@@ -1,0 +1,51 @@
+"""Legend text of cases, kernels and schemes: presentation only, so no simulation hashes it.
+
+Tables that carry a ``label`` column (summaries, COMIC tables, minima) and the figures import
+this module; a simulation job does not (tests/test_labels.py holds that), so editing a label
+redraws figures and rebuilds those tables but reruns no simulation.
+"""
+
+from __future__ import annotations
+
+from .case import Case
+
+KERNEL_NAMES = {
+    "bins": "binned",
+    "fixed": "fixed kernel",
+    "adaptive": "adaptive kernel",
+    "collision": "collision",
+    "sph": "SPH",
+    "implicit": "implicit",
+    "explicit": "explicit",
+}
+SCHEME_LABELS = {  # legend text of a non-default scheme (registry.SCHEME_RECORDS)
+    "sequential": "sequential loop",
+    "compensated": "compensated width",
+    "sequential_sorted": "sequential loop in position order",
+    "sequential_symnorm": "sequential loop, symmetric weights",
+    "sequential_noclip": "sequential loop, no clipping",
+}
+
+
+def variant_parts(case: Case) -> list[str]:
+    """Legend words for the dimensions that differ from the paper's defaults, e.g.
+    ['truncation 3', 'sequential loop']."""
+    v, parts = case.variant(), []
+    if "truncation" in v:
+        parts.append(f"truncation {v['truncation']:g}")
+    if "dt_growth" in v:
+        parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
+    if "scheme" in v:
+        parts.append(SCHEME_LABELS[v["scheme"]])
+    return parts
+
+
+def case_label(case: Case, n: bool = True) -> str:
+    """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
+    parts = [f"{case.method.upper()} {KERNEL_NAMES[case.kernel]}"]
+    if case.method == "mtpt":
+        parts.append(f"η={case.eta:g}")
+    parts += variant_parts(case)
+    if n and case.n is not None:
+        parts.append(f"N={case.n:,}")
+    return ", ".join(parts)
