@@ -39,7 +39,7 @@ m0 = np.exp(-x * x / (4 * D * t)); m0 /= m0.sum()
 label = rng.permutation(n)
 for name, kw in {"mtpt equations": dict(scheme="symmetric"),
                  "authors' loop": dict(scheme="sequential", truncation=3.0)}.items():
-    cfg = RunConfig(method="mtpt", kernel="collision", n=n, **kw).resolved()
+    cfg = RunConfig.of(method="mtpt", kernel="collision", n=n, **kw).resolved()
     mtpt.warm_up(cfg)
     times = []
     for k in range(repeats + 2):
@@ -48,7 +48,7 @@ for name, kw in {"mtpt equations": dict(scheme="symmetric"),
         mtpt.step(cfg, x, m, label, dt, t, np.random.default_rng(k))
         times.append(time.perf_counter() - t0)
     out[name] = statistics.median(times[2:])
-cfg = RunConfig(method="fd", kernel="implicit", n=n).resolved()
+cfg = RunConfig.of(method="fd", kernel="implicit", n=n).resolved()
 xg, dx = fd.grid(cfg)
 c = np.exp(-xg * xg / (4 * D * t)) / math.sqrt(4 * math.pi * D * t)
 solver = fd.ImplicitSolver(n - 1, D * 0.05 / dx**2)

@@ -41,7 +41,7 @@ def main() -> None:
     print(f"{'method':6} {'kernel':9} {'N':>9} {'steps':>8} {'peak MB':>8} {'estimate MB':>11}")
     with tempfile.TemporaryDirectory() as tmp:
         for method, kernel, n, t_final, dt0, growth in RUNS:
-            cfg = RunConfig(method=method, kernel=kernel, n=n, t_final=t_final, dt0=dt0, dt_growth=growth).resolved()
+            cfg = RunConfig.of(method=method, kernel=kernel, n=n, t_final=t_final, dt0=dt0, dt_growth=growth).resolved()
             args = ["--method", method, "--kernel", kernel, "--n", str(n), "--t-final", str(t_final)]
             args += ["--dt0", str(cfg.dt0), "--dt-growth", str(cfg.dt_growth), "--out", f"{tmp}/x.parquet"]
             steps = step_count(t_final, cfg.dt0, cfg.dt_growth)

@@ -22,7 +22,7 @@ from particle_entropy.numerics.gauss import gauss_transform
 import numpy as np
 gauss_transform(np.zeros(2), np.zeros(2), np.ones(2), 1.0, method='direct')  # JIT/cache load
 gauss_transform(np.zeros(2), np.zeros(2), np.ones(2), 1.0, method='taylor')
-cfg = RunConfig(**json.loads(sys.argv[1]))
+cfg = RunConfig.of(**json.loads(sys.argv[1]))
 t0 = time.perf_counter()
 table, _ = run(cfg)
 wall = time.perf_counter() - t0

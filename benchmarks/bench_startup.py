@@ -38,7 +38,7 @@ try:
     from particle_entropy.models.simulate import run_seeds_arrow as run_seeds
 except ImportError:  # an earlier checkout
     from particle_entropy.models.simulate import run_seeds
-cfg = RunConfig({case}, n=30, t_final=0.0551, dt0=0.01, seed=0).resolved()
+cfg = getattr(RunConfig, "of", RunConfig)({case}, n=30, t_final=0.0551, dt0=0.01, seed=0).resolved()
 write_parquet(run_seeds(cfg, range(1)), sys.argv[1])
 """
 

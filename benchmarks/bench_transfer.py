@@ -50,7 +50,7 @@ def particles(n: int, seed: int = 0):
 
 def run_states(n: int, seed: int = 0):
     """`run` states: (x, m) of an MTPT run before its first and before its last step."""
-    cfg = RunConfig(method="mtpt", kernel="collision", n=n, seed=seed).resolved()
+    cfg = RunConfig.of(method="mtpt", kernel="collision", n=n, seed=seed).resolved()
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth)
     ts = step_times(dts, cfg.t_final)
     rng = cfg.rng()

@@ -43,7 +43,7 @@ SEEDS = (3, 4, 5)
 @pytest.fixture(scope="module")
 def runs() -> list[pd.DataFrame]:
     """Three realisations of MTPT collision, N = 50, t = 0 ... 2."""
-    return [run(RunConfig(method="mtpt", kernel="collision", n=50, t_final=2.0, seed=s))[0] for s in SEEDS]
+    return [run(RunConfig.of(method="mtpt", kernel="collision", n=50, t_final=2.0, seed=s))[0] for s in SEEDS]
 
 
 # --------------------------------------------------------------------------- summarise_runs

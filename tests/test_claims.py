@@ -287,7 +287,7 @@ def test_single_run_claims_without_the_mtpt_case_skip_it():
     from particle_entropy.core.runconfig import RunConfig
     from particle_entropy.models.simulate import run
 
-    runs = [run(RunConfig(method="pt", kernel=k, n=n, t_final=2.0))[0] for n in (30, 60) for k in ("bins", "fixed")]
+    runs = [run(RunConfig.of(method="pt", kernel=k, n=n, t_final=2.0))[0] for n in (30, 60) for k in ("bins", "fixed")]
     claims = single_run_claims(runs, {})
     assert claims == []  # each N lacks the MTPT collision run its claims compare with: nothing judged, no crash
 

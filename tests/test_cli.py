@@ -215,6 +215,6 @@ def test_memory_estimate_is_above_a_measured_peak(tmp_path):
     _, status, usage = os.wait4(proc.pid, 0)
     assert status == 0
     peak = usage.ru_maxrss * 1024  # Linux reports kB
-    estimate = estimate_bytes(RunConfig(method="fd", n=100, t_final=1000.0, dt0=0.005).resolved())
+    estimate = estimate_bytes(RunConfig.of(method="fd", n=100, t_final=1000.0, dt0=0.005).resolved())
     assert peak > 400e6  # the steps do cost memory (~1.9 kB each): the check is not vacuous
     assert peak < estimate < 2 * peak

@@ -40,7 +40,7 @@ def finite_after_start(table):
 def test_tiny_particle_numbers(n, method, kernel):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        tab, state = run(RunConfig(method=method, kernel=kernel, n=n, t_final=50.0, seed=3), want_state=True)
+        tab, state = run(RunConfig.of(method=method, kernel=kernel, n=n, t_final=50.0, seed=3), want_state=True)
     finite_after_start(tab)
     assert np.allclose(tab["mass_total"], 1.0, rtol=0, atol=1e-14)
     assert (tab["mass_min"] >= 0).all()
@@ -77,19 +77,24 @@ def test_all_particles_at_one_point_mix_to_the_mean():
 
 
 @pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("mtpt", "collision"), ("mtpt", "sph"), ("fd", "implicit")])
-def test_zero_diffusion_changes_nothing(method, kernel):
-    tab, state = run(RunConfig(method=method, kernel=kernel, n=200, D=0.0, t_final=10.0), want_state=True)
-    finite_after_start(tab.drop(columns=["H_C_analytic", "H_I", "E_analytic"]))
-    first, last = tab.iloc[1], tab.iloc[-1]
-    assert last["H_D"] == first["H_D"] == tab["H_D"].iloc[0]  # a delta stays a delta
-    assert last["mass_total"] == pytest.approx(1.0, abs=1e-14)
+def test_zero_diffusion_is_refused_as_the_config_refuses_it(method, kernel):
+    """D = 0 leaves a delta whose analytic reference is a delta too: SSE 0 and COMIC -inf would
+    score as perfect. The run refuses it as the config's schema does (settings.SETTINGS)."""
+    with pytest.raises(SettingError, match=r"D=0.0 is not allowed: a number > 0"):
+        run(RunConfig.of(method=method, kernel=kernel, n=200, D=0.0, t_final=10.0))
+
+
+@pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("mtpt", "collision"), ("fd", "implicit")])
+def test_tiny_diffusion_keeps_the_mass(method, kernel):
+    tab, _ = run(RunConfig.of(method=method, kernel=kernel, n=200, D=1e-12, t_final=10.0))
+    assert tab["mass_total"].iloc[-1] == pytest.approx(1.0, abs=1e-13)
 
 
 def test_eta_zero_is_a_pure_random_walk_and_eta_one_never_moves():
-    walk, s0 = run(RunConfig(method="mtpt", n=300, eta=0.0, t_final=100.0, seed=4), want_state=True)
+    walk, s0 = run(RunConfig.of(method="mtpt", n=300, eta=0.0, t_final=100.0, seed=4), want_state=True)
     assert (walk["H_D"] == 0.0).all() and (walk["beta"] == 0.0).all()
-    still, s1 = run(RunConfig(method="mtpt", n=300, eta=1.0, t_final=100.0, seed=4), want_state=True)
-    init = run(RunConfig(method="mtpt", n=300, eta=1.0, t_final=1e-9, seed=4), want_state=True)[1]
+    still, s1 = run(RunConfig.of(method="mtpt", n=300, eta=1.0, t_final=100.0, seed=4), want_state=True)
+    init = run(RunConfig.of(method="mtpt", n=300, eta=1.0, t_final=1e-9, seed=4), want_state=True)[1]
     np.testing.assert_array_equal(s1["x"].to_numpy(), init["x"].to_numpy())
     assert not np.array_equal(s0["x"].to_numpy(), init["x"].to_numpy())
 
@@ -98,7 +103,7 @@ def test_eta_zero_is_a_pure_random_walk_and_eta_one_never_moves():
     "dt0,growth,t_final", [(1e-6, 1.5, 1.0), (1e3, 1.05, 10.0), (1e3, 1.0, 3000.0), (0.5, 1.0, 0.2)]
 )
 def test_time_steps_from_tiny_to_huge(dt0, growth, t_final):
-    tab = run(RunConfig(method="mtpt", kernel="collision", n=500, dt0=dt0, dt_growth=growth, t_final=t_final))[0]
+    tab = run(RunConfig.of(method="mtpt", kernel="collision", n=500, dt0=dt0, dt_growth=growth, t_final=t_final))[0]
     assert tab["time"].iloc[-1] == t_final
     assert abs(tab["mass_total"].iloc[-1] - 1.0) < 1e-12 and (tab["mass_min"] >= 0).all()
     finite_after_start(tab)
@@ -108,7 +113,7 @@ def test_time_steps_from_tiny_to_huge(dt0, growth, t_final):
 
 def test_forced_huge_sph_beta_stays_positive_and_conservative():
     """Omega = 0.005 packs N = 2000 particles so densely that beta = 2 D dt / h^2 >> 1."""
-    tab = run(RunConfig(method="mtpt", kernel="sph", n=2000, omega=0.005, t_final=100.0, seed=1))[0]
+    tab = run(RunConfig.of(method="mtpt", kernel="sph", n=2000, omega=0.005, t_final=100.0, seed=1))[0]
     assert tab["beta"].max() > 20
     assert tab["substeps"].max() > 10
     assert (tab["mass_min"] >= 0).all()
@@ -116,7 +121,7 @@ def test_forced_huge_sph_beta_stays_positive_and_conservative():
 
 
 def test_explicit_fd_past_its_limit_is_refused_with_the_safe_range():
-    cfg = RunConfig(method="fd", kernel="explicit", n=3000, dt0=0.05)  # r = 1e-3 * 0.05 / 0.004^2 = 3.1
+    cfg = RunConfig.of(method="fd", kernel="explicit", n=3000, dt0=0.05)  # r = 1e-3 * 0.05 / 0.004^2 = 3.1
     with pytest.raises(SettingError) as err:
         cfg.resolved()
     msg = str(err.value)
@@ -125,8 +130,8 @@ def test_explicit_fd_past_its_limit_is_refused_with_the_safe_range():
 
 def test_explicit_fd_within_its_limit_matches_implicit():
     kw = dict(method="fd", n=300, dt0=0.05, t_final=200.0)  # r = 0.03
-    ex = run(RunConfig(kernel="explicit", **kw))[0].iloc[-1]
-    im = run(RunConfig(kernel="implicit", **kw))[0].iloc[-1]
+    ex = run(RunConfig.of(kernel="explicit", **kw))[0].iloc[-1]
+    im = run(RunConfig.of(kernel="implicit", **kw))[0].iloc[-1]
     assert ex["H_C"] == pytest.approx(im["H_C"], abs=1e-3)
     assert ex["H_C"] == pytest.approx(ex["H_C_analytic"], abs=2e-3)
 
@@ -159,7 +164,7 @@ def test_implicit_fd_with_a_million_nodes_in_bounded_memory():
         "import resource\n"
         "from particle_entropy.models.simulate import run\n"
         "from particle_entropy.core.runconfig import RunConfig\n"
-        "t = run(RunConfig(method='fd', n=1_200_000, t_final=0.15))[0]\n"  # dx = 1e-5
+        "t = run(RunConfig.of(method='fd', n=1_200_000, t_final=0.15))[0]\n"  # dx = 1e-5
         "print(t['mass_total'].iloc[-1], t['mass_min'].min(), t['H_C'].iloc[-1], t['H_C_analytic'].iloc[-1],"
         " resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)\n"
     )
@@ -172,7 +177,7 @@ def test_implicit_fd_with_a_million_nodes_in_bounded_memory():
 
 
 def test_entropy_before_the_settling_time_is_flagged_not_nan():
-    tab = run(RunConfig(method="mtpt", n=30, t_final=1.0))[0]
+    tab = run(RunConfig.of(method="mtpt", n=30, t_final=1.0))[0]
     t_settle = M.settling_time(10.0 / 30, 1e-3)
     early = tab[(tab["time"] > 0) & (tab["time"] <= t_settle)]
     assert len(early) > 0 and not early["settled"].any()

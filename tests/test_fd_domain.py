@@ -42,7 +42,7 @@ def paper_dt():
 # --------------------------------------------------------------------------- the module itself
 def test_run_case_is_the_workflow_fd_run():
     """Same solver, grid, initial delta and measures as simulate.run (Fig. 8's runs)."""
-    tab, _ = run(RunConfig(method="fd", kernel="implicit", n=100, t_final=20.0))
+    tab, _ = run(RunConfig.of(method="fd", kernel="implicit", n=100, t_final=20.0))
     rows = F.run_case(100, times=(5.0, 20.0))
     for r in rows:
         s = tab.loc[np.isclose(tab.time, r["time"])].iloc[0]

@@ -11,22 +11,22 @@ from particle_entropy.experiments.lattice import lattice_run, lattice_state
 
 
 def floor(n=1001, **kw) -> float:
-    return lattice_run(RunConfig(method="mtpt", kernel="collision", n=n, **kw), [1000.0])[-1]["SSE_over_N"]
+    return lattice_run(RunConfig.of(method="mtpt", kernel="collision", n=n, **kw), [1000.0])[-1]["SSE_over_N"]
 
 
 def test_lattice_is_even_with_the_unit_mass_stored_first_at_zero():
-    cfg = RunConfig(method="mtpt", n=11).resolved()
+    cfg = RunConfig.of(method="mtpt", n=11).resolved()
     x, m, label = lattice_state(cfg, np.random.default_rng(0))
     np.testing.assert_allclose(np.diff(x), 1.0)  # Omega = 10 over 10 gaps
     assert x[5] == 0.0 and m[5] == 1.0 and m.sum() == 1.0 and label[5] == 0
     assert sorted(label) == list(range(11))
     with pytest.raises(ValueError, match="odd"):
-        lattice_state(RunConfig(method="mtpt", n=10).resolved(), np.random.default_rng(0))
+        lattice_state(RunConfig.of(method="mtpt", n=10).resolved(), np.random.default_rng(0))
 
 
 def test_lattice_run_refuses_random_walks():
     with pytest.raises(ValueError, match="eta = 1"):
-        lattice_run(RunConfig(method="mtpt", n=11, eta=0.5), [1.0])
+        lattice_run(RunConfig.of(method="mtpt", n=11, eta=0.5), [1.0])
 
 
 def test_the_equations_floor_does_not_depend_on_n_and_falls_with_the_time_step():

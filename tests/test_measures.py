@@ -157,7 +157,8 @@ def test_analytic_sampled_is_the_normalised_gaussian():
 def test_measurement_points_are_fixed_sorted_and_in_the_fd_domain():
     """Section 6, point 1: 15 points common to all simulations, uniform on [-6, 6] (the paper's FD
     domain), drawn once from the registry's seed."""
-    from particle_entropy.core.registry import MEASUREMENT_POINTS, MEASUREMENT_SEED, PAPER
+    from particle_entropy.core.registry import MEASUREMENT_POINTS, MEASUREMENT_SEED
+    from particle_entropy.core.settings import PAPER
 
     p = M.measurement_points()
     assert p.shape == (MEASUREMENT_POINTS,) == (15,)

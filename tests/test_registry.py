@@ -9,7 +9,8 @@ import pytest
 import yaml
 
 from particle_entropy.cli import build_parser
-from particle_entropy.core.registry import ALL_KERNELS, KERNELS, METHODS, PAPER, SCHEMES, SHEAR_CASES, TRANSFER_METHODS
+from particle_entropy.core.registry import ALL_KERNELS, KERNELS, METHODS, SCHEMES, SHEAR_CASES, TRANSFER_METHODS
+from particle_entropy.core.settings import PAPER
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())

@@ -54,7 +54,7 @@ def _calls(monkeypatch):
 @pytest.mark.parametrize("name", [s for s in SCHEMES if EXPECTED[s]["sequential"]])
 def test_sequential_step_passes_the_records_flags(monkeypatch, name):
     seen = _calls(monkeypatch)
-    cfg = RunConfig(method="mtpt", n=40, truncation=3.0, scheme=name).resolved()
+    cfg = RunConfig.of(method="mtpt", n=40, truncation=3.0, scheme=name).resolved()
     x, m, label = _state()
     mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))
     (call,) = seen
@@ -70,7 +70,7 @@ def test_a_new_record_needs_no_string_test(monkeypatch):
         "my_loop", "the authors' loop, symmetric weights, no clipping", sequential=True, symnorm=True, clip=False
     )
     monkeypatch.setitem(registry.SCHEME_RECORDS, "my_loop", new)
-    cfg = dataclasses.replace(RunConfig(method="mtpt", n=40).resolved(), scheme="my_loop")
+    cfg = dataclasses.replace(RunConfig.of(method="mtpt", n=40).resolved(), scheme="my_loop")
     x, m, label = _state()
     mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))
     assert seen == [{"label": label, "symnorm": True, "clip": False}]
@@ -80,7 +80,7 @@ def test_compensated_widens_the_cut_kernel_and_symmetric_does_not():
     x, m, label = _state(200)
     widths = {}
     for name in ("symmetric", "compensated"):
-        cfg = RunConfig(method="mtpt", n=200, truncation=2.0, scheme=name).resolved()
+        cfg = RunConfig.of(method="mtpt", n=200, truncation=2.0, scheme=name).resolved()
         widths[name] = mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))[3]
     # the variance of a Gaussian cut at 2 widths is 0.7737 of the whole one's (tables of the
     # truncated normal), so the compensated width is 1 / sqrt(0.7737) = 1.1369 times wider

@@ -85,7 +85,9 @@ def test_bit_identical_when_every_mass_is_clipped_or_none_is():
     ],
 )
 def test_whole_runs_bit_identical(monkeypatch, scheme, kernel, eta):
-    cfg = RunConfig(method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3)
+    cfg = RunConfig.of(
+        method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3
+    )
     _, new = simulate.run(cfg, want_state=True)
     monkeypatch.setattr(sequential, "_sweep", ref._sweep)
     _, old = simulate.run(cfg, want_state=True)

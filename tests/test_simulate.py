@@ -26,7 +26,7 @@ T = 1000.0
 @pytest.mark.parametrize("kernel", ["collision", "sph"])
 def test_mtpt_conserves_mass_at_every_step(kernel, eta, truncation):
     tab, state = run(
-        RunConfig(method="mtpt", kernel=kernel, n=300, eta=eta, truncation=truncation, seed=11), want_state=True
+        RunConfig.of(method="mtpt", kernel=kernel, n=300, eta=eta, truncation=truncation, seed=11), want_state=True
     )
     assert len(tab) == 176 and tab["time"].iloc[-1] == T
     assert np.max(np.abs(tab["mass_total"].to_numpy() - 1.0)) <= 1e-12
@@ -46,7 +46,7 @@ def test_mtpt_conserves_mass_at_every_step(kernel, eta, truncation):
 def test_mtpt_sph_substepping_run_conserves_mass(truncation):
     """Dense particles (N / Omega = 3000, as N = 30000 on Omega = 10) make the SPH beta exceed
     the explicit limit, so steps are split; masses must stay non-negative and conserved."""
-    tab, _ = run(RunConfig(method="mtpt", kernel="sph", n=300, omega=0.1, truncation=truncation, seed=2))
+    tab, _ = run(RunConfig.of(method="mtpt", kernel="sph", n=300, omega=0.1, truncation=truncation, seed=2))
     assert tab["substeps"].max() > 1
     assert np.max(np.abs(tab["mass_total"].to_numpy() - 1.0)) <= 1e-12
     assert np.all(tab["mass_min"].to_numpy() >= 0.0)
@@ -56,7 +56,7 @@ def test_mtpt_sph_substepping_run_conserves_mass(truncation):
 @pytest.mark.parametrize("eta", [1.0, 0.1])
 def test_mtpt_initial_entropy_is_zero(kernel, eta):
     """MTPT represents the delta exactly: one particle with all the mass, H_D(0) = 0."""
-    tab, _ = run(RunConfig(method="mtpt", kernel=kernel, n=200, eta=eta, t_final=1.0, seed=4))
+    tab, _ = run(RunConfig.of(method="mtpt", kernel=kernel, n=200, eta=eta, t_final=1.0, seed=4))
     assert tab["step"].iloc[0] == 0 and tab["time"].iloc[0] == 0.0
     assert tab["H_D"].iloc[0] == 0.0
     assert tab["H_C"].iloc[0] == 0.0
@@ -66,7 +66,7 @@ def test_mtpt_initial_entropy_is_zero(kernel, eta):
 @pytest.mark.parametrize("kernel", ["bins", "fixed", "adaptive"])
 def test_classical_pt_discrete_entropy_is_ln_n(kernel):
     n = 250
-    tab, _ = run(RunConfig(method="pt", kernel=kernel, n=n, seed=5))
+    tab, _ = run(RunConfig.of(method="pt", kernel=kernel, n=n, seed=5))
     assert np.all(tab["H_D"].to_numpy() == pytest.approx(math.log(n), rel=1e-15))
     assert tab["mass_total"].eq(1.0).all()
 
@@ -93,7 +93,7 @@ N_SEEDS_MTPT = 6
 def _final_errors(cfg_kwargs, seeds):
     errs, E, E_an = [], [], []
     for s in seeds:
-        tab, _ = run(RunConfig(seed=s, **cfg_kwargs))
+        tab, _ = run(RunConfig.of(seed=s, **cfg_kwargs))
         last = tab.iloc[-1]
         assert last["time"] == T
         errs.append(last["H_C"] - last["H_C_analytic"])
@@ -134,7 +134,7 @@ def test_mtpt_collision_small_n_under_mixes():
 def _fd_error(n, dt, t_final, length):
     """Max-norm error of the final FD profile against N(0, 2Dt), relative to the peak."""
     tab, state = run(
-        RunConfig(method="fd", n=n, dt0=dt, dt_growth=1.0, t_final=t_final, fd_length=length), want_state=True
+        RunConfig.of(method="fd", n=n, dt0=dt, dt_growth=1.0, t_final=t_final, fd_length=length), want_state=True
     )
     t = tab["time"].iloc[-1]
     assert t == pytest.approx(t_final, rel=1e-12)
@@ -169,7 +169,7 @@ def test_fd_second_order_in_space():
 
 
 def test_fd_conserves_mass_and_starts_from_discrete_delta():
-    tab, state = run(RunConfig(method="fd", n=120, dt0=0.05, t_final=5.0, fd_length=2.0), want_state=True)
+    tab, state = run(RunConfig.of(method="fd", n=120, dt0=0.05, t_final=5.0, fd_length=2.0), want_state=True)
     assert tab["H_C"].iloc[0] == 0.0  # all mass on the centre node
     assert tab["mass_total"].iloc[0] == pytest.approx(1.0, rel=1e-15)
     # the plume (sd 0.1) never reaches the zero end nodes at +-1: no mass lost
@@ -193,9 +193,9 @@ def _bytes(tab, path):
     ],
 )
 def test_same_seed_same_bytes_different_seed_different_results(tmp_path, kwargs):
-    a, sa = run(RunConfig(seed=7, **kwargs), want_state=True)
-    b, sb = run(RunConfig(seed=7, **kwargs), want_state=True)
-    c, _ = run(RunConfig(seed=8, **kwargs))
+    a, sa = run(RunConfig.of(seed=7, **kwargs), want_state=True)
+    b, sb = run(RunConfig.of(seed=7, **kwargs), want_state=True)
+    c, _ = run(RunConfig.of(seed=8, **kwargs))
     assert _bytes(a, tmp_path / "a.parquet") == _bytes(b, tmp_path / "b.parquet")
     assert sa.equals(sb)
     assert not np.array_equal(a["H_C"].to_numpy()[1:], c["H_C"].to_numpy()[1:])
@@ -208,8 +208,8 @@ def test_same_seed_same_bytes_different_seed_different_results(tmp_path, kwargs)
 
 def test_fd_is_deterministic(tmp_path):
     kw = dict(method="fd", n=200, dt0=0.05, t_final=20.0)
-    a, _ = run(RunConfig(**kw))
-    b, _ = run(RunConfig(**kw))
+    a, _ = run(RunConfig.of(**kw))
+    b, _ = run(RunConfig.of(**kw))
     assert _bytes(a, tmp_path / "a.parquet") == _bytes(b, tmp_path / "b.parquet")
 
 
@@ -232,7 +232,7 @@ def test_tables_have_no_nan_and_runs_emit_no_runtime_warning(kwargs):
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         with no_runtime_warnings():
-            tab, state = run(RunConfig(seed=3, **kwargs), want_state=True)
+            tab, state = run(RunConfig.of(seed=3, **kwargs), want_state=True)
     # 'truncation' is a case column, +inf by design for the whole Gaussian (truncation=None)
     assert np.all(tab["truncation"] == math.inf)
     num = tab.select_dtypes(include=[np.number]).drop(columns=["truncation"])
@@ -256,7 +256,7 @@ def test_tables_have_no_nan_and_runs_emit_no_runtime_warning(kwargs):
 def test_pt_bins_final_entropy_is_histogram_entropy():
     """Binned PT: H_C = -sum p ln p of the histogram on bins of width dV = Omega / N (Eq. 11)."""
     n = 300
-    tab, st = run(RunConfig(method="pt", kernel="bins", n=n, seed=9), want_state=True)
+    tab, st = run(RunConfig.of(method="pt", kernel="bins", n=n, seed=9), want_state=True)
     x = st["x"].to_numpy()
     dV = 10.0 / n
     counts = np.unique(np.floor((x + 5.0) / dV).astype(int), return_counts=True)[1]
@@ -269,7 +269,7 @@ def test_pt_bins_final_entropy_is_histogram_entropy():
 def test_pt_adaptive_final_entropy_is_kde_entropy():
     """Adaptive PT: H_C = -ln dV - integral f ln f of the Gaussian KDE with h_DE (Eqs. 10, 23)."""
     n = 300
-    tab, st = run(RunConfig(method="pt", kernel="adaptive", n=n, seed=9), want_state=True)
+    tab, st = run(RunConfig.of(method="pt", kernel="adaptive", n=n, seed=9), want_state=True)
     x = st["x"].to_numpy()
     h = 1.06 * n**-0.2 * math.sqrt(2 * D * T)
     grid = np.arange(x.min() - 9 * h, x.max() + 9 * h, h / 40)
@@ -288,7 +288,7 @@ def test_pt_adaptive_final_entropy_is_kde_entropy():
 def test_mtpt_final_row_recomputed_from_state(kernel, eta):
     """H_D of the masses, SSE against the normalised Gaussian at the particles, COMIC (Eq. 43)."""
     n = 400
-    tab, st = run(RunConfig(method="mtpt", kernel=kernel, eta=eta, n=n, seed=13), want_state=True)
+    tab, st = run(RunConfig.of(method="mtpt", kernel=kernel, eta=eta, n=n, seed=13), want_state=True)
     x, m = st["x"].to_numpy(), st["mass"].to_numpy()
     dV = 10.0 / n
     p = m[m > 0] / m.sum()
@@ -307,7 +307,7 @@ def test_mtpt_final_row_recomputed_from_state(kernel, eta):
 
 def test_fd_final_row_recomputed_from_state():
     n = 300
-    tab, st = run(RunConfig(method="fd", n=n, dt0=0.05, t_final=100.0), want_state=True)
+    tab, st = run(RunConfig.of(method="fd", n=n, dt0=0.05, t_final=100.0), want_state=True)
     x, c = st["x"].to_numpy(), st["c"].to_numpy()
     dx = 12.0 / n
     assert np.allclose(np.diff(x), dx, rtol=1e-12) and x[0] == -6.0 and x[-1] == pytest.approx(6.0, rel=1e-14)
@@ -335,7 +335,7 @@ def test_fd_final_row_recomputed_from_state():
 def test_h_pmf_is_h_d_plus_ln_sampling_volume(kwargs):
     """Section 5.4: H_PMF = H_D + ln(Omega / N), with Omega / N = dV (the paper sets
     dV = dx = Omega / N for particles and for FD nodes alike, Section 6.1)."""
-    tab, _ = run(RunConfig(seed=1, **kwargs))
+    tab, _ = run(RunConfig.of(seed=1, **kwargs))
     np.testing.assert_allclose(tab["H_PMF"], tab["H_D"] + np.log(tab["dV"]), rtol=0, atol=1e-12)
     ts = tab["dV"] ** 2 / (4 * math.pi * math.e * D)
     assert (tab["settled"] == (tab["time"] > ts)).all()
@@ -346,7 +346,7 @@ def test_pt_random_walk_spreads_as_2dt():
     3000 walkers; the standard error of one run's sample variance is 2 sqrt(2 / N) = 0.05)."""
     v = []
     for s in range(6):
-        _, st = run(RunConfig(method="pt", kernel="bins", n=3000, seed=s), want_state=True)
+        _, st = run(RunConfig.of(method="pt", kernel="bins", n=3000, seed=s), want_state=True)
         x = st["x"].to_numpy()
         v.append(np.mean(x * x))
     mean, se = ensemble_stats(v)
@@ -357,15 +357,15 @@ def test_kernels_and_eta_share_the_random_stream():
     """Documented (RunConfig.rng): the stream is keyed by (seed, method, N), so the two MTPT
     kernels start from the same particles, and the PT reconstructions see the same walkers."""
     kw = dict(method="mtpt", n=120, eta=1.0, t_final=5.0, seed=21)
-    _, a = run(RunConfig(kernel="collision", **kw), want_state=True)
-    _, b = run(RunConfig(kernel="sph", **kw), want_state=True)
+    _, a = run(RunConfig.of(kernel="collision", **kw), want_state=True)
+    _, b = run(RunConfig.of(kernel="sph", **kw), want_state=True)
     np.testing.assert_array_equal(a["x"].to_numpy(), b["x"].to_numpy())
     assert not np.array_equal(a["mass"].to_numpy(), b["mass"].to_numpy())
-    _, c = run(RunConfig(kernel="collision", **{**kw, "seed": 22}), want_state=True)
+    _, c = run(RunConfig.of(kernel="collision", **{**kw, "seed": 22}), want_state=True)
     assert not np.array_equal(a["x"].to_numpy(), c["x"].to_numpy())
     kw = dict(method="pt", n=120, t_final=5.0, seed=21)
-    _, p = run(RunConfig(kernel="bins", **kw), want_state=True)
-    _, q = run(RunConfig(kernel="adaptive", **kw), want_state=True)
+    _, p = run(RunConfig.of(kernel="bins", **kw), want_state=True)
+    _, q = run(RunConfig.of(kernel="adaptive", **kw), want_state=True)
     np.testing.assert_array_equal(p["x"].to_numpy(), q["x"].to_numpy())
 
 
@@ -374,7 +374,7 @@ def test_seed_blocks_do_not_change_results():
     from particle_entropy.core.records import TIMING_COLUMNS
     from particle_entropy.models.simulate import run_seeds
 
-    cfg = RunConfig(method="mtpt", kernel="collision", n=200, eta=0.5, t_final=50.0)
+    cfg = RunConfig.of(method="mtpt", kernel="collision", n=200, eta=0.5, t_final=50.0)
     block = run_seeds(cfg, [3, 4, 5]).drop(columns=TIMING_COLUMNS)
     alone = pd.concat([run_seeds(cfg, [s]) for s in (5, 3, 4)]).drop(columns=TIMING_COLUMNS)
     alone = alone.sort_values(["seed", "step"], kind="stable").reset_index(drop=True)
@@ -386,8 +386,8 @@ def test_schemes_share_positions_and_walks_for_a_seed():
     # the sequential loop draws its partner orders from a stream of its own: with eta < 1 the
     # particles of both schemes walk identically, so the schemes differ only in the transfer
     base = dict(method="mtpt", kernel="collision", n=200, eta=0.5, t_final=20.0, seed=3, truncation=3.0)
-    _, sym = run(RunConfig(**base), want_state=True)
-    _, seq = run(RunConfig(**base, scheme="sequential"), want_state=True)
+    _, sym = run(RunConfig.of(**base), want_state=True)
+    _, seq = run(RunConfig.of(**base, scheme="sequential"), want_state=True)
     np.testing.assert_array_equal(sym["x"].to_numpy(), seq["x"].to_numpy())
     assert not np.allclose(sym["mass"].to_numpy(), seq["mass"].to_numpy())
 
@@ -395,7 +395,7 @@ def test_schemes_share_positions_and_walks_for_a_seed():
 @pytest.mark.parametrize("scheme", ["sequential", "sequential_sorted", "sequential_symnorm"])
 def test_sequential_collision_runs_conserve_mass(scheme):
     # beta = 1/2 and W_ij <= r_i: the clipping never acts, so mass is conserved to round-off
-    tab, _ = run(RunConfig(method="mtpt", kernel="collision", n=300, t_final=100.0, truncation=3.0, scheme=scheme))
+    tab, _ = run(RunConfig.of(method="mtpt", kernel="collision", n=300, t_final=100.0, truncation=3.0, scheme=scheme))
     assert np.max(np.abs(tab["mass_total"] - 1.0)) < 1e-13
     assert tab["H_D"].iloc[-1] > 3.0  # and the mass did spread
 
@@ -404,15 +404,15 @@ def test_compensated_scheme_widens_the_cut_kernel():
     from particle_entropy.numerics.kernels import collision_sigma, truncated_variance_fraction
 
     cfg = dict(method="mtpt", kernel="collision", n=100, t_final=1.0, truncation=3.0)
-    cut, _ = run(RunConfig(**cfg))
-    widened, _ = run(RunConfig(**cfg, scheme="compensated"))
+    cut, _ = run(RunConfig.of(**cfg))
+    widened, _ = run(RunConfig.of(**cfg, scheme="compensated"))
     dt = cut["dt"].iloc[1]
     assert cut["h"].iloc[1] == pytest.approx(collision_sigma(1.0, 1e-3, dt), rel=1e-14)
     assert widened["h"].iloc[1] == pytest.approx(cut["h"].iloc[1] / math.sqrt(truncated_variance_fraction(3.0)))
 
 
 def test_authors_time_grid_ends_after_t_final():
-    tab, _ = run(RunConfig(method="mtpt", kernel="collision", n=30, time_grid="authors"))
+    tab, _ = run(RunConfig.of(method="mtpt", kernel="collision", n=30, time_grid="authors"))
     assert len(tab) - 1 == 175 and tab["time"].iloc[-1] == pytest.approx(1021.1, abs=0.05)
     assert set(tab["time_grid"]) == {"authors"}
 
@@ -442,7 +442,7 @@ def test_every_run_measures_at_the_same_points_and_comic_points_is_eq43(monkeypa
     want = np.sort(np.random.default_rng(MEASUREMENT_SEED).uniform(-6.0, 6.0, 15))
     for kwargs in POINT_RUNS:
         seen.clear()
-        tab, _ = run(RunConfig(**kwargs))
+        tab, _ = run(RunConfig.of(**kwargs))
         assert len(seen) >= len(tab) - 1, kwargs  # every step measured at the points (PT adaptive: not t = 0)
         for p in seen:
             np.testing.assert_array_equal(p, want)
@@ -462,7 +462,7 @@ def test_fd_sse_points_by_hand_at_three_points(monkeypatch):
     import particle_entropy.core.measures as M
 
     monkeypatch.setattr(M, "measurement_points", lambda fd_length=12.0: np.array([-3.0, 0.5, 5.5]))
-    tab, st = run(RunConfig(method="fd", n=6, D=0.01, dt0=5.0, t_final=100.0), want_state=True)
+    tab, st = run(RunConfig.of(method="fd", n=6, D=0.01, dt0=5.0, t_final=100.0), want_state=True)
     x, c = st["x"].to_numpy(), st["c"].to_numpy()
     np.testing.assert_allclose(x, [-6, -4, -2, 0, 2, 4, 6], rtol=0, atol=1e-15)
     model = [0.5 * c[1] + 0.5 * c[2], 0.75 * c[3] + 0.25 * c[4], 0.25 * c[5] + 0.75 * c[6]]
@@ -495,7 +495,7 @@ def test_fd_sse_points_falls_with_n_as_the_leading_error_predicts():
     p = M.measurement_points()
     sse, pred = {}, {}
     for n in (100, 1000, 10000):
-        tab, _ = run(RunConfig(method="fd", n=n, t_final=t))
+        tab, _ = run(RunConfig.of(method="fd", n=n, t_final=t))
         assert tab["time"].iloc[-1] == t and tab["dt"].iloc[-1] == pytest.approx(dt, rel=1e-6)
         sse[n] = tab["SSE_points"].iloc[-1]
         dx = 12.0 / n

@@ -7,27 +7,61 @@ import math
 import os
 import sys
 
-from .core.registry import (
-    ALL_KERNELS,
-    DEFAULT_KERNEL,
-    KERNELS,
-    METHODS,
-    PAPER,
-    SCHEME_DOCS,
-    SCHEMES,
-    TIME_GRIDS,
-    TRANSFER_METHODS,
-)
+from .core.registry import ALL_KERNELS, DEFAULT_KERNEL, KERNELS, METHODS, SCHEME_DOCS
 from .core.runconfig import RunConfig, SettingError
+from .core.settings import BY_NAME, PAPER, Setting
+
+# The run settings the simulate command takes, as options named and described by settings.py.
+# dt0 and dt_growth have method-dependent defaults (None here, filled by RunConfig).
+CLI_SETTINGS = (
+    "eta",
+    "truncation",
+    "dt_growth",
+    "scheme",
+    "D",
+    "t_final",
+    "dt0",
+    "omega",
+    "fd_length",
+    "fixed_kernel_time",
+    "transfer_method",
+    "transfer_tolerance",
+    "time_grid",
+)
+CHOICE_DOCS = {"scheme": SCHEME_DOCS}  # what each choice means, in the option's help
+METHOD_DEFAULTS = {
+    "dt0": f"{PAPER['dt0']:g}; fixed step {PAPER['fixed_dt']:g} when dt-growth is 1; fd: {PAPER['fd_dt']:g}",
+    "dt_growth": f"{PAPER['dt_growth']:g}; fd: 1",
+}
 
 
-def _truncation(text: str):
+def _number_or_none(text: str):
+    """An option value: a number, or the word none (a truncation's whole Gaussian)."""
     if text.lower() == "none":
         return None
     try:
         return float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"'none' or a number of kernel widths > 0, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"'none' or a number, got {text!r}") from None
+
+
+def _add_setting(parser: argparse.ArgumentParser, setting: Setting) -> None:
+    """The option of one setting: its type, choices, default and help from its definition."""
+    default = None if setting.name in METHOD_DEFAULTS else setting.default
+    shown = METHOD_DEFAULTS.get(
+        setting.name, "none" if default is None else f"{default:g}" if isinstance(default, float) else default
+    )
+    unit = "" if setting.unit == "-" else f" [{setting.unit}]"
+    kwargs = {"default": default, "help": f"{setting.doc}{unit}; {setting.allowed()} (default: {shown})"}
+    if setting.choices is not None:
+        words = CHOICE_DOCS.get(setting.name, {})
+        kwargs["choices"] = setting.choices
+        kwargs["help"] = f"{setting.doc} (default: {shown})" + "".join(f"; {k}: {v}" for k, v in words.items())
+    elif setting.none:
+        kwargs.update(type=_number_or_none, metavar="{none,<number>}")
+    else:
+        kwargs["type"] = float
+    parser.add_argument(setting.option, **kwargs)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,7 +70,6 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser(
         "simulate",
         help="run one simulation and write its per-step table",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
         description="Run one PT, MTPT or FD simulation of 1-D diffusion from a delta at x = 0 "
         "and write one row per time step (entropies, dilution index, SSE, COMIC, mass, cost) as Parquet.",
     )
@@ -54,66 +87,9 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"{by_method}. Default: {', '.join(DEFAULT_KERNEL[m] for m in METHODS)}",
     )
     s.add_argument("--n", type=int, default=300, help="particles (pt, mtpt) or FD intervals, dx = L / N [-]")
-    s.add_argument(
-        "--eta", type=float, default=PAPER["eta"], help="mtpt: fraction of D done by mass transfer, in [0, 1] [-]"
-    )
-    s.add_argument("--D", type=float, default=PAPER["D"], help="diffusion coefficient [L^2/T]")
-    s.add_argument("--t-final", type=float, default=PAPER["t_final"], help="final time [T]")
-    s.add_argument(
-        "--dt0",
-        type=float,
-        default=None,
-        help=f"first time step [T] (default {PAPER['dt0']:g}; fixed step {PAPER['fixed_dt']:g} when "
-        f"dt-growth is 1; fd: {PAPER['fd_dt']:g})",
-    )
-    s.add_argument(
-        "--dt-growth",
-        type=float,
-        default=None,
-        help=f"dt_{{n+1}} = growth dt_n, 1 = fixed step [-] (default {PAPER['dt_growth']:g}; fd: 1)",
-    )
-    s.add_argument(
-        "--truncation",
-        type=_truncation,
-        default=None,
-        metavar="{none,<widths>}",
-        help="truncate the transfer kernel at this many kernel widths; none = whole Gaussian (Eqs. 17, 21)",
-    )
     s.add_argument("--seed", type=int, default=0, help="random seed (>= 0)")
-    s.add_argument("--omega", type=float, default=PAPER["omega"], help="particle domain length Omega [L]")
-    s.add_argument("--fd-length", type=float, default=PAPER["fd_length"], help="FD domain length [L], centred on 0")
-    s.add_argument(
-        "--fixed-kernel-time",
-        type=float,
-        default=PAPER["fixed_kernel_time"],
-        help="pt fixed kernel: reconstruct with variance 2 D x this time [T]",
-    )
-    s.add_argument(
-        "--transfer-method",
-        choices=TRANSFER_METHODS,
-        default=PAPER["transfer_method"],
-        help="Gauss-transform algorithm for mass transfer (auto picks the faster exact one)",
-    )
-    s.add_argument(
-        "--transfer-tolerance",
-        type=float,
-        default=PAPER["transfer_tolerance"],
-        help="error bound of the fast Gauss transform, relative to the summed |weights| in reach "
-        f"[-] (default {PAPER['transfer_tolerance']:g}: round-off, mass conserved to 1e-13)",
-    )
-    s.add_argument(
-        "--scheme",
-        choices=SCHEMES,
-        default=PAPER["scheme"],
-        help="mtpt: " + "; ".join(f"{k}: {v}" for k, v in SCHEME_DOCS.items()),
-    )
-    s.add_argument(
-        "--time-grid",
-        choices=TIME_GRIDS,
-        default=PAPER["time_grid"],
-        help="particles: exact = last step shortened to end at t-final; authors = whole steps while "
-        "t < t-final, as the authors' code (175 steps to t = 1021.1 for the defaults)",
-    )
+    for name in CLI_SETTINGS:
+        _add_setting(s, BY_NAME[name])
     s.add_argument("--out", required=True, help="output Parquet path (per-step table)")
     s.add_argument("--state-out", default=None, help="optional Parquet path for the final state (x, mass, c)")
     s.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
@@ -147,25 +123,8 @@ def check_config_files(files: list[str]) -> int:
 
 
 def config_from_args(a: argparse.Namespace) -> RunConfig:
-    return RunConfig(
-        method=a.method,
-        kernel=a.kernel,
-        n=a.n,
-        eta=a.eta,
-        D=a.D,
-        t_final=a.t_final,
-        dt0=a.dt0,
-        dt_growth=a.dt_growth,
-        truncation=a.truncation,
-        seed=a.seed,
-        omega=a.omega,
-        fd_length=a.fd_length,
-        fixed_kernel_time=a.fixed_kernel_time,
-        transfer_method=a.transfer_method,
-        transfer_tolerance=a.transfer_tolerance,
-        scheme=a.scheme,
-        time_grid=a.time_grid,
-    ).resolved()
+    settings = {name: getattr(a, name) for name in CLI_SETTINGS}
+    return RunConfig.of(method=a.method, kernel=a.kernel, n=a.n, seed=a.seed, **settings).resolved()
 
 
 def _same_file(a: str, b: str) -> bool:

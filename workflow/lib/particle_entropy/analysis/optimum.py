@@ -39,7 +39,8 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import APPLIES, Case, SettingError
-from ..core.registry import MEASUREMENT_POINTS, PAPER
+from ..core.registry import MEASUREMENT_POINTS
+from ..core.settings import PAPER
 from ..core.runconfig import first_step
 from ..core.timegrid import step_count
 from .aggregate import (

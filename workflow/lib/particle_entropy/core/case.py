@@ -20,7 +20,8 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-from .registry import KERNELS, METHODS, PAPER, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES
+from .registry import KERNELS, METHODS, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES
+from .settings import PAPER
 
 # Case field -> (wildcard name, path segment); the path of a case is these segments in order.
 PATH_SEGMENTS = {

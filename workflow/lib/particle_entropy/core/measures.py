@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from .registry import MEASUREMENT_POINTS, MEASUREMENT_SEED, PAPER
+from .registry import MEASUREMENT_POINTS, MEASUREMENT_SEED
+from .settings import PAPER
 
 
 def entropy_discrete(p: np.ndarray) -> float:

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..core import measures as M
-from ..core.registry import PAPER
+from ..core.settings import PAPER
 from ..core.runconfig import RunConfig
 from ..models import fd
 
@@ -94,7 +94,7 @@ def run_case(
     """Implicit FD (backward Euler, fd.ImplicitSolver) of grid ``n`` (dx = ref_length / n) on
     [-fd_length/2, fd_length/2] with zero end nodes; the measures at ``times`` per reference."""
     n_int = _grid_n(n, fd_length, ref_length)
-    cfg = RunConfig(method="fd", kernel="implicit", n=n_int, D=D, fd_length=fd_length, dt0=fd_dt).resolved()
+    cfg = RunConfig.of(method="fd", kernel="implicit", n=n_int, D=D, fd_length=fd_length, dt0=fd_dt).resolved()
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
     solver = fd.ImplicitSolver(n_int - 1, D * fd_dt / dx**2)

@@ -15,8 +15,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ..core.case import CASE_DIR, Case, SettingError
-from ..core.registry import PAPER
 from ..core.runconfig import MAX_SEED, RunConfig, first_step
+from ..core.settings import PAPER, SETTINGS
 
 RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
@@ -26,8 +26,8 @@ PAPER_FIGURES = tuple(f"fig{k}" for k in range(1, 10))  # the case-drawn figures
 # table, the trade-off table; every other figure reads case summaries (ensemble statistics).
 FIGURE_READS = {"fig1": "runs", "fig2": "runs", "fig7": "snapshots", "fig9": "comic", "tradeoff": "tradeoff"}
 # config.physics / config.time keys -> RunConfig settings shared by every case
-PHYSICS = ("D", "t_final", "omega", "fd_length", "fixed_kernel_time")
-NUMERICS = ("transfer_method", "transfer_tolerance")
+PHYSICS = tuple(s.name for s in SETTINGS if s.section == "physics")  # D, t_final, omega, ...
+NUMERICS = tuple(s.name for s in SETTINGS if s.section == "numerics")  # transfer_method, _tolerance
 
 
 @dataclass(frozen=True)
@@ -154,7 +154,7 @@ def run_settings(case: Case, config: Mapping) -> dict:
     physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
     out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
     out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
-    out["time_grid"] = time.get("grid", PAPER["time_grid"])
+    out["time_grid"] = time.get("grid", PAPER["time_grid"])  # settings: time_grid is the key time.grid
     out["dt0"] = float(
         first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"], time.get("fixed_dt", PAPER["fixed_dt"]))
     )
@@ -188,8 +188,8 @@ def _first_step_key(case: Case) -> str:
 
 # RunConfig settings that come from a shared config key, not from the case: a SettingError about
 # them names that key (and the case it fails for)
-SHARED_KEYS = {"dt0": _first_step_key, **{k: f"physics.{k}" for k in PHYSICS}, "time_grid": "time.grid"}
-SHARED_KEYS.update({k: f"numerics.{k}" for k in NUMERICS})
+SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "numerics") or s.name == "time_grid"}
+SHARED_KEYS["dt0"] = _first_step_key
 
 
 def check_seeds(config: Mapping) -> None:
