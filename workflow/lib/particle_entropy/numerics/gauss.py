@@ -43,6 +43,7 @@ def cutoff_radius(sigma: float, truncation: float | None) -> float:
     authors' cut), or CUTOFF_SIGMAS for the whole Gaussian (below round-off of the self term)."""
     return (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
 
+
 P_TERMS = 24
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes
 # mean fewer translations (each p^2) but more terms p. A translation's term pair costs about
