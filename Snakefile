@@ -35,7 +35,7 @@ rule all:
 
 
 onerror:
-    from particle_entropy.core.io import disk_space_problem
+    from particle_entropy.core.verify import disk_space_problem
 
     problem = disk_space_problem(".")
     if problem:

@@ -34,6 +34,7 @@ from particle_entropy.analysis.aggregate import (
 )
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
+from particle_entropy.core.labels import case_label
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.models.simulate import run
 
@@ -177,7 +178,7 @@ def test_comic_table_keeps_models_apart(variant):
     assert table["label"].nunique() == 2
     assert set(table["time"]) == {5.0, 20.0} and set(table["time_step"]) == {4.8, 20.0}
     for model, name in ((PAPER, "paper"), (variant, "variant")):
-        rows = table[table["label"] == model.label(n=False)]
+        rows = table[table["label"] == case_label(model, n=False)]
         assert len(rows) == 6
         for _, r in rows.iterrows():
             k = {4.8: 0, 20.0: 2}[r["time_step"]]
@@ -189,16 +190,16 @@ def test_comic_minima_one_per_model_and_time_at_the_hand_argmin(variant):
     minima = comic_minima(comic_table(_summaries(variant), [5.0, 10.0, 20.0]))
     assert len(minima) == 2 * 3
     for model, name in ((PAPER, "paper"), (variant, "variant")):
-        rows = minima[minima["label"] == model.label()]
+        rows = minima[minima["label"] == case_label(model)]
         assert len(rows) == 3
         assert all(Case.from_row(r) == model for _, r in rows.iterrows())
         got = dict(zip(rows["time"], rows["n_opt"], strict=True))
         assert got == {5.0: OPT[name][4.8], 10.0: OPT[name][10.0], 20.0: OPT[name][20.0]}
     # neighbours of the paper model's optimum at t = 10 (N = 100): 30 below, 300 above, interior
-    r = minima[(minima["label"] == PAPER.label()) & (minima["time"] == 10.0)].iloc[0]
+    r = minima[(minima["label"] == case_label(PAPER)) & (minima["time"] == 10.0)].iloc[0]
     assert (r["n_below"], r["n_above"], bool(r["interior"])) == (30, 300, True)
     assert (r["COMIC_below"], r["COMIC_opt"], r["COMIC_above"]) == (2.0, 1.0, 3.0)
-    edge = minima[(minima["label"] == PAPER.label()) & (minima["time"] == 5.0)].iloc[0]
+    edge = minima[(minima["label"] == case_label(PAPER)) & (minima["time"] == 5.0)].iloc[0]
     assert (edge["n_below"], bool(edge["interior"])) == (-1, False)
 
 
@@ -231,7 +232,7 @@ def test_tradeoff_marks_one_optimum_per_model_and_time(variant):
     assert len(marked) == 2 * 3
     assert marked.groupby(["label", "time"]).size().eq(1).all()
     for model, name in ((PAPER, "paper"), (variant, "variant")):
-        rows = marked[marked["label"] == model.label(n=False)]
+        rows = marked[marked["label"] == case_label(model, n=False)]
         assert dict(zip(rows["time"], rows["n"], strict=True)) == {
             5.0: OPT[name][4.8],
             10.0: OPT[name][10.0],
@@ -298,7 +299,7 @@ def _realisations(values: dict[Case, list[float]], time: float = 10.0, sse: dict
             s = sse[case][seed] if sse else math.exp(c)
             rows.append(
                 {
-                    "label": case.label(n=False),
+                    "label": case_label(case, n=False),
                     **case.columns(),
                     "time": time,
                     "time_step": time,
@@ -442,7 +443,7 @@ def test_minima_carry_the_bootstrap_interval_and_share():
             c, e = s["COMIC_mean"][k], s["SSE_mean"][k]
             for seed, d in enumerate((-0.01, 0.01, 0.0)):
                 rows.append(
-                    {"label": case.label(n=False), **case.columns(), "time": time, "time_step": s["time"][k]}
+                    {"label": case_label(case, n=False), **case.columns(), "time": time, "time_step": s["time"][k]}
                     | {"seed": seed, "SSE": e * (1 + d), "COMIC": c + d, "n_sse": case.n, "dV": 10.0 / case.n}
                 )
     argmin = comic_argmin(pd.DataFrame(rows))

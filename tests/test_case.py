@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 
 from particle_entropy.core.case import Case, SettingError, by_model, case_mask, case_of_table, models_in, rows_of, text
+from particle_entropy.core.labels import case_label
 
 
 def _grid() -> list[Case]:
@@ -146,7 +147,7 @@ def test_cases_one_dimension_apart_differ_everywhere(change):
     assert other != BASE
     assert other.path() != BASE.path()
     assert other.columns() != BASE.columns()
-    assert other.label() != BASE.label()
+    assert case_label(other) != case_label(BASE)
     assert other.wildcards() != BASE.wildcards()
 
 
@@ -222,15 +223,17 @@ def test_labels_name_variants_and_not_paper_cases():
     trunc = Case("mtpt", "collision", 300, truncation=3)
     seq = Case("mtpt", "collision", 300, scheme="sequential")
     fixed = Case("mtpt", "collision", 300, dt_growth=1)
-    assert "truncation 3" in trunc.label() and "sequential" not in trunc.label()
-    assert "sequential" in seq.label() and "truncation" not in seq.label()
+    assert "truncation 3" in case_label(trunc) and "sequential" not in case_label(trunc)
+    assert "sequential" in case_label(seq) and "truncation" not in case_label(seq)
     for word in ("truncation", "sequential", "growth", "fixed"):
-        assert word not in paper.label()
-    assert fixed.label() != paper.label() and fixed.label() != Case("mtpt", "collision", 300, dt_growth=1.01).label()
-    assert "N=300" in paper.label() and "N=" not in paper.label(n=False)
-    assert "300" in paper.label() and "300" not in paper.model.label()
-    assert "MTPT" in paper.label() and "η=1" in paper.label()
-    assert Case("fd", "implicit", 30).label() != Case("fd", "explicit", 30).label()
+        assert word not in case_label(paper)
+    assert case_label(fixed) != case_label(paper) and case_label(fixed) != case_label(
+        Case("mtpt", "collision", 300, dt_growth=1.01)
+    )
+    assert "N=300" in case_label(paper) and "N=" not in case_label(paper, n=False)
+    assert "300" in case_label(paper) and "300" not in case_label(paper.model)
+    assert "MTPT" in case_label(paper) and "η=1" in case_label(paper)
+    assert case_label(Case("fd", "implicit", 30)) != case_label(Case("fd", "explicit", 30))
 
 
 def test_variant_lists_only_the_dimensions_off_the_paper():

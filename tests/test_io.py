@@ -3,22 +3,18 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import random
 import stat
+from pathlib import Path
 
 import pandas as pd
 import pytest
 
-from particle_entropy.core.io import (
-    OutputError,
-    check_output_path,
-    checksum_path,
-    corrupt_tables,
-    set_aside,
-    table_problem,
-    write_parquet,
-)
+import particle_entropy.core.verify as verify
+from particle_entropy.core.io import OutputError, check_output_path, checksum_path, write_parquet
+from particle_entropy.core.verify import corrupt_tables, set_aside, table_problem
 
 DF = pd.DataFrame({"step": range(50), "SSE": [0.5 / (k + 1) for k in range(50)], "label": ["a"] * 50})
 
@@ -109,14 +105,140 @@ def test_a_folder_or_pipe_with_a_table_name_is_set_aside_without_reading_it(tmp_
     assert corrupt_tables(tmp_path) == {pipe: "it is not a regular file"}
 
 
+# --- digests remembered against size, mtime and inode (a workflow start rereads no unchanged table)
+
+HOUR_NS = 3600 * 10**9
+
+
+def _settled_tables(root, count):
+    """``count`` tables written an hour ago (their mtime set back)."""
+    paths = [root / "runs" / f"t{k}.parquet" for k in range(count)]
+    for path in paths:
+        write_parquet(DF, path)
+        old = path.stat().st_mtime_ns - HOUR_NS
+        os.utime(path, ns=(old, old))
+    return paths
+
+
+def _count_reads(monkeypatch):
+    """The names of the tables hashed from now on, in order."""
+    reads, real = [], verify.file_sha256
+
+    def counted(path):
+        reads.append(Path(path).name)
+        return real(path)
+
+    monkeypatch.setattr(verify, "file_sha256", counted)
+    return reads
+
+
+def _flip_in_place(path, pos):
+    with open(path, "r+b") as f:  # same inode, same size
+        f.seek(pos)
+        byte = f.read(1)[0]
+        f.seek(pos)
+        f.write(bytes([byte ^ 1]))
+
+
+def test_unchanged_tables_are_not_read_again(tmp_path, monkeypatch):
+    paths = _settled_tables(tmp_path, 3)
+    digests = tmp_path / "state" / "table_digests.json"
+    reads = _count_reads(monkeypatch)
+    assert corrupt_tables(tmp_path, digests) == {} and len(reads) == 3
+    saved = digests.read_bytes()
+    assert corrupt_tables(tmp_path, digests) == {} and len(reads) == 3  # nothing read again
+    assert digests.read_bytes() == saved  # nor the digests file rewritten
+    write_parquet(DF.head(10), paths[0])  # a new file renamed into place: new inode and mtime
+    paths[2].unlink()
+    checksum_path(paths[2]).unlink()
+    assert corrupt_tables(tmp_path, digests) == {} and reads[3:] == ["t0.parquet"]
+    assert sorted(json.loads(digests.read_text())["tables"]) == ["runs/t1.parquet"]  # t0 is too fresh
+
+
+def test_a_table_written_moments_ago_is_read_again_next_time(tmp_path, monkeypatch):
+    write_parquet(DF, tmp_path / "t.parquet")  # a second write in the same clock tick would keep its mtime
+    digests = tmp_path / "table_digests.json"
+    reads = _count_reads(monkeypatch)
+    corrupt_tables(tmp_path, digests)
+    assert corrupt_tables(tmp_path, digests) == {} and reads == ["t.parquet", "t.parquet"]
+
+
+def test_a_flipped_byte_is_found_when_the_mtime_changed(tmp_path):
+    (path,) = _settled_tables(tmp_path, 1)
+    digests = tmp_path / "table_digests.json"
+    assert corrupt_tables(tmp_path, digests) == {}
+    before = path.stat()
+    _flip_in_place(path, 100)  # the write sets the mtime to now
+    after = path.stat()
+    assert (after.st_ino, after.st_size) == (before.st_ino, before.st_size) and after.st_mtime_ns != before.st_mtime_ns
+    assert "differs from the recorded" in corrupt_tables(tmp_path, digests)[path]
+
+
+def test_a_change_keeping_size_mtime_and_inode_is_the_accepted_limit(tmp_path):
+    (path,) = _settled_tables(tmp_path, 1)
+    digests = tmp_path / "table_digests.json"
+    corrupt_tables(tmp_path, digests)
+    before = path.stat()
+    _flip_in_place(path, 100)
+    os.utime(path, ns=(before.st_atime_ns, before.st_mtime_ns))  # the mtime set back by hand
+    assert corrupt_tables(tmp_path, digests) == {}  # unseen, as in DVC (and as bit rot on the disk would be)
+    assert path in corrupt_tables(tmp_path)  # a check without the digests reads every table
+    digests.unlink()  # the escape: delete the digests file
+    assert path in corrupt_tables(tmp_path, digests)
+
+
+def test_a_remembered_digest_never_condemns_a_good_table(tmp_path):
+    (path,) = _settled_tables(tmp_path, 1)
+    digests = tmp_path / "table_digests.json"
+    corrupt_tables(tmp_path, digests)
+    entries = json.loads(digests.read_text())
+    good = entries["tables"]["runs/t0.parquet"][3]
+    entries["tables"]["runs/t0.parquet"][3] = "0" * 64
+    digests.write_text(json.dumps(entries))
+    assert corrupt_tables(tmp_path, digests) == {}  # reread before it is judged
+    assert json.loads(digests.read_text())["tables"]["runs/t0.parquet"][3] == good
+
+
+@pytest.mark.parametrize(
+    "content",
+    [
+        b"",  # lost in a crash
+        b'{"version": 1, "tables": {"runs/t0.parquet": [1, 2',  # cut short
+        b"\xff\xfe\x00 not text",
+        b"[1, 2, 3]",
+        b'{"version": 99, "tables": {}}',
+        b'{"version": 1, "tables": {"runs/t0.parquet": ["x", 0, 0, 0], "runs/t1.parquet": 5}}',
+        b"[" * 100_000,  # nested too deep to parse
+    ],
+)
+def test_a_damaged_digests_file_is_ignored_and_rebuilt(tmp_path, content):
+    good, bad = _settled_tables(tmp_path, 2)
+    bad.write_bytes(bad.read_bytes()[:100])
+    digests = tmp_path / "table_digests.json"
+    digests.write_bytes(content)
+    assert list(corrupt_tables(tmp_path, digests)) == [bad]
+    entries = json.loads(digests.read_text())["tables"]
+    assert list(entries) == ["runs/t0.parquet"] and entries["runs/t0.parquet"][3] == verify.file_sha256(good)
+
+
+def test_a_digests_file_that_cannot_be_written_is_skipped(tmp_path):
+    good, bad = _settled_tables(tmp_path, 2)
+    bad.write_bytes(bad.read_bytes()[:100])
+    folder = tmp_path / "table_digests.json"
+    folder.mkdir()  # a folder in its place
+    assert list(corrupt_tables(tmp_path, folder)) == [bad] and folder.is_dir() and not any(folder.iterdir())
+    assert not list(tmp_path.glob(".*.tmp"))  # its temporary file removed
+    assert list(corrupt_tables(tmp_path, tmp_path / "runs" / "t0.parquet" / "x.json")) == [bad]  # under a file
+
+
 def test_a_nearly_full_disk_is_named(tmp_path, monkeypatch):
     from collections import namedtuple
 
-    import particle_entropy.core.io as io
-
     usage = namedtuple("usage", "total used free")
-    monkeypatch.setattr(io.shutil, "disk_usage", lambda path: usage(10 * 2**30, 10 * 2**30 - 50 * 2**20, 50 * 2**20))
-    message = io.disk_space_problem(tmp_path)
+    monkeypatch.setattr(
+        verify.shutil, "disk_usage", lambda path: usage(10 * 2**30, 10 * 2**30 - 50 * 2**20, 50 * 2**20)
+    )
+    message = verify.disk_space_problem(tmp_path)
     assert message.startswith("No space left on device?") and "50 MB free" in message and str(tmp_path) in message
-    monkeypatch.setattr(io.shutil, "disk_usage", lambda path: usage(10 * 2**30, 2**30, 9 * 2**30))
-    assert io.disk_space_problem(tmp_path) is None
+    monkeypatch.setattr(verify.shutil, "disk_usage", lambda path: usage(10 * 2**30, 2**30, 9 * 2**30))
+    assert verify.disk_space_problem(tmp_path) is None

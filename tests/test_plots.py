@@ -16,12 +16,23 @@ import pandas as pd
 import pytest
 import yaml
 
+from particle_entropy.core.labels import case_label
+
 matplotlib.use("Agg")
 
 from particle_entropy.analysis.aggregate import METRICS  # noqa: E402
 from particle_entropy.core.case import CASE_COLUMNS, Case, rows_of  # noqa: E402
 from particle_entropy.core.runconfig import RunConfig  # noqa: E402
-from particle_entropy.figures import plots, plots_shear  # noqa: E402
+from particle_entropy.figures import (  # noqa: E402
+    FIGURE_MODULES,
+    dilution,
+    fig1,
+    fig9,
+    figure_function,
+    plots_shear,
+    style,
+    tradeoff,
+)
 from particle_entropy.models.simulate import run  # noqa: E402
 
 CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config.yaml").read_text())
@@ -89,7 +100,7 @@ def comic_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
             mu, sd = rng.uniform(-10, -5), rng.uniform(0.1, 1.0)
             rows.append(
                 {
-                    "label": c.label(n=False),
+                    "label": case_label(c, n=False),
                     **c.columns(),
                     "time": t,
                     "time_step": t - 0.1,
@@ -142,7 +153,7 @@ def tradeoff_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
         for t in times:
             rows.append(
                 {
-                    "label": c.label(n=False),
+                    "label": case_label(c, n=False),
                     **c.columns(),
                     "time": t,
                     "wall_s": rng.uniform(0.01, 1),
@@ -173,7 +184,7 @@ def inputs(fig: str, cases: list[Case]) -> list[pd.DataFrame]:
 
 
 def draw(fig: str, cases: list[Case], tables=None):
-    figure, data = plots.FIGURES[fig](inputs(fig, cases) if tables is None else tables, cases, **KW)
+    figure, data = figure_function(fig)(inputs(fig, cases) if tables is None else tables, cases, **KW)
     return figure, data
 
 
@@ -194,7 +205,7 @@ def line_styles(ax) -> dict[str, tuple]:
     }
 
 
-FIGURE_NAMES = list(plots.FIGURES)
+FIGURE_NAMES = list(FIGURE_MODULES)
 
 
 # ------------------------------------------------------------------ every figure
@@ -205,7 +216,7 @@ def test_every_figure_returns_its_cases_and_only_them(fig):
     if fig in ("fig9", "tradeoff"):  # rows of a model not in the section must not be drawn
         tables = [pd.concat([tables[0], inputs(fig, [Case("mtpt", "sph", n, eta=0.3) for n in NS])[0]])]
     figure, data = draw(fig, cases, tables)
-    assert list(data.columns) == list(plots.SOURCE_COLUMNS)
+    assert list(data.columns) == list(style.SOURCE_COLUMNS)
     assert len(data) > 0 and set(data["figure"]) == {fig}
     drawn = data[data["method"] != "analytic"]
     assert {case_of(r) for _, r in drawn.drop_duplicates(list(CASE_COLUMNS)).iterrows()} == set(cases)
@@ -240,15 +251,15 @@ def test_fig5_added_case_data_and_paper_colours():
         plotted = table[table["time"] > 0]
         assert np.allclose(rows["y"], plotted["E_mean"]) and np.allclose(rows["x"], plotted["time"])
         assert np.allclose(rows["y_std"], plotted["E_std"]) and (rows["n_realisations"] == 3).all()
-        assert set(rows["series"]) == {case.label()} and set(rows["y_name"]) == {"E"}
+        assert set(rows["series"]) == {case_label(case)} and set(rows["y_name"]) == {"E"}
     added = data[data["eta"] == 0.25]
     assert set(added["truncation"]) == {3.0} and set(added["n"]) == set(NS)
     for ax, n in zip(figure.axes, sorted(NS, reverse=True), strict=True):
         styles = line_styles(ax)
-        colour = {(c.kernel, c.eta): styles[c.label()][0] for c in cases if c.n == n}
-        assert colour["collision", 1.0] == colour["collision", 0.1] == hex_of(plots.GREEN)
-        assert colour["sph", 1.0] == colour["sph", 0.1] == hex_of(plots.VERMILLION)
-        assert colour["collision", 0.25] not in map(hex_of, (plots.GREEN, plots.VERMILLION, plots.BLACK))
+        colour = {(c.kernel, c.eta): styles[case_label(c)][0] for c in cases if c.n == n}
+        assert colour["collision", 1.0] == colour["collision", 0.1] == hex_of(style.GREEN)
+        assert colour["sph", 1.0] == colour["sph", 0.1] == hex_of(style.VERMILLION)
+        assert colour["collision", 0.25] not in map(hex_of, (style.GREEN, style.VERMILLION, style.BLACK))
 
 
 def test_analytic_references_are_marked_as_such():
@@ -267,15 +278,15 @@ def test_a_case_without_a_table_is_marked_no_data():
     texts = [t.get_text() for ax in figure.axes for t in ax.texts]
     assert any(t.startswith("no data") and "SPH" in t for t in texts)
     _, empty = draw("fig9", paper_cases("fig9"), [comic_table([])])
-    assert empty.empty and list(empty.columns) == list(plots.SOURCE_COLUMNS)
+    assert empty.empty and list(empty.columns) == list(style.SOURCE_COLUMNS)
 
 
 # ------------------------------------------------------------------ styles
 def test_paper_style_goes_to_the_case_closest_to_the_paper():
     base, truncated = Case("mtpt", "collision", eta=1.0), Case("mtpt", "collision", eta=1.0, truncation=3)
-    style = plots.styles("fig9", [truncated.at(30), base.at(30)])
-    assert style[base] == plots.PAPER_STYLES["fig9"][("mtpt", "collision", 1.0)]
-    assert style[truncated]["color"] not in (plots.GREEN, plots.VERMILLION, plots.BLUE)
+    looks = style.styles([truncated.at(30), base.at(30)], fig9.PAPER_STYLES)
+    assert looks[base] == fig9.PAPER_STYLES[("mtpt", "collision", 1.0)]
+    assert looks[truncated]["color"] not in (style.GREEN, style.VERMILLION, style.BLUE)
 
 
 def test_automatic_styles_stay_distinct_and_off_the_paper_palette():
@@ -285,10 +296,10 @@ def test_automatic_styles_stay_distinct_and_off_the_paper_palette():
         for eta in (0.2, 0.3, 0.4)
         for tr in (None, 3)
     ]
-    style = plots.styles("fig5", paper_cases("fig5", extra=tuple(added)))
-    looks = [(s["color"], s.get("marker"), s.get("linestyle", "-"), bool(s.get("open"))) for s in style.values()]
-    assert len(set(looks)) == len(looks)
-    assert all(style[m]["color"] not in (plots.GREEN, plots.VERMILLION) for m in added)
+    looks = style.styles(paper_cases("fig5", extra=tuple(added)), dilution.PAPER_STYLES["fig5"])
+    kinds = [(s["color"], s.get("marker"), s.get("linestyle", "-"), bool(s.get("open"))) for s in looks.values()]
+    assert len(set(kinds)) == len(kinds)
+    assert all(looks[m]["color"] not in (style.GREEN, style.VERMILLION) for m in added)
 
 
 def test_scheme_variants_are_side_by_side_in_fig9_and_apart_in_tradeoff():
@@ -304,12 +315,12 @@ def test_scheme_variants_are_side_by_side_in_fig9_and_apart_in_tradeoff():
     assert data.groupby("series")["scheme"].nunique().eq(1).all() and data["series"].nunique() == 6
     figure, data = draw("tradeoff", cases)
     assert data.groupby("panel")["series"].nunique().eq(2).all()
-    assert set(data["series"]) == {symmetric.label(n=False), sequential.label(n=False)}
+    assert set(data["series"]) == {case_label(symmetric, n=False), case_label(sequential, n=False)}
     styles = line_styles(figure.axes[0])
-    assert styles[symmetric.label(n=False)] != styles[sequential.label(n=False)]
-    variant = plots.tradeoff_styles(cases)
-    assert variant[symmetric]["linestyle"] == plots.VARIANT_LINES[("truncation",)]
-    assert variant[sequential]["linestyle"] == plots.VARIANT_LINES[("truncation", "scheme")]
+    assert styles[case_label(symmetric, n=False)] != styles[case_label(sequential, n=False)]
+    variant = tradeoff.tradeoff_styles(cases)
+    assert variant[symmetric]["linestyle"] == tradeoff.VARIANT_LINES[("truncation",)]
+    assert variant[sequential]["linestyle"] == tradeoff.VARIANT_LINES[("truncation", "scheme")]
 
 
 # ------------------------------------------------------------------ fig9, tradeoff, fig7, fig10
@@ -333,7 +344,7 @@ def test_fig9_error_bars_are_comic_std_at_the_time_nearest_t_final():
         assert g.loc[g["marked"], "y"].tolist() == [g["y"].min()]
     assert mean.groupby("panel")["series"].nunique().max() == 2  # the equations beside the authors' loop
     of_mean = data[data["y_name"] == "COMIC of mean SSE"]
-    assert set(mean["series"]) == {f"{m.label(n=False)}: mean COMIC" for m in {c.model for c in cases}}
+    assert set(mean["series"]) == {f"{case_label(m, n=False)}: mean COMIC" for m in {c.model for c in cases}}
     assert np.isneginf(of_mean["y_lo"]).all() and of_mean["y_std"].isna().all()
 
 
@@ -373,7 +384,7 @@ def test_fig7_plots_every_particle():
 def test_fig1_and_fig6_from_tiny_real_runs():
     cases = [Case(m, k, 30, dt_growth=1.3) for m, k in (("pt", "bins"), ("pt", "fixed"), ("mtpt", "collision"))]
     runs = [run(RunConfig.for_case(c, t_final=2.0))[0] for c in cases]
-    figure, data = plots.fig1(runs, cases, D=1e-3, t_final=2.0)
+    figure, data = fig1.fig1(runs, cases, D=1e-3, t_final=2.0)
     h_c = data[(data["y_name"] == "H_C") & (data["method"] != "analytic")]
     assert len(h_c) == sum(((r["time"] > 0) & np.isfinite(r["H_C"])).sum() for r in runs)
     h_d = data[data["y_name"] == "H_D"]
@@ -407,6 +418,6 @@ def test_save_figure_is_byte_stable(tmp_path):
     outputs = []
     for k in range(2):
         figure, _ = draw("fig5", paper_cases("fig5"))
-        plots.save_figure(figure, tmp_path / f"{k}.png", tmp_path / f"{k}.pdf")
+        style.save_figure(figure, tmp_path / f"{k}.png", tmp_path / f"{k}.pdf")
         outputs.append([(tmp_path / f"{k}.{ext}").read_bytes() for ext in ("png", "pdf")])
     assert outputs[0] == outputs[1]

@@ -70,7 +70,10 @@ def test_a_new_record_needs_no_string_test(monkeypatch):
         "my_loop", "the authors' loop, symmetric weights, no clipping", sequential=True, symnorm=True, clip=False
     )
     monkeypatch.setitem(registry.SCHEME_RECORDS, "my_loop", new)
-    cfg = dataclasses.replace(RunConfig.of(method="mtpt", n=40).resolved(), scheme="my_loop")
+    cfg = RunConfig.of(method="mtpt", n=40).resolved()
+    case = dataclasses.replace(cfg.case)
+    object.__setattr__(case, "scheme", "my_loop")  # past Case's check, which knows the shipped names only
+    cfg = dataclasses.replace(cfg, case=case)
     x, m, label = _state()
     mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))
     assert seen == [{"label": label, "symnorm": True, "clip": False}]

@@ -17,6 +17,7 @@ from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
+from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.pipeline.sweeps import (
     FIGURE_READS,
@@ -382,7 +383,7 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
     assert not np.array_equal(at(truncated), at(sequential))  # the scheme changes the numbers
     claims = pd.read_parquet(tiny_run / "results/tables/paper_claims.parquet")
     for m in models:  # each model gets its own Fig. 9 claims
-        assert claims["claim"].str.startswith(m.label() + ": COMIC minimum").sum() == 2, m.label()
+        assert claims["claim"].str.startswith(case_label(m) + ": COMIC minimum").sum() == 2, case_label(m)
 
 
 def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run):
@@ -450,7 +451,9 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
     assert plan()[0] == set()  # the same code in another place: nothing to do
     lib = src / "workflow/lib/particle_entropy"
     for module, expected in [
-        ("figures/plots.py", lambda r: r.startswith("plot_")),
+        ("figures/style.py", lambda r: r.startswith("plot_")),
+        # legend text: the tables with a label column and the figures, never a simulation
+        ("core/labels.py", lambda r: not r.startswith("simulate") and r not in ("fd_domain", "mechanism_floors")),
         ("numerics/mass_transfer.py", None),
     ]:
         original = (lib / module).read_text()
@@ -694,3 +697,87 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
             assert (tiny_run / run_path(search.case_at(getattr(r, search.over)), r.first, r.last)).exists(), r
     proc = snakemake(tiny_run, "-n", "optimum", configfile=TINY)
     assert "Nothing to be done" in proc.stdout + proc.stderr
+
+
+def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
+    from particle_entropy.figures import FIGURE_MODULES
+
+    src, work = tmp_path / "src", tmp_path / "work"  # copies: the library edited, the finished run
+    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
+    shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(src / "Snakefile"), "-d", str(work), "-n"]
+    plan = lambda: subprocess.run([*cmd, "--configfile", str(TINY)], capture_output=True, text=True, check=True)
+    assert _planned_rules(plan()) == set()  # the same code in another place: nothing to do
+    figures = src / "workflow/lib/particle_entropy/figures"
+    every_figure = {f"plot_{fig}" for fig in FIGURE_MODULES}
+    for module, expected in [
+        ("fig7.py", lambda rules: rules == {"plot_fig7"}),
+        ("dilution.py", lambda rules: rules == {"plot_fig2", "plot_fig4", "plot_fig5"}),
+        ("style.py", lambda rules: every_figure <= rules and all(r.startswith("plot_") for r in rules)),
+    ]:
+        original = (figures / module).read_text()
+        (figures / module).write_text(original + "# an edit\n")
+        proc = plan()
+        assert expected(_planned_rules(proc)), (module, sorted(_planned_rules(proc)))
+        assert planned_outputs(proc) == [], module  # no simulation
+        (figures / module).write_text(original)
+
+
+# --- what parsing imports -----------------------------------------------------------------------
+
+# Runs Snakemake with every `import pandas` / `import scipy` statement recorded by the file that
+# runs it (sys.modules alone cannot tell: Snakemake's SLURM executor plugin imports pandas itself).
+RECORD_IMPORTS = """
+import atexit, builtins, json, runpy, sys
+root, out = sys.argv.pop(1), sys.argv.pop(1)
+found, real = set(), builtins.__import__
+
+def record(name, globals=None, locals=None, fromlist=(), level=0):
+    where = sys._getframe(1).f_code.co_filename.removeprefix(root)
+    if level == 0 and name.partition(".")[0] in ("pandas", "scipy") and where.startswith(("Snakefile", "workflow/")):
+        found.add(where)
+    return real(name, globals, locals, fromlist, level)
+
+builtins.__import__ = record
+atexit.register(lambda: open(out, "w").write(json.dumps({"by": sorted(found), "scipy": "scipy" in sys.modules})))
+sys.argv[0] = "snakemake"
+runpy.run_module("snakemake", run_name="__main__")
+"""
+
+
+def test_parsing_the_workflow_imports_no_scipy_and_pandas_only_where_known(tmp_path):
+    import json
+
+    out = tmp_path / "imports.json"
+    args = ["-s", str(ROOT / "Snakefile"), "-d", str(tmp_path / "work"), "-n", "--configfile", str(TINY)]
+    proc = subprocess.run([sys.executable, "-c", RECORD_IMPORTS, f"{ROOT}/", str(out), *args], capture_output=True)
+    assert proc.returncode == 0, proc.stderr.decode()[-3000:]
+    seen = json.loads(out.read_text())
+    assert not seen["scipy"]
+    assert not [f for f in seen["by"] if not f.startswith("workflow/lib/")]  # Snakefile, rules, scripts: none
+    # left (Snakemake's SLURM plugin has imported pandas by then anyway): modules that import it at
+    # module level and that the parse reaches to check a config section, optimum.py (and the
+    # aggregate module it imports) through sweeps.optimum_searches, shear2d.py through check_shear
+    known = {"analysis/optimum.py", "analysis/aggregate.py", "experiments/shear2d.py"}
+    assert set(seen["by"]) <= {f"workflow/lib/particle_entropy/{m}" for m in known}
+
+
+def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run):
+    import json
+
+    digests = tiny_run / ".snakemake" / "particle_entropy" / "table_digests.json"
+    for _ in range(2):  # nothing to do; the parse checks every table (the second reads none settled before)
+        proc = snakemake(tiny_run, configfile=TINY)
+        assert "Nothing to be done" in proc.stdout + proc.stderr
+    tables = {p.relative_to(tiny_run / "results").as_posix() for p in (tiny_run / "results").rglob("*.parquet")}
+    assert set(json.loads(digests.read_text())["tables"]) == tables
+    kept = digests.stat().st_mtime_ns
+    snakemake(tiny_run, configfile=TINY)
+    assert digests.stat().st_mtime_ns == kept  # nothing changed, nothing rewritten
+    cfg = load(TINY)
+    run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
+    run.write_bytes(run.read_bytes()[:100])  # in place: the same inode
+    proc = snakemake(tiny_run, configfile=TINY)
+    assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
+    assert pd.read_parquet(run).shape[0] > 0 and (run.parent / (run.name + ".corrupt")).exists()

@@ -17,6 +17,8 @@ rule summarise_case:
     params:
         code=SUMMARY_CODE,
     run:
+        from particle_entropy.analysis.aggregate import summarise_files  # pandas: not at parse
+
         count = summarise_files(list(input), output[0])
         Path(log[0]).write_text(f"summarised {count} realisations\n")
 

@@ -3,7 +3,6 @@ import re
 import sys
 from pathlib import Path
 
-import pandas as pd
 from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
@@ -18,13 +17,12 @@ SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
-from particle_entropy.analysis.aggregate import summarise_files
 from particle_entropy.core.case import Case
 from particle_entropy.pipeline.codeversion import code_version
-from particle_entropy.core.io import CORRUPT_SUFFIX, corrupt_tables, set_aside
+from particle_entropy.core.verify import CORRUPT_SUFFIX, corrupt_tables, set_aside
 from particle_entropy.core.memory import available_bytes, estimate_mb
-from particle_entropy.analysis.optimum import MAX_ROUNDS
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES
+from particle_entropy.figures import FIGURE_MODULES
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,
@@ -47,18 +45,24 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 check_sweeps(config)
-OPTIMUM = optimum_searches(config)  # the adaptive COMIC searches (workflow/rules/optimum.smk), by name
-if workflow.is_main_process and workflow.local_exec:  # jobs run here: each must fit in this machine's memory
+LOCAL = workflow.is_main_process and workflow.local_exec  # jobs run here: each must fit in this machine's memory
+if LOCAL:
     check_memory(config, available_bytes())
+# The adaptive COMIC searches (workflow/rules/optimum.smk), by name; each is checked when a
+# requested target first needs it, so a config layered over config.yaml's searches runs.
+OPTIMUM = optimum_searches(config, available_bytes() if LOCAL else None)
 
 
-def set_aside_corrupt_tables(root="results", look_only=False):
+def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):
     """Tables whose bytes no longer match their checksum (truncated, a flipped bit, empty) are
     moved to <name>.corrupt before the DAG is built. The default target rebuilds every table set
     aside and not yet rebuilt, so a dry run in between loses nothing. ``look_only`` (a dry run):
-    read no table and move none, only name those set aside before."""
+    read no table and move none, only name those set aside before. ``digests``: each table's
+    SHA-256 against its size, mtime and inode (verify.corrupt_tables), so a table is reread only when
+    it changed; beside Snakemake's own state, not in results/, which may be copied elsewhere.
+    Deleting it makes the next run read every table."""
     if not look_only:
-        for path, problem in corrupt_tables(root).items():
+        for path, problem in corrupt_tables(root, digests).items():
             moved = set_aside(path)
             print(
                 f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it",
@@ -178,6 +182,9 @@ def optimum_plan_runs(name, plan):
 
 def optimum_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
+    import pandas as pd  # here, not at parse: only a search's DAG reads its plans
+
+    OPTIMUM[wildcards.name]  # builds and checks the search (sweeps.check_search) before its first job
     k = int(wildcards.k)
     if k == 0:
         return {}
@@ -190,6 +197,10 @@ def optimum_round_inputs(wildcards):
 
 def optimum_final_inputs(wildcards):
     """The first finished plan of a search and its runs: rounds are requested one at a time."""
+    import pandas as pd
+
+    from particle_entropy.analysis.optimum import MAX_ROUNDS
+
     for k in range(MAX_ROUNDS + 2):  # next_plan stops by round MAX_ROUNDS + 1
         path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k)).output[0]
         plan = pd.read_parquet(path)
@@ -224,7 +235,10 @@ SUMMARY_CODE = code_version("aggregate", files=[Path(workflow.basedir) / "workfl
 COMIC_CODE = code_version("aggregate", "io", "htmlpage", files=[SCRIPTS / "comic_tables.py"])
 TRADEOFF_CODE = code_version("aggregate", "io", files=[SCRIPTS / "tradeoff_table.py"])
 CLAIMS_CODE = code_version("claims", "io", "htmlpage", files=[SCRIPTS / "paper_claims.py"])
-PLOT_CODE = code_version("plots", "io", files=[SCRIPTS / "plot_figure.py"])
+
+PLOT_CODE = {  # per figure, the module that draws it: editing one figure redraws it alone
+    fig: code_version(module, "io", files=[SCRIPTS / "plot_figure.py"]) for fig, module in FIGURE_MODULES.items()
+}
 SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
 SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])
 MECHANISM_PLOT_CODE = code_version("plots_mechanism", "io", files=[SCRIPTS / "plot_fig9_mechanism.py"])

@@ -30,6 +30,6 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             cases=section_cases(_fig),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
-            code=PLOT_CODE,
+            code=PLOT_CODE[_fig],
         script:
             "../scripts/plot_figure.py"

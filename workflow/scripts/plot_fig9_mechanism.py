@@ -12,8 +12,8 @@ import pandas as pd
 
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
-from particle_entropy.figures.plots import save_figure
 from particle_entropy.figures.plots_mechanism import fig9_mechanism
+from particle_entropy.figures.style import save_figure
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output
 cases = [Case.from_wildcards(c) for c in par.cases]

@@ -12,12 +12,13 @@ import pandas as pd
 
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
-from particle_entropy.figures import plots
+from particle_entropy.figures import figure_function
+from particle_entropy.figures.style import save_figure
 
 par, out = snakemake.params, snakemake.output
 tables = [pd.read_parquet(p) for p in snakemake.input]
 cases = [Case.from_wildcards(c) for c in par.cases]
-figure, data = plots.FIGURES[par.fig](tables, cases, D=float(par.D), t_final=float(par.t_final))
-plots.save_figure(figure, out.png, out.pdf)
+figure, data = figure_function(par.fig)(tables, cases, D=float(par.D), t_final=float(par.t_final))
+save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)
 print(f"drew {par.fig}: {len(cases)} cases from {len(tables)} tables, {len(data)} plotted points", file=sys.stderr)

@@ -10,8 +10,8 @@ matplotlib.use("Agg")
 
 import pandas as pd
 
-from particle_entropy.figures.plots import save_figure
 from particle_entropy.figures.plots_optimum import optimum_figure
+from particle_entropy.figures.style import save_figure
 
 inp, out = snakemake.input, snakemake.output
 table = pd.read_parquet(inp[0])

@@ -11,19 +11,37 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
+from ..core.labels import case_label
 from ..core.measures import comic
 
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
 SUMMARY_COLUMNS = {
     "step": "time-step index",
-    "time": "time [T]",
-    "n_realisations": "number of realisations averaged",
-    "wall_cum_mean": "wall seconds of one realisation from t = 0 to this step, ensemble mean (varies run to run)",
-    "wall_cum_std": "its standard deviation",
-    "work_mean": "particle-steps (FD: node-steps) from t = 0 to this step, incl. substeps, ensemble mean",
-    "peak_rss_mb_max": "largest peak resident memory of a realisation's process so far [MB] (varies run to run)",
-    **{f"{m}_mean": f"ensemble mean of {m}" for m in METRICS},
-    **{f"{m}_std": f"ensemble standard deviation of {m} (ddof = 1; 0 for one realisation)" for m in METRICS},
+    "time": "time at the end of the step [T]",
+    "n_realisations": "realisations averaged (K)",
+    "wall_cum_mean": "wall-clock seconds of one realisation from t = 0 to this step, ensemble mean (differs run "
+    "to run) [s]",
+    "wall_cum_std": "its standard deviation [s]",
+    "work_mean": "ensemble mean of `work` (particle- or node-steps from t = 0, substeps counted)",
+    "peak_rss_mb_max": "largest `peak_rss_mb` over the realisations (differs run to run) [MB]",
+    "H_D_mean": "ensemble mean of `H_D` (Eq. 2) [nats]",
+    "H_C_mean": "ensemble mean of `H_C` (Eqs. 6-7) [nats]",
+    "H_I_mean": "ensemble mean of `H_I` (Eq. 3) [nats]",
+    "H_PMF_mean": "ensemble mean of `H_PMF` (Section 5.4) [nats]",
+    "E_mean": "ensemble mean of the dilution index `E` (Eqs. 8-9) [L]",
+    "SSE_mean": "ensemble mean of `SSE` (Eq. 44) [1/L²]",
+    "AIC_mean": "ensemble mean of `AIC` (Eq. 41)",
+    "COMIC_mean": "ensemble mean of per-realisation `COMIC` (Eq. 43)",
+    "mass_total_mean": "ensemble mean of `mass_total`",
+    "H_D_std": "ensemble standard deviation of `H_D` [nats]",
+    "H_C_std": "ensemble standard deviation of `H_C` [nats]",
+    "H_I_std": "ensemble standard deviation of `H_I` [nats]",
+    "H_PMF_std": "ensemble standard deviation of `H_PMF` [nats]",
+    "E_std": "ensemble standard deviation of `E` [L]",
+    "SSE_std": "ensemble standard deviation of `SSE` [1/L²]",
+    "AIC_std": "ensemble standard deviation of `AIC`",
+    "COMIC_std": "ensemble standard deviation of `COMIC`",
+    "mass_total_std": "ensemble standard deviation of `mass_total`",
 }
 
 
@@ -71,7 +89,7 @@ def _case_rows(summaries: list[pd.DataFrame], times: list[float]):
     for s in summaries:
         case = case_of_table(s)
         for _, r in at_times(s, times).iterrows():
-            yield r, {"label": case.label(n=False), **case.columns(), "time": float(r["time_requested"])}
+            yield r, {"label": case_label(case, n=False), **case.columns(), "time": float(r["time_requested"])}
 
 
 def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:
@@ -174,29 +192,29 @@ def comic_minima(comic: pd.DataFrame, argmin: pd.DataFrame | None = None) -> pd.
 
 
 MINIMA_COLUMN_DOCS = {
-    "label": "legend label of the model (Case.label)",
+    "label": "legend label of the model (without N)",
     **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},
-    "time": "requested time [T] (the COMIC table's rows are at the nearest recorded step)",
-    "n_opt": "N minimising the ensemble mean of per-realisation COMIC (smallest N among ties)",
-    "COMIC_opt": "mean COMIC at n_opt",
-    "COMIC_opt_std": "ensemble standard deviation of COMIC at n_opt (ddof = 1; 0 for one realisation)",
-    "n_opt_of_mean_SSE": "N minimising the COMIC of the ensemble-mean SSE, 2 ln(mean SSE / n) - ln dV "
-    "(the authors' Fig. 9 convention)",
-    "n_below": "the next smaller N of the grid (-1: n_opt is the smallest)",
-    "COMIC_below": "mean COMIC at n_below (nan if none)",
-    "n_above": "the next larger N of the grid (-1: n_opt is the largest)",
-    "COMIC_above": "mean COMIC at n_above (nan if none)",
-    "interior": "n_opt has a neighbour on both sides, so the minimum is bracketed",
-    "n_opt_ci_lo": "lower end of the 95 % bootstrap percentile interval of the argmin N of mean COMIC, "
-    "widened outward to a grid N (aggregate.argmin_bootstrap; -1: no bootstrap table)",
-    "n_opt_ci_hi": "upper end of that interval, a grid N (-1: no bootstrap table)",
-    "n_opt_share": "fraction of bootstrap resamples whose argmin of mean COMIC is n_opt (1 when nothing "
-    "is resampled; nan: no bootstrap table)",
-    "n_opt_of_mean_SSE_ci_lo": "the same interval for the argmin of the COMIC of the mean SSE: lower end",
+    "time": "requested time (the COMIC rows are at the nearest recorded step) [T]",
+    "n_opt": "N of least mean COMIC, the ensemble mean of per-realisation COMIC (the smallest N among ties)",
+    "COMIC_opt": "mean COMIC at `n_opt` (Eq. 43)",
+    "COMIC_opt_std": "ensemble standard deviation of COMIC at `n_opt` (ddof = 1; 0 for one realisation)",
+    "n_opt_of_mean_SSE": "N of least COMIC of the ensemble-mean SSE, 2 ln(SSE_mean / n_sse) - ln dV (the authors' "
+    "convention for Fig. 9)",
+    "n_below": "next smaller N of the grid (-1: `n_opt` is the smallest)",
+    "COMIC_below": "mean COMIC at `n_below` (NaN if none)",
+    "n_above": "next larger N of the grid (-1: `n_opt` is the largest)",
+    "COMIC_above": "mean COMIC at `n_above` (NaN if none)",
+    "interior": "`n_opt` has a grid neighbour on both sides: the minimum is bracketed",
+    "n_opt_ci_lo": "lower end of the 95 % bootstrap percentile interval of the N of least mean COMIC, widened "
+    "outward to a grid N (`argmin_bootstrap`; -1: no bootstrap table)",
+    "n_opt_ci_hi": "its upper end, a grid N (-1: no bootstrap table)",
+    "n_opt_share": "fraction of bootstrap resamples in which `n_opt` has the least mean COMIC (1 when nothing is "
+    "resampled; NaN: no bootstrap table)",
+    "n_opt_of_mean_SSE_ci_lo": "lower end of the same interval for the N of least COMIC of the mean SSE",
     "n_opt_of_mean_SSE_ci_hi": "its upper end",
-    "n_opt_of_mean_SSE_share": "fraction of resamples whose argmin of the COMIC of the mean SSE is n_opt_of_mean_SSE",
-    "n_resamples": "bootstrap resamples drawn (aggregate.N_RESAMPLES; 0: every N has one realisation, "
-    "e.g. FD, so the optimum is certain and its share 1)",
+    "n_opt_of_mean_SSE_share": "fraction of resamples in which `n_opt_of_mean_SSE` has the least COMIC of the mean SSE",
+    "n_resamples": "bootstrap resamples drawn (`N_RESAMPLES`; 0 when every N has one realisation, e.g. FD: the "
+    "optimum is then certain and its share 1)",
 }
 MINIMA_COLUMNS = list(MINIMA_COLUMN_DOCS)
 
@@ -207,7 +225,7 @@ def _minimum(model, time: float, g: pd.DataFrame) -> dict:
     below = g.iloc[k - 1] if k > 0 else None
     above = g.iloc[k + 1] if k + 1 < len(g) else None
     return {
-        "label": model.label(),
+        "label": case_label(model),
         **model.columns(),
         "time": time,
         "n_opt": int(g["n"][k]),
@@ -224,17 +242,17 @@ def _minimum(model, time: float, g: pd.DataFrame) -> dict:
 
 # --------------------------------------------------------------------------- per-realisation values
 REALISATION_COLUMN_DOCS = {
-    "label": "legend label of the model (Case.label without N)",
+    "label": "legend label of the model (without N)",
     **{c: f"case column (case.COLUMN_DOCS): {c}" for c in CASE_COLUMNS},
     "time": "requested time [T]",
-    "time_step": "time of the recorded step nearest to it [T] (the rule of at_times)",
+    "time_step": "time of the recorded step nearest to it (`at_times`) [T]",
     "seed": "seed of the realisation",
-    "SSE": "sum of squared errors of this realisation, Eq. 44",
+    "SSE": "SSE of this realisation, Eq. 44 [1/L²]",
     "COMIC": "2 ln(SSE / n_sse) - ln dV of this realisation, Eq. 43",
-    "n_sse": "number of points in SSE",
+    "n_sse": "points in `SSE`",
     "dV": "sampling volume [L]",
-    "SSE_points": "SSE of this realisation at the 15 measurement points common to all models (Section 6, "
-    "point 1; records.COLUMNS)",
+    "SSE_points": "SSE of this realisation at the 15 measurement points common to all models (the run tables' "
+    "`SSE_points`; Section 6, point 1) [1/L²]",
     "COMIC_points": "2 ln(SSE_points / 15) - ln dV of this realisation, Eq. 43 at the measurement points",
 }
 REALISATION_COLUMNS = list(REALISATION_COLUMN_DOCS)
@@ -260,7 +278,7 @@ def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataF
             parts.append(
                 pd.DataFrame(
                     {
-                        "label": case.label(n=False),
+                        "label": case_label(case, n=False),
                         **{c: [v] * len(rows) for c, v in case.columns().items()},
                         "time": rows["time_requested"].to_numpy(dtype=np.float64),
                         "time_step": rows["time"].to_numpy(dtype=np.float64),
@@ -291,16 +309,17 @@ CONVENTIONS = {
     "COMIC_of_mean_SSE": ("n_opt_of_mean_SSE", "COMIC of the mean SSE over realisations"),
 }
 ARGMIN_COLUMN_DOCS = {
-    "label": "legend label of the model (Case.label)",
+    "label": "legend label of the model (without N)",
     **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},
     "time": "requested time [T]",
-    "convention": "what is minimised over N: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
-    "n": "particles (FD: intervals): one N of the model's grid",
-    "share": "fraction of bootstrap resamples whose argmin over N is this N (shares of a model, "
-    "time and convention sum to 1; with no resampling, 1 at the point estimate)",
+    "convention": "what is minimised over N: " + " or ".join(f"`{k}` ({what})" for k, (_, what) in CONVENTIONS.items()),
+    "n": "one N of the model's grid (particles; FD: intervals)",
+    "share": "fraction of resamples whose argmin is this N (the shares of a model, time and convention add up to 1; "
+    "without resampling 1 at the point estimate)",
     "n_realisations": "realisations of this N that were resampled (1: held fixed)",
-    "n_resamples": "bootstrap resamples drawn (0: every N has one realisation, nothing to resample)",
-    "ci_lo": "lower end of the 95 % interval of the argmin N of this model, time and convention (argmin_bootstrap)",
+    "n_resamples": "resamples drawn (0: every N has one realisation, nothing to resample)",
+    "ci_lo": "lower end of the 95 % interval of the argmin for this model, time and convention, a grid N "
+    "(`argmin_bootstrap`; the same on every row of that group)",
     "ci_hi": "its upper end",
 }
 ARGMIN_COLUMNS = list(ARGMIN_COLUMN_DOCS)
@@ -416,7 +435,7 @@ def comic_argmin(
                 for n, sample, share in zip(ns, samples, shares):
                     rows.append(
                         {
-                            "label": model.label(),
+                            "label": case_label(model),
                             **model.columns(),
                             "time": time,
                             "convention": convention,
@@ -441,7 +460,7 @@ def _bootstrap_columns(model, time: float, minimum: dict, g: pd.DataFrame, argmi
         rows = rows_of(argmin[(argmin["convention"] == convention) & (argmin["time"] == time)], model)
         if sorted(rows["n"]) != sorted(g["n"]):
             raise ValueError(
-                f"{model.label()}, t = {time:g}: the bootstrap has N = {sorted(rows['n'].tolist())}, "
+                f"{case_label(model)}, t = {time:g}: the bootstrap has N = {sorted(rows['n'].tolist())}, "
                 f"the COMIC table N = {sorted(g['n'].tolist())}; they must come from the same ensembles"
             )
         at_opt = rows[rows["n"] == minimum[prefix]].iloc[0]

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import Case, by_model, case_of_table
+from ..core.labels import case_label
 from ..core.registry import SCHEME_DOCS
 
 
@@ -20,7 +21,7 @@ def _pick(tables, case: Case) -> pd.DataFrame:
     for df in tables:
         if case_of_table(df) == case:
             return df
-    raise KeyError(f"no table for {case.label()}")
+    raise KeyError(f"no table for {case_label(case)}")
 
 
 COLUMNS = ("claim", "paper", "reproduced", "tolerance", "passed")  # of the claims table
@@ -131,7 +132,7 @@ def ensemble_claims(summaries: list[pd.DataFrame], tol_hc: float, defaults: dict
             d = last.H_C_mean - last.H_C_analytic
             out.append(
                 _claim(
-                    f"adaptive-kernel PT matches analytic H_C ({case.label()})",
+                    f"adaptive-kernel PT matches analytic H_C ({case_label(case)})",
                     "close at t = 1000",
                     f"{d:+.4f} nats ({int(last.n_realisations)} realisations)",
                     f"{tol_hc} nats",
@@ -223,7 +224,7 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
         inside = (fd["n_opt"] >= lo) & (fd["n_opt"] <= hi)
         out.append(
             _claim(
-                f"{model.label()}: COMIC minimal near 3000 nodes at almost every time",
+                f"{case_label(model)}: COMIC minimal near 3000 nodes at almost every time",
                 "~3000",
                 ", ".join(f"t={t:g}: {n}" for t, n in zip(fd["time"], fd["n_opt"])),
                 f"N_opt in [{lo}, {hi}]",
@@ -243,7 +244,7 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
                 n_opt = int(row[col])
                 out.append(
                     _claim(
-                        f"{model.label()}: COMIC minimum at t = {row['time']:g} ({how}; {_model_words(model)[0]})",
+                        f"{case_label(model)}: COMIC minimum at t = {row['time']:g} ({how}; {_model_words(model)[0]})",
                         f"{paper}, the authors' code",
                         f"{_model_words(model)[1]} {_optimum_text(row, col)}",
                         f"N_opt in [{lo}, {hi}]",
@@ -256,7 +257,7 @@ def comic_claims(minima: pd.DataFrame, comic: pd.DataFrame, tol: dict) -> list[d
         f = flatness(sph, min_n)
         out.append(
             _claim(
-                f"{model.label()}: COMIC roughly flat for N >= {min_n} ({_model_words(model)[0]})",
+                f"{case_label(model)}: COMIC roughly flat for N >= {min_n} ({_model_words(model)[0]})",
                 "flat, worse only for N < 100",
                 f"largest distance from the minimum {f['ratio']:.2f} combined std, at N={f['n_worst']} "
                 f"(N_opt={f['n_opt']}, t = {sph['time'].iloc[0]:g})",

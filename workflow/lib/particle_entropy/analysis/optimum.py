@@ -39,9 +39,10 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import APPLIES, Case, SettingError
+from ..core.labels import case_label
 from ..core.registry import MEASUREMENT_POINTS
-from ..core.settings import PAPER
 from ..core.runconfig import first_step
+from ..core.settings import PAPER
 from ..core.timegrid import step_count
 from .aggregate import (
     CONVENTIONS,
@@ -73,37 +74,38 @@ REASONS = (
 RESULT_COLUMN_DOCS = {
     "search": "name of the search (config key under `optimum`)",
     "label": "legend label of the searched model",
-    "time": "time at which COMIC is judged [T]",
-    "convention": "what is minimised: " + "; ".join(f"{k} = {what}" for k, (_, what) in CONVENTIONS.items()),
-    "measure": "where SSE is taken: " + "; ".join(f"{k} = {v}" for k, v in MEASURES.items()),
-    "time_volume": "the time step is part of the sampling volume: COMIC - ln(mean dt) (section 6, point 3)",
-    "over": "the searched dimension: " + "; ".join(f"{k} = {v}" for k, v in OVER.items()),
-    "n": "N of this point (particles; FD: intervals): the searched value when over = n",
-    "dt_growth": "time-step growth factor of this point: the searched value when over = dt_growth",
+    "time": "time at which COMIC is judged (nearest recorded step) [T]",
+    "convention": "what is minimised over N: " + " or ".join(f"`{k}` ({what})" for k, (_, what) in CONVENTIONS.items()),
+    "measure": "where SSE is taken: " + "; ".join(f"`{k}`, {v}" for k, v in MEASURES.items()),
+    "time_volume": "the time step is part of the sampling volume: COMIC - ln(mean dt), mean dt = time / steps "
+    "(Section 6, point 3)",
+    "over": "the searched dimension: " + "; ".join(f"`{k}`, {v}" for k, v in OVER.items()),
+    "n": "N of this point (particles; FD: intervals): the searched value when `over` is `n`",
+    "dt_growth": "time-step growth factor of this point: the searched value when `over` is `dt_growth`",
     "realisations": "realisations of this point",
     "round_added": "round in which this point was first visited (0 = the first coarse points)",
-    "COMIC_mean": "mean over realisations of per-realisation COMIC (Eq. 43) [nats]",
+    "COMIC_mean": "mean over realisations of per-realisation COMIC, Eq. 43",
     "COMIC_std": "its standard deviation over realisations (NaN for one realisation)",
-    "COMIC_se": "standard error of the mean (std / sqrt(realisations); 0 for FD)",
+    "COMIC_se": "standard error of the mean, std / sqrt(realisations) (0 for FD)",
     "share": "fraction of bootstrap resamples whose lowest visited point is this one",
-    "core_s": "measured wall time of this point's runs, summed over realisations (step timings) [s]",
+    "core_s": "wall time of this point's runs, the sum of their steps' `wall_s` over realisations [s]",
     "best": "the visited value (N or dt growth) with the lowest value of the search's convention",
     "optimum": "the fitted optimum: vertex of a quadratic in log N (log(dt_growth - 1)), weighted by "
-    "realisations, through the visited values within two of `best` (`best` itself at an end of them)",
-    "ci_lo": "lower end of the 95 % bootstrap interval of the optimum, widened to every visited value whose mean "
-    "COMIC is within 2 combined standard errors of best's (FD, deterministic: the visited value below best)",
-    "ci_hi": "its upper end (FD: the visited value above best)",
-    "bracket_lo": "the largest visited value <= ci_lo (the lowest visited if none): the minimum lies above it",
-    "bracket_hi": "the smallest visited value >= ci_hi (the highest visited if none): the minimum lies below it",
-    "reason": "why the search stopped: " + ", ".join(REASONS),
+    "realisations, through the visited values within two of `best`; `best` at an end of the visited values",
+    "ci_lo": "lower end of the 95 % bootstrap percentile interval of `optimum`, widened to every visited value whose "
+    "mean COMIC is within 2 combined standard errors of `best`'s (FD, deterministic: the visited value below `best`)",
+    "ci_hi": "its upper end (FD: the visited value above `best`)",
+    "bracket_lo": "the largest visited value <= `ci_lo` (the lowest visited if none): the minimum lies above it",
+    "bracket_hi": "the smallest visited value >= `ci_hi` (the highest visited if none): the minimum lies below it",
+    "reason": "why the search stopped: " + ", ".join(f"`{r}`" for r in REASONS),
     "rounds": "rounds evaluated",
-    "runs_spent": "runs (realisations x N) the search used",
-    "core_s_spent": "sum of core_s over every visited N [s]",
+    "runs_spent": "runs (realisations × N) the search used",
+    "core_s_spent": "sum of `core_s` over the visited points [s]",
     "full_sweep_core_s": "estimated cost of a full grid sweep giving the same bracket: every value of a "
     "grid even in log N (log(dt_growth - 1)) over the range, with the step half the bracket's width in "
     "that log (a grid brackets its minimum "
     "between the argmin's neighbours), each with the search's largest realisation count, at the "
-    "measured cost per run (cost_model) [s]",
+    "measured cost per run (`cost_model`) [s]",
 }
 RESULT_COLUMNS = list(RESULT_COLUMN_DOCS)
 
@@ -140,8 +142,8 @@ class Search:
     def label(self) -> str:
         """The searched model's legend label (a growth search: at its N, without a growth)."""
         if self.over == "dt_growth":
-            return replace(self.model, dt_growth=PAPER["dt_growth"]).label()
-        return self.model.label()
+            return case_label(replace(self.model, dt_growth=PAPER["dt_growth"]))
+        return case_label(self.model)
 
     def u(self, x):
         """The searched value on the axis the search is even in: log N, or log(dt_growth - 1)."""

@@ -37,13 +37,18 @@ CASE_DIR = "/".join(seg.format("{" + w + "}") for w, seg in PATH_SEGMENTS.values
 MODEL_COLUMNS = ("method", "kernel", "eta", "truncation", "dt_growth", "scheme")
 CASE_COLUMNS = ("method", "kernel", "n", "eta", "truncation", "dt_growth", "scheme")
 COLUMN_DOCS = {
-    "method": "pt (random walks), mtpt (mass transfer) or fd (finite differences)",
-    "kernel": "pt: bins | fixed | adaptive; mtpt: collision | sph; fd: implicit | explicit",
-    "n": "particles (FD: intervals)",
-    "eta": "fraction of D by mass transfer (PT, FD: 1)",
-    "truncation": "transfer kernel cut at this many kernel widths; inf = whole Gaussian",
-    "dt_growth": "time-step growth factor dt_{k+1} / dt_k (1: fixed step)",
-    "scheme": "; ".join(f"{k}: {v}" for k, v in SCHEME_DOCS.items()),
+    "method": "`pt` (random-walk particle tracking), `mtpt` (mass-transfer particle tracking) or `fd` (implicit or "
+    "explicit finite differences); in figure source data also `analytic` for a reference curve",
+    "kernel": "`pt`: `bins`, `fixed` or `adaptive` (how the density is reconstructed); `mtpt`: `collision` (Eq. 17) "
+    "or `sph` (Eqs. 20, 21, 26); `fd`: `implicit` or `explicit` (time scheme)",
+    "n": "number of particles; for FD the number of grid intervals (the grid has N + 1 nodes)",
+    "eta": "fraction of D carried by mass transfer, the rest by random walks (MTPT); 1 for PT and FD",
+    "truncation": "MTPT transfer kernel cut at this many kernel widths; `inf` for the whole Gaussian (PT and FD "
+    "always `inf`) [kernel widths]",
+    "dt_growth": "time-step growth factor dt_(k+1) / dt_k; 1 is a fixed step (FD always 1)",
+    "scheme": "how MTPT transfers mass: "
+    + "; ".join(f"`{k}` ({v})" for k, v in SCHEME_DOCS.items())
+    + "; PT and FD always `symmetric`",
 }
 # Which dimensions apply to which method; the others hold NEUTRAL values.
 APPLIES = {
@@ -220,16 +225,6 @@ class Case:
             if self.method in APPLIES[dim] and getattr(self, dim) != PAPER[dim]:
                 out[dim] = getattr(self, dim)
         return out
-
-    def label(self, n: bool = True) -> str:  # TEMPORARY shim, removed once callers use labels.case_label
-        from .labels import case_label
-
-        return case_label(self, n)
-
-    def variant_parts(self) -> list[str]:  # TEMPORARY shim
-        from .labels import variant_parts
-
-        return variant_parts(self)
 
     def sort_key(self) -> tuple:
         return (

@@ -1,7 +1,7 @@
 """Legend text of cases, kernels and schemes: presentation only, so no simulation hashes it.
 
 Tables that carry a ``label`` column (summaries, COMIC tables, minima) and the figures import
-this module; a simulation job does not (tests/test_labels.py holds that), so editing a label
+this module; a simulation job does not (a test in tests/test_workflow.py holds that), so editing a label
 redraws figures and rebuilds those tables but reruns no simulation.
 """
 

@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from ..core import measures as M
-from ..core.settings import PAPER
 from ..core.runconfig import RunConfig
+from ..core.settings import PAPER
 from ..models import fd
 
 REFERENCES = ("unit", "exact", "fd_mass", "images")

@@ -30,32 +30,32 @@ import numpy as np
 import pandas as pd
 
 from ..core.records import Recorder
+from ..core.registry import SHEAR_CASES
 from ..core.runconfig import MAX_SEED, SettingError, check_range
 from ..core.timegrid import MAX_STEPS
 
-CASES = ("rw_nodrift", "rw_drift", "mt")
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
 V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
 KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
 
 STEP_COLUMNS = {
     "step": "time-step index, 0 = initial condition",
-    "time": "time at the end of the step [T]",
+    "time": "time at the end of the step (step × dt) [T]",
     "mass_total": "total particle mass (1 at t = 0)",
     "mass_min": "smallest particle mass",
-    "wall_fraction": f"rw: fraction of all particles, mt: fraction of mass, within {WALL_BAND} of a wall "
-    f"(uniform in y: {2 * WALL_BAND})",
-    "mean_y": "rw: mean y of all particles; mt: mass-weighted mean y [L]",
-    "substeps": "mass-transfer substeps taken to keep masses non-negative (0: no transfer)",
-    "max_offdiag_beta": "beta * max_i sum_{j != i} P_ij before splitting (0: no transfer)",
-    "n_pairs": "particle pairs within the kernel cut-off (mt; 0 for random walks)",
-    "wall_s": "wall-clock seconds spent in the step",
+    "wall_fraction": f"share of particles (random walks) or of mass (`mt`) within {WALL_BAND} of a wall; "
+    f"{2 * WALL_BAND} if spread evenly in y",
+    "mean_y": "mean lateral position: of all particles (random walks), mass-weighted (`mt`) [L]",
+    "substeps": "mass-transfer substeps taken to keep masses non-negative (0 for random walks and step 0)",
+    "max_offdiag_beta": "beta × the largest row sum of P_ij over j ≠ i before splitting (0: no transfer)",
+    "n_pairs": "particle pairs within the kernel cut-off (`mt`; 0 for random walks)",
+    "wall_s": "wall-clock seconds spent in the step [s]",
 }
 STATE_COLUMNS = {
     "x": "final position along the flow, in [0, length) [L]",
     "y": "final lateral position, in [0, 1] [L]",
     "mass": "final particle mass",
-    "case": "one of " + ", ".join(CASES),
+    "case": "shear case: " + ", ".join(f"`{c}`" for c in SHEAR_CASES),
     "seed": "random seed",
 }
 
@@ -79,8 +79,8 @@ class ShearConfig:
 
     def check(self) -> None:
         """Raise SettingError naming the first setting outside its allowed range."""
-        if self.case not in CASES:
-            raise SettingError("case", self.case, f"one of {', '.join(CASES)}")
+        if self.case not in SHEAR_CASES:
+            raise SettingError("case", self.case, f"one of {', '.join(SHEAR_CASES)}")
         if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or self.n < 1:
             raise SettingError("n", self.n, "an integer >= 1")
         check_range("length", self.length, 0.0, math.inf, open_low=True)

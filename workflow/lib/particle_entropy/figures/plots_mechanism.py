@@ -20,8 +20,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..core.case import Case, rows_of
+from ..core.labels import case_label, variant_parts
 from ..numerics.kernels import truncated_variance_fraction
-from .plots import (
+from .fig9 import PAPER_STYLES as FIG9_STYLES
+from .style import (
     BLACK,
     BLUE,
     GREEN,
@@ -31,13 +33,13 @@ from .plots import (
     SKY,
     VERMILLION,
     Series,
-    style_axes,
     distinct_models,
+    draw,
+    mark_no_data,
     n_ticks,
     rows_nearest,
-    mark_no_data,
-    draw,
     source_table,
+    style_axes,
     styles,
 )
 
@@ -56,10 +58,10 @@ def truncation_floor(D: float, t: float, fraction: float, omega: float) -> float
 
 def _label(model: Case, equations: Case | None) -> str:
     """A model by what it changes from the paper's equations."""
-    text = ", ".join(model.variant_parts())
+    text = ", ".join(variant_parts(model))
     if model == equations:
         return "paper's equations (whole Gaussian)" + (f", {text}" if text else "")
-    return text or model.label(n=False)
+    return text or case_label(model, n=False)
 
 
 def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final) -> list[Series]:
@@ -85,7 +87,7 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
         out.append(
             Series(
                 "a",
-                f"{model.label(n=False)}: mean COMIC",
+                f"{case_label(model, n=False)}: mean COMIC",
                 legend=_label(model, equations),
                 y_name="COMIC",
                 y=mu,
@@ -100,7 +102,7 @@ def _comic_series(comic: pd.DataFrame, models, cases, style, equations, t_final)
         out.append(
             Series(
                 "b",
-                f"{model.label(n=False)}: SSE/N",
+                f"{case_label(model, n=False)}: SSE/N",
                 legend="_" + _label(model, equations),  # named in panel (a)
                 y_name="SSE/N",
                 y=sse,
@@ -135,7 +137,7 @@ def _floor_series(floors: pd.DataFrame, comic: pd.DataFrame, models, cases, styl
         out.append(
             Series(
                 "b",
-                f"{model.label(n=False)}: lattice floor",
+                f"{case_label(model, n=False)}: lattice floor",
                 legend=text,
                 case=model,
                 x_name="N",
@@ -177,7 +179,7 @@ def _paired_series(realisations: pd.DataFrame, models, style, equations, t_final
         out.append(
             Series(
                 "c",
-                f"{model.label(n=False)}: COMIC minus the equations' (same seeds)",
+                f"{case_label(model, n=False)}: COMIC minus the equations' (same seeds)",
                 legend=_label(model, equations),
                 case=model,
                 x_name="N",
@@ -228,7 +230,9 @@ def _fd_series(fd: pd.DataFrame) -> list[Series]:
 def fig9_mechanism(comic, realisations, fd, cases, *, D: float, t_final: float, omega: float, floors=None):
     """The four panels (module docstring) -> (Figure, source data)."""
     models = distinct_models(cases)
-    style = {m: {**st, "color": PALETTE[k % len(PALETTE)]} for k, (m, st) in enumerate(styles("fig9", cases).items())}
+    style = {
+        m: {**st, "color": PALETTE[k % len(PALETTE)]} for k, (m, st) in enumerate(styles(cases, FIG9_STYLES).items())
+    }
     # the reference of panel (c): the first model with the paper's symmetric matrix and whole kernel
     equations = next((m for m in models if m.scheme == "symmetric" and m.truncation is None), None)
     fig = Figure(figsize=(12.5, 10.0), layout="constrained")

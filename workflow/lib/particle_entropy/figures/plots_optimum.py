@@ -17,7 +17,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from .plots import BLACK, GREY, VERMILLION, new_figure, style_axes
+from .style import BLACK, GREY, VERMILLION, new_figure, style_axes
 
 BRACKET, INTERVAL = "#DCE9F5", "#9DC3E6"  # light and dark blue bands
 

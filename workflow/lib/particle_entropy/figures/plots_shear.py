@@ -1,7 +1,7 @@
 """Fig. 10 (Appendix B): shear flow dispersed by random walks (with and without div D drift) or mass transfer.
 
 ``fig10`` takes the final particle tables of ``shear2d.run_shear`` (columns x, y, mass, case,
-seed) and returns ``(Figure, source data)``: the figure (save it with ``plots.save_figure``,
+seed) and returns ``(Figure, source data)``: the figure (save it with ``style.save_figure``,
 byte-stable PNG/PDF) and a tidy table of what it plots, columns in ``SOURCE_COLUMNS``.
 """
 
@@ -13,8 +13,9 @@ import pandas as pd
 from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
-from .plots import save_figure  # noqa: F401  (re-exported for the Fig. 10 script)
-from ..experiments.shear2d import CASES, WALL_BAND
+from ..core.registry import SHEAR_CASES
+from ..experiments.shear2d import WALL_BAND
+from .style import save_figure  # noqa: F401  (re-exported for the Fig. 10 script)
 
 TITLES = {
     "rw_nodrift": "random walk, no drift correction",
@@ -26,17 +27,18 @@ MASS_FLOOR = 1e-6  # the paper shows only particles with mass > 1e-6
 MASS_CMAP = ListedColormap(matplotlib.colormaps["plasma"](np.linspace(0.0, 0.8, 256)), name="plasma_08")
 N_BINS = 20  # y bins of width 0.05 = WALL_BAND, so the outer bins are the wall bands
 SOURCE_COLUMNS = {
-    "figure": "fig10",
-    "panel": "panel letter: a-c particles, d-f mass against y",
-    "series": "what the points are: the case's title (a-c) or the legend label of a histogram or line (d-f)",
-    "case": "shear case: " + ", ".join(CASES),
-    "seed": "random seed of the realisation",
-    "n": "particles in the run (all of them, massless ones included)",
-    "x_name": "x (a-c) or y bin centre (d-f)",
+    "figure": "`fig10`",
+    "panel": f"a-c: particles with mass > {MASS_FLOOR:g} coloured by mass; d-f: mass against y",
+    "series": "the case's title (a-c), or the legend label of the histogram or line (d-f)",
+    "case": "shear case: " + ", ".join(f"`{c}`" for c in SHEAR_CASES),
+    "seed": "seed of the realisation",
+    "n": "particles in the run, massless ones included",
+    "x_name": "`x` (a-c), `y bin centre` (histograms) or `y` (the uniform-density line)",
     "x": "its value [L]",
-    "y_name": "y (a-c) or the normalised mass (or walker) density per unit y (d-f)",
-    "y": "its value ([L] in a-c, dimensionless in d-f)",
-    "mass": f"particle mass, the colour in a-c (only particles with mass > {MASS_FLOOR:g} are drawn); NaN in d-f",
+    "y_name": "`y` (a-c); `mass density`, `walker density` or `density` (d-f)",
+    "y": "its value: position y in a-c; in d-f the mass (or walker count) per unit y, normalised to integrate to 1 "
+    "over 0 < y < 1 [L in a-c, 1/L in d-f]",
+    "mass": f"particle mass, the colour of a-c (only particles with mass > {MASS_FLOOR:g} are drawn); NaN in d-f",
 }
 
 
@@ -73,7 +75,7 @@ def source_data(states: list[pd.DataFrame]) -> pd.DataFrame:
     edges = np.linspace(0.0, 1.0, N_BINS + 1)
     mid = 0.5 * (edges[1:] + edges[:-1])
     parts = []
-    for k, case in enumerate(c for c in CASES if c in by_case):
+    for k, case in enumerate(c for c in SHEAR_CASES if c in by_case):
         df = by_case[case]
         s = df[df["mass"].to_numpy(float) > MASS_FLOOR]
         title, n = TITLES.get(case, case), len(df)

@@ -1,6 +1,6 @@
 """Content hashes of the library code a task runs, so a workflow reruns exactly what an edit changes.
 
-``code_version("plots")`` hashes figures/plots.py and every package module it imports, directly or
+``code_version("fig7")`` hashes figures/fig7.py and every package module it imports, directly or
 not (found by reading the import statements, so a new import is followed without a list to
 keep up to date). A rule that passes this hash as a parameter reruns when, and only when, the
 content of that code changes: restoring a file's old content, or touching it, reruns nothing.

@@ -115,8 +115,10 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
 
 
 def check_config(config: Mapping, schema: Mapping | None = None) -> None:
-    """Everything a dry run checks: the schema, then every rule between fields (sweeps.check_sweeps)."""
-    from .sweeps import check_sweeps
+    """Everything a dry run checks: the schema, then every rule between fields (sweeps.check_sweeps),
+    and every adaptive search, which a dry run checks only when a target needs it."""
+    from .sweeps import check_optimum, check_sweeps
 
     check_schema(config, load_schema() if schema is None else schema)
     check_sweeps(config)
+    check_optimum(config)

@@ -2,8 +2,8 @@
 
 The schema (workflow/schemas/config.schema.yaml) is hand-written except between the lines
 ``# BEGIN generated: <block>`` and ``# END generated: <block>``: there this module writes the
-entries of physics, time, numerics and case_defaults (type, range or enum, default, description)
-and the $defs of the case dimensions, from ``settings.SETTINGS`` and the registry. Snakemake
+entries of physics, time, numerics and case_defaults (type, range or enum, default, description),
+the $defs of the case dimensions and the shear cases' enum, from ``settings.SETTINGS`` and the registry. Snakemake
 reads the schema from a file, so the generated lines are committed;
 ``python -m particle_entropy.pipeline.schemagen --check`` (and tests/test_settings.py) fails
 when they are stale, ``--write`` rewrites them.
@@ -18,7 +18,7 @@ import re
 import sys
 from pathlib import Path
 
-from ..core.registry import ALL_KERNELS, METHODS
+from ..core.registry import ALL_KERNELS, METHODS, SHEAR_CASES
 from ..core.settings import SETTINGS, Setting
 from .configcheck import SCHEMA_PATH
 
@@ -91,6 +91,7 @@ def blocks() -> dict[str, list[tuple[str, dict]]]:
         else:
             out[s.section].append((key, entry(s)))
     out["defs"] = defs
+    out["shear_cases"] = [("items", {"type": "string", "enum": list(SHEAR_CASES)})]
     return out
 
 
@@ -104,7 +105,7 @@ def render(text: str) -> str:
         if name not in generated:
             raise ValueError(f"schema block {name!r} is not one this module writes: {', '.join(generated)}")
         seen.add(name)
-        lines = [f"{indent}# BEGIN generated: {name} (from core/settings.py by `{COMMAND}`; do not edit)\n"]
+        lines = [f"{indent}# BEGIN generated: {name} (from core/settings.py and registry.py by `{COMMAND}`; do not edit)\n"]
         lines += [f"{indent}{key}: {_yaml(value)}\n" for key, value in generated[name]]
         return "".join(lines) + f"{indent}# END generated: {name}\n"
 

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ..core.case import CASE_DIR, Case, SettingError
+from ..core.labels import case_label
 from ..core.runconfig import MAX_SEED, RunConfig, first_step
 from ..core.settings import PAPER, SETTINGS
 
@@ -97,7 +98,9 @@ def check_lattice(config: Mapping) -> None:
     for case in lattice_cases(config):
         if case.method != "mtpt" or case.eta != 1.0:
             raise SettingError(
-                "mechanism.lattice", case.label(), "mtpt cases at eta = 1 only (random walks would leave the lattice)"
+                "mechanism.lattice",
+                case_label(case),
+                "mtpt cases at eta = 1 only (random walks would leave the lattice)",
             )
 
 
@@ -193,12 +196,14 @@ SHARED_KEYS["dt0"] = _first_step_key
 
 
 def check_seeds(config: Mapping) -> None:
-    """Realisation r of every case (and of every adaptive search, up to its max_realisations) uses
-    seed base_seed + r, stored as int64 in every table."""
+    """Realisation r of every case uses seed base_seed + r, stored as int64 in every table (an
+    adaptive search's seeds, up to its max_realisations: check_search)."""
     base = int(config["base_seed"])
     counts = [e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)]
-    counts += [search.max_realisations for search in optimum_searches(config).values()]
-    most = max(counts, default=1)
+    _check_seed_count(base, max(counts, default=1))
+
+
+def _check_seed_count(base: int, most: int) -> None:
     if base + most - 1 > MAX_SEED:
         raise SettingError(
             "base_seed",
@@ -221,42 +226,64 @@ def check_shear(config: Mapping) -> None:
             raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
 
 
-def optimum_searches(config: Mapping) -> dict:
-    """The adaptive COMIC searches of config `optimum` (optimum.Search), by name."""
-    from ..analysis.optimum import Search
+class Searches(Mapping):
+    """The adaptive COMIC searches of config `optimum` (optimum.Search) by name, each built and
+    checked (check_search) when it is first used: a search that no requested target needs
+    cannot block a run, as when a small config is layered over config.yaml's searches."""
 
-    return {name: Search.from_config(name, spec, config) for name, spec in config.get("optimum", {}).items()}
+    def __init__(self, config: Mapping, available: float | None = None):
+        self._config, self._available, self._built = config, available, {}
+        self._names = list(config.get("optimum", {}) or {})
+
+    def __getitem__(self, name: str):
+        if name not in self._names:
+            raise KeyError(name)
+        if name not in self._built:
+            self._built[name] = check_search(name, self._config, self._available)
+        return self._built[name]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
 
 
-def optimum_largest_jobs(config: Mapping) -> list[tuple[str, Ensemble]]:
-    """Per search, its largest possible simulation jobs: both ends of its range (the top N; the
+def optimum_searches(config: Mapping, available: float | None = None) -> Searches:
+    """The adaptive COMIC searches of config `optimum`, by name, checked when used (Searches)."""
+    return Searches(config, available)
+
+
+def optimum_largest_jobs(search) -> list[Ensemble]:
+    """A search's largest possible simulation jobs: both ends of its range (the top N; the
     smallest growth, most steps) with the most seeds one block can hold (the first round's
     realisations, or a doubling up to max_realisations)."""
-    out = []
-    for name, search in optimum_searches(config).items():
-        seeds = 1 if search.fd else max(search.initial_realisations, search.max_realisations // 2)
-        key = f"optimum.{name}.{'growth_range' if search.over == 'dt_growth' else 'n_range'}"
-        out += [(key, Ensemble(search.case_at(x), seeds)) for x in search.grid(2)]
-    return out
+    seeds = 1 if search.fd else max(search.initial_realisations, search.max_realisations // 2)
+    return [Ensemble(search.case_at(x), seeds) for x in search.grid(2)]
 
 
 def check_memory(config: Mapping, available: float) -> None:
-    """Every simulation job must fit in ``available`` bytes (memory.estimate_mb of its seed block)."""
-    from ..core.memory import estimate_mb
-
+    """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
+    of its seed block; an adaptive search's jobs: check_search)."""
     jobs = [
         (f"{name}.n", ens, max(b - a + 1 for a, b in seed_blocks(ens, config)))
         for name, spec in case_sections(config).items()
         for ens in spec_ensembles(spec, config)
     ]
-    jobs += [(key, ens, ens.realisations) for key, ens in optimum_largest_jobs(config)]
+    _check_jobs_fit(jobs, config, available)
+
+
+def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
+    """SettingError naming the key of the first (key, ensemble, seeds) job that needs more memory."""
+    from ..core.memory import estimate_mb
+
     for key, ens, runs in jobs:
         need = estimate_mb(run_config(ens.case, config), runs) * 2**20
         if need > available:
             raise SettingError(
                 key,
                 ens.case.n,
-                f"an N whose job fits in this machine's memory: {ens.case.label()} needs about "
+                f"an N whose job fits in this machine's memory: {case_label(ens.case)} needs about "
                 f"{need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available (or run it on a cluster)",
             )
 
@@ -266,25 +293,41 @@ def _case_error(e: SettingError, where: str, case: Case) -> SettingError:
     names that key and the case, any other the case's own key under ``where``."""
     if e.name in SHARED_KEYS:
         key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
-        return SettingError(key, e.value, f"{e.allowed} (for {where}, {case.label()})")
+        return SettingError(key, e.value, f"{e.allowed} (for {where}, {case_label(case)})")
     return SettingError(f"{where}.{e.name}", e.value, e.allowed)
 
 
-def check_optimum(config: Mapping) -> None:
-    """Every adaptive search (config `optimum`) must be able to run: a model that exists, a range
-    with room for a minimum, a budget of at least its first round, a time within t_final
-    (optimum.Search.check) and runs valid at both ends of its range (seeds: check_seeds)."""
-    for name, search in optimum_searches(config).items():
-        where = f"optimum.{name}"
-        key = "growth_range" if search.over == "dt_growth" else "n_range"
-        for x in search.grid(2):  # the range's ends (FD: even)
-            case = search.case_at(x)
-            try:
-                run_config(case, config)
-            except SettingError as e:
-                if e.name in ("n", "dt_growth"):
-                    raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
-                raise _case_error(e, f"{where}.case", case) from None
+def check_search(name: str, config: Mapping, available: float | None = None):
+    """The adaptive search ``optimum.<name>`` (optimum.Search), refused unless it can run: a model
+    that exists, a range with room for a minimum, a budget of at least its first round, a time
+    within t_final (optimum.Search.check), runs valid at both ends of its range, its seeds within
+    int64 and (given ``available`` bytes) its largest jobs within memory."""
+    from ..analysis.optimum import Search
+
+    search = Search.from_config(name, config["optimum"][name], config)
+    where = f"optimum.{name}"
+    key = "growth_range" if search.over == "dt_growth" else "n_range"
+    for x in search.grid(2):  # the range's ends (FD: even)
+        case = search.case_at(x)
+        try:
+            run_config(case, config)
+        except SettingError as e:
+            if e.name in ("n", "dt_growth"):
+                raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
+            raise _case_error(e, f"{where}.case", case) from None
+    _check_seed_count(int(config["base_seed"]), search.max_realisations)
+    if available is not None:
+        _check_jobs_fit(
+            [(f"{where}.{key}", e, e.realisations) for e in optimum_largest_jobs(search)], config, available
+        )
+    return search
+
+
+def check_optimum(config: Mapping, available: float | None = None) -> None:
+    """Every adaptive search of config `optimum` (check_search): what check-config judges, since
+    it does not know which targets will be asked for."""
+    for name in config.get("optimum", {}) or {}:
+        check_search(name, config, available)
 
 
 def check_sweeps(config: Mapping) -> None:
@@ -313,7 +356,7 @@ def check_sweeps(config: Mapping) -> None:
             except SettingError as e:
                 if e.name in SHARED_KEYS:  # a shared setting, wrong for this case: name both
                     key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
-                    raise SettingError(key, e.value, f"{e.allowed} (for {where}, {case.label()})") from None
+                    raise SettingError(key, e.value, f"{e.allowed} (for {where}, {case_label(case)})") from None
                 raise SettingError(f"{where}.{e.name}", e.value, e.allowed) from None
         particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
         for n in spec["n"] if particles else []:
@@ -323,8 +366,7 @@ def check_sweeps(config: Mapping) -> None:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     check_lattice(config)
     check_seeds(config)
-    check_shear(config)
-    check_optimum(config)
+    check_shear(config)  # the optimum searches are checked when a target uses them (Searches)
     t_final = float(config["physics"]["t_final"])
     for key, times in (
         ("comic_times", config.get("comic_times", [])),

@@ -1,0 +1,164 @@
+"""Tables that can no longer be trusted, found before a run; and the full-disk message.
+
+Beside each table a ``<name>.sha256`` file records the SHA-256 of its bytes (io.write_parquet);
+``corrupt_tables`` finds every table whose bytes no longer match (a truncation, a flipped bit,
+an empty file) so that the workflow can set it aside and rebuild it. Given a digests file, it
+remembers each table's SHA-256 against the table's size, mtime and inode (as DVC does) and reads
+a table again only when one of them changed. Only the workflow's main process imports this
+module, never a job, so editing it reruns no rule.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+
+from .io import checksum_path, write_bytes_atomically
+
+CORRUPT_SUFFIX = ".corrupt"
+MAGIC = b"PAR1"
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """SHA-256 of the bytes of the file at ``path`` (hex), read in blocks."""
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def table_problem(path: str | os.PathLike, digest: str | None = None) -> str | None:
+    """Why the table at ``path`` cannot be trusted, or None: its bytes differ from its recorded
+    checksum, or (without one) it lacks the Parquet magic bytes at either end. ``digest``: the
+    SHA-256 of its bytes when already known (corrupt_tables' cache); else they are read."""
+    path = Path(path)
+    if not path.is_file():  # never read a pipe (it would block) or a folder
+        return "it is a folder, not a table" if path.is_dir() else "it is not a regular file"
+    recorded = checksum_path(path)
+    if recorded.exists():
+        text = recorded.read_text()
+        want = text.split()[0] if text.strip() else ""
+        got = digest or file_sha256(path)
+        return None if got == want else f"its SHA-256 {got[:12]}... differs from the recorded {want[:12] or 'nothing'}"
+    with path.open("rb") as f:
+        size = os.fstat(f.fileno()).st_size
+        head = f.read(4)
+        f.seek(max(size - 4, 0))
+        tail = f.read(4)
+    if size < 12 or head != MAGIC or tail != MAGIC:
+        return f"it is not a whole Parquet file ({size} bytes, no PAR1 at both ends)"
+    return None
+
+
+DIGESTS_VERSION = 1
+# A table changed less than this before it was hashed is hashed again next time: a write in the
+# same tick of the file system's clock (or within its 1-2 s granularity) would keep the mtime.
+SETTLED_NS = 2 * 10**9
+
+
+def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = None) -> dict[Path, str]:
+    """Every table below ``root`` that cannot be trusted, with the reason (a folder, pipe or device
+    with a table's name included).
+
+    With ``digests`` (a JSON file) each table's SHA-256 is kept against its size, mtime and inode,
+    as DVC does, and a table is read again only when one of them changed, as a new write (a new
+    file renamed into place) always does; the checksum beside it is read every time, and a table
+    that seems not to match is read before it is condemned. The accepted limit: bytes changed with
+    all three kept (rewritten in place with the mtime set back, or decayed on the disk) go unseen
+    until the digests file is deleted. A missing or unreadable digests file is rebuilt."""
+    root = Path(root)
+    if not root.exists():
+        return {}
+    known = _read_digests(digests) if digests is not None else {}
+    kept, out = {}, {}
+    for path in sorted(root.rglob("*.parquet")):
+        key = path.relative_to(root).as_posix()
+        stamp = digest = None
+        remembered = False
+        if path.is_file() and checksum_path(path).exists():
+            st = path.stat()
+            stamp = [st.st_size, st.st_mtime_ns, st.st_ino]
+            remembered = known.get(key, [])[:3] == stamp
+            if remembered:
+                digest = known[key][3]
+            else:
+                hashed_at = time.time_ns()
+                digest = file_sha256(path)
+                if st.st_mtime_ns > hashed_at - SETTLED_NS:
+                    stamp = None  # too fresh to vouch for: hashed again next time
+        problem = table_problem(path, digest)
+        if problem and remembered:  # a remembered digest may spare a read, never condemn
+            digest = file_sha256(path)
+            problem = table_problem(path, digest)
+        if problem:
+            out[path] = problem
+        elif stamp:
+            kept[key] = [*stamp, digest]
+    if digests is not None and kept != known:
+        _write_digests(Path(digests), kept)
+    return out
+
+
+def _read_digests(path: str | os.PathLike) -> dict[str, list]:
+    """The entries of a digests file, {table: [size, mtime_ns, inode, sha256]}; none when it is
+    missing, not a regular file, unreadable or not in this format."""
+    path = Path(path)
+    try:
+        if not path.is_file():
+            return {}
+        data = json.loads(path.read_bytes())
+        tables = data["tables"] if data["version"] == DIGESTS_VERSION else {}
+        return {
+            key: entry
+            for key, entry in tables.items()
+            if isinstance(key, str)
+            and isinstance(entry, list)
+            and len(entry) == 4
+            and all(type(x) is int for x in entry[:3])
+            and isinstance(entry[3], str)
+        }
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError):
+        return {}
+
+
+def _write_digests(path: Path, tables: dict[str, list]) -> None:
+    """Replace the digests file whole (a temporary file renamed over it; not flushed: a cache lost
+    in a crash costs one reread)."""
+    data = json.dumps({"version": DIGESTS_VERSION, "tables": tables}, sort_keys=True, separators=(",", ":"))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_bytes_atomically(data.encode(), path, sync=False)
+    except OSError:
+        pass  # a read-only folder, or a folder in its place: the next check reads every table
+
+
+def set_aside(path: str | os.PathLike) -> Path:
+    """Move a corrupt table (and its checksum) to ``<name>.corrupt`` so that it is rebuilt."""
+    path = Path(path)
+    target = path.with_name(path.name + CORRUPT_SUFFIX)
+    if target.is_dir() and not target.is_symlink():  # an older copy set aside
+        shutil.rmtree(target)
+    os.replace(path, target)
+    checksum_path(path).unlink(missing_ok=True)
+    return target
+
+
+MIN_FREE_MB_ENV = "PARTICLE_ENTROPY_MIN_FREE_MB"  # a test sets it high to see the message
+MIN_FREE_MB = 200.0
+
+
+def disk_space_problem(path: str | os.PathLike = ".") -> str | None:
+    """A message when the file system holding ``path`` has less than MIN_FREE_MB free (none
+    otherwise): a job that fails on a full disk often cannot write its own log, so the
+    workflow says so on the terminal (Snakefile `onerror`)."""
+    limit = float(os.environ.get(MIN_FREE_MB_ENV, MIN_FREE_MB))
+    free_mb = shutil.disk_usage(path).free / 2**20
+    if free_mb >= limit:
+        return None
+    return (
+        f"No space left on device? The file system holding {Path(path).resolve()} has {free_mb:.0f} MB free "
+        f"(below {limit:.0f} MB); a job that fails on a full disk may leave an empty log. "
+        "Free some space and rerun the same command: finished tables are kept."
+    )
