@@ -105,7 +105,9 @@ def render(text: str) -> str:
         if name not in generated:
             raise ValueError(f"schema block {name!r} is not one this module writes: {', '.join(generated)}")
         seen.add(name)
-        lines = [f"{indent}# BEGIN generated: {name} (from core/settings.py and registry.py by `{COMMAND}`; do not edit)\n"]
+        lines = [
+            f"{indent}# BEGIN generated: {name} (from core/settings.py and registry.py by `{COMMAND}`; do not edit)\n"
+        ]
         lines += [f"{indent}{key}: {_yaml(value)}\n" for key, value in generated[name]]
         return "".join(lines) + f"{indent}# END generated: {name}\n"
 
