@@ -308,3 +308,16 @@ def test_case_mask_and_rows_of_select_one_case_or_a_model():
 def test_non_integer_n_is_refused_naming_n(n):
     with pytest.raises(SettingError, match=r"^n="):
         Case("mtpt", "collision", n)
+
+
+def test_the_word_none_reads_as_none_in_configs_paths_and_options():
+    from particle_entropy.cli import build_parser
+    from particle_entropy.core.case import from_text, text
+
+    assert from_text("none") is None and from_text("None") is None and from_text(3.0) == 3.0
+    assert text(from_text("none")) == "none" and from_text(text(None)) is None
+    spec = Case.from_spec({"method": "mtpt", "kernel": "collision", "truncation": "none"}, 30)
+    assert spec.truncation is None
+    assert Case.from_wildcards({**spec.wildcards()}).truncation is None
+    args = build_parser().parse_args(["simulate", "--truncation", "None", "--out", "x.parquet"])
+    assert args.truncation is None

@@ -7,6 +7,7 @@ import math
 import os
 import sys
 
+from .core.case import NONE, from_text
 from .core.registry import ALL_KERNELS, DEFAULT_KERNEL, KERNELS, METHODS, SCHEME_DOCS
 from .core.runconfig import RunConfig, SettingError
 from .core.settings import BY_NAME, PAPER, Setting
@@ -37,7 +38,7 @@ METHOD_DEFAULTS = {
 
 def _number_or_none(text: str):
     """An option value: a number, or the word none (a truncation's whole Gaussian)."""
-    if text.lower() == "none":
+    if from_text(text) is None:
         return None
     try:
         return float(text)
@@ -49,7 +50,7 @@ def _add_setting(parser: argparse.ArgumentParser, setting: Setting) -> None:
     """The option of one setting: its type, choices, default and help from its definition."""
     default = None if setting.name in METHOD_DEFAULTS else setting.default
     shown = METHOD_DEFAULTS.get(
-        setting.name, "none" if default is None else f"{default:g}" if isinstance(default, float) else default
+        setting.name, NONE if default is None else f"{default:g}" if isinstance(default, float) else default
     )
     unit = "" if setting.unit == "-" else f" [{setting.unit}]"
     kwargs = {"default": default, "help": f"{setting.doc}{unit}; {setting.allowed()} (default: {shown})"}

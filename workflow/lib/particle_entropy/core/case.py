@@ -80,10 +80,18 @@ def check_range(name, value, lo, hi, open_low=False) -> float:
     return v
 
 
+NONE = "none"  # None as configs, paths and options write it (truncation: the whole Gaussian)
+
+
+def from_text(value):
+    """The inverse of ``text`` for the word none: 'none' -> None, any other value unchanged."""
+    return None if isinstance(value, str) and value.lower() == NONE else value
+
+
 def text(value) -> str:
     """A value as it appears in a path: 1.0 -> '1', 0.5 -> '0.5', None -> 'none'."""
     if value is None:
-        return "none"
+        return NONE
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return str(value)
@@ -153,7 +161,7 @@ class Case:
                 value = spec[dim]
             else:
                 value = merged[dim] if method in methods else NEUTRAL[dim]
-            dims[dim] = None if value == "none" else value
+            dims[dim] = from_text(value)
         return cls(method=method, kernel=spec.get("kernel"), n=n, **dims)
 
     @classmethod
@@ -164,7 +172,7 @@ class Case:
             kernel=w["kernel"],
             n=int(w["n"]) if "n" in w.keys() else None,
             eta=float(w["eta"]),
-            truncation=None if w["trunc"] == "none" else float(w["trunc"]),
+            truncation=None if from_text(w["trunc"]) is None else float(w["trunc"]),
             dt_growth=float(w["growth"]),
             scheme=w["scheme"],
         )

@@ -18,6 +18,7 @@ import re
 import sys
 from pathlib import Path
 
+from ..core.case import NONE
 from ..core.registry import ALL_KERNELS, METHODS, SHEAR_CASES
 from ..core.settings import SETTINGS, Setting
 from .configcheck import SCHEMA_PATH
@@ -65,9 +66,9 @@ def entry(s: Setting, default: bool = True) -> dict:
             number["exclusiveMinimum" if s.open_low else "minimum"] = _number(s.low)
         if s.high != math.inf:
             number["maximum"] = _number(s.high)
-        out = {"oneOf": [{"type": "string", "enum": ["none"]}, number]} if s.none else number
+        out = {"oneOf": [{"type": "string", "enum": [NONE]}, number]} if s.none else number
     if default:
-        out["default"] = "none" if s.none and s.default is None else s.default
+        out["default"] = NONE if s.none and s.default is None else s.default
     out["description"] = description(s)
     return out
 
@@ -86,7 +87,7 @@ def blocks() -> dict[str, list[tuple[str, dict]]]:
         key = s.key.split(".", 1)[1]
         if s.section == "case_defaults":
             defs.append((key, entry(s, default=False)))
-            d = "none" if s.none and s.default is None else s.default
+            d = NONE if s.none and s.default is None else s.default
             out["case_defaults"].append((key, {"$ref": f"#/$defs/{key}", "default": d}))
         else:
             out[s.section].append((key, entry(s)))
