@@ -746,7 +746,7 @@ runpy.run_module("snakemake", run_name="__main__")
 """
 
 
-def test_parsing_the_workflow_imports_no_scipy_and_pandas_only_where_known(tmp_path):
+def test_parsing_the_workflow_imports_neither_scipy_nor_pandas(tmp_path):
     import json
 
     out = tmp_path / "imports.json"
@@ -756,11 +756,9 @@ def test_parsing_the_workflow_imports_no_scipy_and_pandas_only_where_known(tmp_p
     seen = json.loads(out.read_text())
     assert not seen["scipy"]
     assert not [f for f in seen["by"] if not f.startswith("workflow/lib/")]  # Snakefile, rules, scripts: none
-    # left (Snakemake's SLURM plugin has imported pandas by then anyway): modules that import it at
-    # module level and that the parse reaches to check a config section, optimum.py (and the
-    # aggregate module it imports) through sweeps.optimum_searches, shear2d.py through check_shear
-    known = {"analysis/optimum.py", "analysis/aggregate.py", "experiments/shear2d.py"}
-    assert set(seen["by"]) <= {f"workflow/lib/particle_entropy/{m}" for m in known}
+    # nor the library: config sections are checked without tables (Snakemake's SLURM plugin
+    # imports pandas itself, which the floor in docs/speed.md measures)
+    assert not seen["by"], seen["by"]
 
 
 def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run):
