@@ -17,6 +17,9 @@ import sys
 from collections import defaultdict
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow" / "lib"))
+from particle_entropy.core.registry import SCHEME_RECORDS  # noqa: E402
+
 
 def family(rel: Path) -> str:
     """Rule family of a benchmark file, from its path below results/benchmarks."""
@@ -26,7 +29,7 @@ def family(rel: Path) -> str:
     # simulate/<kind>/<method>/<kernel>/n~/eta~/trunc~/growth~/scheme~<scheme>/seeds~...
     method = parts[2]
     scheme = next((p.split("~", 1)[1] for p in parts if p.startswith("scheme~")), "")
-    if method == "mtpt" and scheme.startswith("sequential"):
+    if method == "mtpt" and scheme in SCHEME_RECORDS and SCHEME_RECORDS[scheme].sequential:
         return "simulate: authors' loop"
     return f"simulate: {method}"
 

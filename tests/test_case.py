@@ -96,21 +96,28 @@ def test_model_and_at():
 @pytest.mark.parametrize(
     "case,path",
     [
-        (Case("mtpt", "collision", 300), "mtpt/collision/n~300/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
+        (
+            Case("mtpt", "collision", 300),
+            "mtpt/collision/n~300/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact",
+        ),
         (
             Case("mtpt", "collision", 30000, eta=0.5),
-            "mtpt/collision/n~30000/eta~0.5/trunc~none/growth~1.05/scheme~symmetric",
+            "mtpt/collision/n~30000/eta~0.5/trunc~none/growth~1.05/scheme~symmetric/grid~exact",
         ),
         (
             Case("mtpt", "sph", 100, eta=0.1, truncation=3, dt_growth=1.01, scheme="sequential"),
-            "mtpt/sph/n~100/eta~0.1/trunc~3/growth~1.01/scheme~sequential",
+            "mtpt/sph/n~100/eta~0.1/trunc~3/growth~1.01/scheme~sequential/grid~exact",
         ),
         (
             Case("mtpt", "collision", 300, eta=0.25, truncation=2.5, dt_growth=1),
-            "mtpt/collision/n~300/eta~0.25/trunc~2.5/growth~1/scheme~symmetric",
+            "mtpt/collision/n~300/eta~0.25/trunc~2.5/growth~1/scheme~symmetric/grid~exact",
         ),
-        (Case("pt", "adaptive", 1000), "pt/adaptive/n~1000/eta~1/trunc~none/growth~1.05/scheme~symmetric"),
-        (Case("fd", "implicit", 3000), "fd/implicit/n~3000/eta~1/trunc~none/growth~1/scheme~symmetric"),
+        (Case("pt", "adaptive", 1000), "pt/adaptive/n~1000/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact"),
+        (Case("fd", "implicit", 3000), "fd/implicit/n~3000/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact"),
+        (
+            Case("mtpt", "collision", 300, truncation=3, scheme="sequential", time_grid="authors"),
+            "mtpt/collision/n~300/eta~1/trunc~3/growth~1.05/scheme~sequential/grid~authors",
+        ),
     ],
 )
 def test_path_text_written_by_hand(case, path):
@@ -321,3 +328,36 @@ def test_the_word_none_reads_as_none_in_configs_paths_and_options():
     assert Case.from_wildcards({**spec.wildcards()}).truncation is None
     args = build_parser().parse_args(["simulate", "--truncation", "None", "--out", "x.parquet"])
     assert args.truncation is None
+
+
+def test_the_time_grid_is_a_dimension_of_particle_cases_only():
+    from particle_entropy.core.labels import case_label
+
+    authors = Case("pt", "bins", 100, time_grid="authors")
+    assert authors != Case("pt", "bins", 100) and authors.path() != Case("pt", "bins", 100).path()
+    assert Case.from_wildcards(authors.wildcards()) == authors
+    assert Case.from_row(authors.columns()) == authors
+    assert authors.columns()["time_grid"] == "authors" and "authors' time grid" in case_label(authors)
+    assert Case("fd", "implicit", 30).time_grid == "exact"
+    with pytest.raises(SettingError, match="time_grid applies to method pt and mtpt only"):
+        Case("fd", "implicit", 30, time_grid="authors")
+    with pytest.raises(SettingError, match="time_grid='daily' is not allowed: one of exact, authors"):
+        Case("mtpt", "collision", 30, time_grid="daily")
+    spec = Case.from_spec({"method": "mtpt", "kernel": "sph"}, 30, {"time_grid": "authors"})
+    assert spec.time_grid == "authors"  # from case_defaults
+
+
+def test_the_authors_preset_is_all_of_their_algorithm_and_explicit_keys_win():
+    from particle_entropy.core.labels import case_label
+
+    spec = {"method": "mtpt", "kernel": "sph", "eta": 1, "preset": "authors"}
+    authors = Case.from_spec(spec, 300, {"truncation": "none", "time_grid": "exact"})
+    assert (authors.scheme, authors.truncation, authors.time_grid) == ("authors", 3.0, "authors")
+    assert "the authors' algorithm" in case_label(authors)
+    exact = Case.from_spec({**spec, "time_grid": "exact"}, 300)  # one change from the preset
+    assert (exact.scheme, exact.truncation, exact.time_grid) == ("authors", 3.0, "exact")
+    assert "the authors' algorithm" not in case_label(exact) and "SPH constant 0.822" in case_label(exact)
+    with pytest.raises(SettingError, match="preset='theirs' is not allowed: one of authors"):
+        Case.from_spec({**spec, "preset": "theirs"}, 300)
+    with pytest.raises(SettingError, match="preset='authors' is not allowed: a preset of mtpt cases"):
+        Case.from_spec({"method": "pt", "kernel": "bins", "preset": "authors"}, 300)

@@ -21,7 +21,7 @@ from particle_entropy.core.labels import case_label
 matplotlib.use("Agg")
 
 from particle_entropy.analysis.aggregate import METRICS  # noqa: E402
-from particle_entropy.core.case import CASE_COLUMNS, Case, rows_of  # noqa: E402
+from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, rows_of  # noqa: E402
 from particle_entropy.core.runconfig import RunConfig  # noqa: E402
 from particle_entropy.figures import (  # noqa: E402
     FIGURE_MODULES,
@@ -121,7 +121,7 @@ def argmin_and_minima(comic: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Synthetic bootstrap tables for a COMIC table: per model and time, the N of least mean COMIC
     is the argmin of 70 % of resamples and the next N of 30 % (the last N: the one before)."""
     shares, minima = [], []
-    model_cols = ["method", "kernel", "eta", "truncation", "dt_growth", "scheme"]
+    model_cols = list(MODEL_COLUMNS)
     for key, g in comic.groupby([*model_cols, "time"]):
         g = g.sort_values("n").reset_index(drop=True)
         k = int(np.argmin(g["COMIC_mean"].to_numpy()))
@@ -166,7 +166,7 @@ def tradeoff_table(cases: list[Case], times=(5.0, 20.0)) -> pd.DataFrame:
                 }
             )
     df = pd.DataFrame(rows)
-    keys = ["method", "kernel", "eta", "truncation", "dt_growth", "scheme", "time"]
+    keys = [*MODEL_COLUMNS, "time"]
     df["is_comic_optimum"] = df["COMIC_mean"] == df.groupby(keys)["COMIC_mean"].transform("min")
     return df
 
@@ -355,7 +355,7 @@ def test_fig9_draws_the_argmin_shares_and_names_each_minimum_with_its_interval()
     figure, data = draw("fig9", cases, [comic, minima, argmin])
     bars = data[data["y_name"] == "share of resamples with this argmin"]
     expected = argmin[argmin["time"] == 20.0]
-    merged = bars.merge(expected, on=["method", "kernel", "eta", "truncation", "dt_growth", "scheme", "n"])
+    merged = bars.merge(expected, on=[*MODEL_COLUMNS, "n"])
     assert len(merged) == len(bars) == len(expected) and np.allclose(merged["y"], merged["share"])
     texts = [t.get_text() for ax in figure.axes for t in ax.texts]
     for _, m in minima[minima["time"] == 20.0].iterrows():

@@ -22,6 +22,8 @@ EXPECTED = {
     "sequential_sorted": dict(sequential=True, by_label=False, symnorm=False, clip=True),
     "sequential_symnorm": dict(sequential=True, by_label=True, symnorm=True, clip=True),
     "sequential_noclip": dict(sequential=True, by_label=True, symnorm=False, clip=False),
+    # the authors' script: their loop, h_SPH with 0.822 where Eq. 26 has 0.82
+    "authors": dict(sequential=True, by_label=True, symnorm=False, clip=True, sph_constant=0.822),
 }
 
 
@@ -88,3 +90,16 @@ def test_compensated_widens_the_cut_kernel_and_symmetric_does_not():
     # the variance of a Gaussian cut at 2 widths is 0.7737 of the whole one's (tables of the
     # truncated normal), so the compensated width is 1 / sqrt(0.7737) = 1.1369 times wider
     assert widths["compensated"] / widths["symmetric"] == pytest.approx(1.1369, abs=2e-4)
+
+
+def test_the_authors_scheme_widens_the_sph_kernel_by_their_constant_only():
+    x, m, label = _state(200)
+    widths = {}
+    for name in ("sequential", "authors"):
+        for kernel in ("sph", "collision"):
+            cfg = RunConfig.of(method="mtpt", kernel=kernel, n=200, truncation=3.0, scheme=name).resolved()
+            widths[name, kernel] = mtpt.kernel_for_step(cfg, 0.1, 10.0)
+    assert widths["authors", "sph"][0] / widths["sequential", "sph"][0] == pytest.approx(0.822 / 0.82, rel=1e-15)
+    # beta = 2 eta D dt / h^2 (Eq. 20): 0.5 % smaller with the wider kernel
+    assert widths["authors", "sph"][1] / widths["sequential", "sph"][1] == pytest.approx((0.82 / 0.822) ** 2, rel=1e-14)
+    assert widths["authors", "collision"] == widths["sequential", "collision"]  # no SPH constant in Eq. 17

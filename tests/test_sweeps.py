@@ -27,7 +27,7 @@ from particle_entropy.pipeline.sweeps import (
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = yaml.safe_load((ROOT / "config.yaml").read_text())
 TINY = yaml.safe_load((ROOT / "tests" / "data" / "tiny_config.yaml").read_text())
-PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric"
+PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact"
 
 
 # --------------------------------------------------------------------------- seed blocks
@@ -111,13 +111,15 @@ def test_fd_gets_one_realisation():
 
 def test_shipped_fig9_expands_to_the_realisations_table():
     ens = figure_ensembles(SHIPPED, "fig9")
-    # config.yaml: 6 cases (3 models x 2 schemes) x 7 N; counts 80, 80, 60, 50, 20, 6, 4 for N = 30 ... 30000
+    # config.yaml: 6 cases (3 models: the equations and the authors' preset) x 7 N; counts 80, 80, 60,
+    # 50, 20, 6, 4 for N = 30 ... 30000
     counts = {30: 80, 100: 80, 300: 60, 1000: 50, 3000: 20, 10000: 6, 30000: 4}
     assert len(ens) == 42
     for e in ens:
         assert e.realisations == counts[e.case.n]
     paper = [Case("mtpt", "collision"), Case("mtpt", "sph"), Case("mtpt", "collision", eta=0.5)]
-    authors = [Case(m.method, m.kernel, eta=m.eta, truncation=3, scheme="sequential") for m in paper]
+    # the authors' algorithm as registry.PRESETS says it: loop and SPH constant, cut at 3, their grid
+    authors = [Case(m.method, m.kernel, eta=m.eta, truncation=3, scheme="authors", time_grid="authors") for m in paper]
     assert {e.case.model for e in ens} == {*paper, *authors}
 
 
@@ -160,7 +162,7 @@ def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
     # from N = 3,000 the same ensembles (same summaries); below, the mechanism's 20 seeds are the
     # first blocks of Fig. 9's larger ensemble: no run of the equations or the authors' loop is extra
     assert {(e.case.scheme, e.case.n) for e in shared} == {
-        (s, n) for s in ("symmetric", "sequential") for n in (3000, 10000, 30000)
+        (s, n) for s in ("symmetric", "authors") for n in (3000, 10000, 30000)
     }
     fig9_runs = {p for e in fig9 for p in case_run_paths(e, SHIPPED)}
     for e in mech:

@@ -411,7 +411,9 @@ def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_
 
 def test_sequential_scheme_runs_the_authors_loop(tiny_run):
     runs = list(
-        (tiny_run / "results/runs/mtpt/collision").glob("n~100/eta~1/trunc~3/growth~*/scheme~sequential/*.parquet")
+        (tiny_run / "results/runs/mtpt/collision").glob(
+            "n~100/eta~1/trunc~3/growth~*/scheme~sequential/grid~*/*.parquet"
+        )
     )
     assert runs
     table = pd.read_parquet(runs[0])

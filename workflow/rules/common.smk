@@ -21,7 +21,7 @@ from particle_entropy.core.case import Case
 from particle_entropy.pipeline.codeversion import code_version
 from particle_entropy.core.verify import CORRUPT_SUFFIX, corrupt_tables, set_aside
 from particle_entropy.core.memory import available_bytes, estimate_mb
-from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES
+from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.figures import FIGURE_MODULES
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
@@ -90,6 +90,7 @@ wildcard_constraints:
     method="|".join(METHODS),
     kernel="|".join(ALL_KERNELS),
     scheme="|".join(SCHEMES),
+    grid="|".join(TIME_GRIDS),
     n=r"\d+",
     eta=r"[0-9.eE+-]+",
     trunc=r"none|[0-9.eE+-]+",

@@ -9,7 +9,7 @@ import pandas as pd
 
 from ..core.case import Case, by_model, case_of_table
 from ..core.labels import case_label
-from ..core.registry import SCHEME_DOCS
+from ..core.registry import PRESETS, SCHEME_DOCS
 
 
 def _near(df: pd.DataFrame, t: float) -> pd.Series:
@@ -169,6 +169,10 @@ def _model_words(model: Case) -> tuple[str, str]:
     cut = f", kernel cut at {model.truncation:g} widths" if model.truncation is not None else ""
     if model.scheme == "symmetric" and model.truncation is None:
         return "the paper's Eqs. 16-21, whole Gaussian", "the equations give"
+    if model.variant() == PRESETS["authors"]:
+        return "the authors' algorithm (their loop, SPH constant, kernel cut at 3 widths, time grid)", (
+            "the authors' algorithm gives"
+        )
     if model.scheme == "sequential":
         return f"the authors' sequential loop{cut}", "the authors' algorithm gives"
     return f"{SCHEME_DOCS[model.scheme]}{cut}", "this variant gives"

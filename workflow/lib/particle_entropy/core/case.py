@@ -1,10 +1,11 @@
 """The one identity of a simulated model: a ``Case`` builds its path and its table columns, and
 is rebuilt from a config spec, from wildcards or from a table row (its legend text: labels.py).
 
-A case is every dimension a user may sweep: method, kernel, N, eta, truncation, dt growth and
-scheme. With ``n=None`` it is a *model* (the same case at every N), the key COMIC tables,
+A case is every dimension a user may sweep: method, kernel, N, eta, truncation, dt growth,
+scheme and time grid. With ``n=None`` it is a *model* (the same case at every N), the key COMIC tables,
 minima and figure panels group by. Dimensions that do not apply to a method hold a neutral
-value (FD: eta 1, whole kernel, fixed step, symmetric; PT: eta 1, whole kernel, symmetric),
+value (FD: eta 1, whole kernel, fixed step, symmetric, exact grid; PT: eta 1, whole kernel,
+symmetric),
 and a config that sets them otherwise is refused.
 """
 
@@ -20,7 +21,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-from .registry import KERNELS, METHODS, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES
+from .registry import KERNELS, METHODS, PRESETS, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES, TIME_GRIDS
 from .settings import PAPER
 
 # Case field -> (wildcard name, path segment); the path of a case is these segments in order.
@@ -32,10 +33,11 @@ PATH_SEGMENTS = {
     "truncation": ("trunc", "trunc~{}"),
     "dt_growth": ("growth", "growth~{}"),
     "scheme": ("scheme", "scheme~{}"),
+    "time_grid": ("grid", "grid~{}"),
 }
 CASE_DIR = "/".join(seg.format("{" + w + "}") for w, seg in PATH_SEGMENTS.values())
-MODEL_COLUMNS = ("method", "kernel", "eta", "truncation", "dt_growth", "scheme")
-CASE_COLUMNS = ("method", "kernel", "n", "eta", "truncation", "dt_growth", "scheme")
+MODEL_COLUMNS = ("method", "kernel", "eta", "truncation", "dt_growth", "scheme", "time_grid")
+CASE_COLUMNS = ("method", "kernel", "n", "eta", "truncation", "dt_growth", "scheme", "time_grid")
 COLUMN_DOCS = {
     "method": "`pt` (random-walk particle tracking), `mtpt` (mass-transfer particle tracking) or `fd` (implicit or "
     "explicit finite differences); in figure source data also `analytic` for a reference curve",
@@ -49,6 +51,8 @@ COLUMN_DOCS = {
     "scheme": "how MTPT transfers mass: "
     + "; ".join(f"`{k}` ({v})" for k, v in SCHEME_DOCS.items())
     + "; PT and FD always `symmetric`",
+    "time_grid": "particle time grid: `exact` (the last step shortened to end at t_final) or `authors` (whole "
+    "growing steps while t < t_final, as the authors' code); FD always `exact`",
 }
 # Which dimensions apply to which method; the others hold NEUTRAL values.
 APPLIES = {
@@ -56,8 +60,9 @@ APPLIES = {
     "truncation": ("mtpt",),
     "dt_growth": ("pt", "mtpt"),
     "scheme": ("mtpt",),
+    "time_grid": ("pt", "mtpt"),  # FD steps always end at t_final
 }
-NEUTRAL = {"eta": 1.0, "truncation": None, "dt_growth": 1.0, "scheme": "symmetric"}
+NEUTRAL = {"eta": 1.0, "truncation": None, "dt_growth": 1.0, "scheme": "symmetric", "time_grid": "exact"}
 DEFAULT = type("Default", (), {"__repr__": lambda self: "DEFAULT"})()  # an unset dimension
 
 
@@ -108,6 +113,7 @@ class Case:
     truncation: float | None = DEFAULT
     dt_growth: float = DEFAULT
     scheme: str = DEFAULT
+    time_grid: str = DEFAULT
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -134,6 +140,8 @@ class Case:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         if SCHEME_RECORDS[self.scheme].compensated and self.truncation is None:
             raise SettingError("scheme", self.scheme, "needs a truncation (a number of kernel widths), not none")
+        if self.time_grid not in TIME_GRIDS:
+            raise SettingError("time_grid", self.time_grid, f"one of {', '.join(TIME_GRIDS)}")
         for dim, methods in APPLIES.items():
             if self.method not in methods and getattr(self, dim) != NEUTRAL[dim]:
                 raise SettingError(
@@ -146,15 +154,23 @@ class Case:
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_spec(cls, spec: Mapping, n: int | None = None, defaults: Mapping | None = None) -> Case:
-        """A config case ``{method, kernel, eta?, truncation?, dt_growth?, scheme?}`` at ``n``,
-        unset dimensions from ``defaults`` (config case_defaults, then the paper's)."""
-        unknown = set(spec) - {"method", "kernel", *APPLIES}
+        """A config case ``{method, kernel, preset?, eta?, truncation?, dt_growth?, scheme?,
+        time_grid?}`` at ``n``: a dimension it sets, else its preset's (registry.PRESETS), else
+        ``defaults`` (config case_defaults), else the paper's."""
+        unknown = set(spec) - {"method", "kernel", "preset", *APPLIES}
         if unknown:
-            raise SettingError("case key", sorted(unknown)[0], f"one of method, kernel, {', '.join(APPLIES)}")
+            raise SettingError("case key", sorted(unknown)[0], f"one of method, kernel, preset, {', '.join(APPLIES)}")
         method = spec.get("method")
         if method not in METHODS:
             raise SettingError("method", method, f"one of {', '.join(METHODS)}")
-        merged = {**{k: PAPER[k] for k in APPLIES}, **(defaults or {})}
+        preset = {}
+        if "preset" in spec:
+            if spec["preset"] not in PRESETS:
+                raise SettingError("preset", spec["preset"], f"one of {', '.join(PRESETS)}")
+            if method != "mtpt":
+                raise SettingError("preset", spec["preset"], "a preset of mtpt cases (the authors' algorithm)")
+            preset = PRESETS[spec["preset"]]
+        merged = {**{k: PAPER[k] for k in APPLIES}, **(defaults or {}), **preset}
         dims = {}
         for dim, methods in APPLIES.items():
             if dim in spec:
@@ -175,6 +191,7 @@ class Case:
             truncation=None if from_text(w["trunc"]) is None else float(w["trunc"]),
             dt_growth=float(w["growth"]),
             scheme=w["scheme"],
+            time_grid=w["grid"],
         )
 
     @classmethod
@@ -190,6 +207,7 @@ class Case:
             truncation=None if math.isinf(trunc) else trunc,
             dt_growth=float(row["dt_growth"]),
             scheme=str(row["scheme"]),
+            time_grid=str(row["time_grid"]),
         )
 
     # ------------------------------------------------------------------ representations
@@ -200,7 +218,7 @@ class Case:
         return {w: text(getattr(self, f)) for f, (w, _) in PATH_SEGMENTS.items()}
 
     def path(self) -> str:
-        """Folder of this case's files: method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S."""
+        """Folder of this case's files: method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S/grid~R."""
         return CASE_DIR.format(**self.wildcards())
 
     def columns(self) -> dict:
@@ -213,6 +231,7 @@ class Case:
             "truncation": math.inf if self.truncation is None else self.truncation,
             "dt_growth": self.dt_growth,
             "scheme": self.scheme,
+            "time_grid": self.time_grid,
         }
         if self.n is None:
             del cols["n"]
@@ -229,7 +248,7 @@ class Case:
     def variant(self) -> dict:
         """Dimensions that differ from the paper's defaults for this method."""
         out = {}
-        for dim in ("truncation", "dt_growth", "scheme"):
+        for dim in ("truncation", "dt_growth", "scheme", "time_grid"):
             if self.method in APPLIES[dim] and getattr(self, dim) != PAPER[dim]:
                 out[dim] = getattr(self, dim)
         return out
@@ -243,6 +262,7 @@ class Case:
             math.inf if self.truncation is None else self.truncation,
             self.dt_growth,
             SCHEMES.index(self.scheme),
+            TIME_GRIDS.index(self.time_grid),
             self.n or 0,
         )
 

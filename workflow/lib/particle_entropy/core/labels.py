@@ -8,6 +8,7 @@ redraws figures and rebuilds those tables but reruns no simulation.
 from __future__ import annotations
 
 from .case import Case
+from .registry import PRESETS
 
 KERNEL_NAMES = {
     "bins": "binned",
@@ -24,7 +25,12 @@ SCHEME_LABELS = {  # legend text of a non-default scheme (registry.SCHEME_RECORD
     "sequential_sorted": "sequential loop in position order",
     "sequential_symnorm": "sequential loop, symmetric weights",
     "sequential_noclip": "sequential loop, no clipping",
+    "authors": "sequential loop, SPH constant 0.822",
 }
+PRESET_LABELS = {"authors": "the authors' algorithm"}  # a case whose dimensions are all its preset's
+
+
+TIME_GRID_LABELS = {"authors": "authors' time grid"}  # legend text of a non-default time grid
 
 
 def variant_parts(case: Case) -> list[str]:
@@ -37,6 +43,8 @@ def variant_parts(case: Case) -> list[str]:
         parts.append("fixed Δt" if v["dt_growth"] == 1.0 else f"Δt growth {v['dt_growth']:g}")
     if "scheme" in v:
         parts.append(SCHEME_LABELS[v["scheme"]])
+    if "time_grid" in v:
+        parts.append(TIME_GRID_LABELS[v["time_grid"]])
     return parts
 
 
@@ -45,7 +53,8 @@ def case_label(case: Case, n: bool = True) -> str:
     parts = [f"{case.method.upper()} {KERNEL_NAMES[case.kernel]}"]
     if case.method == "mtpt":
         parts.append(f"η={case.eta:g}")
-    parts += variant_parts(case)
+    preset = next((p for p, dims in PRESETS.items() if case.variant() == dims), None)
+    parts += [PRESET_LABELS[preset]] if preset else variant_parts(case)
     if n and case.n is not None:
         parts.append(f"N={case.n:,}")
     return ", ".join(parts)

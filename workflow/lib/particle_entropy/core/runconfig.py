@@ -48,7 +48,6 @@ class RunConfig:
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = PAPER["transfer_method"]
     transfer_tolerance: float = PAPER["transfer_tolerance"]
-    time_grid: str = PAPER["time_grid"]
 
     @classmethod
     def of(
@@ -60,6 +59,7 @@ class RunConfig:
         truncation=DEFAULT,
         dt_growth=DEFAULT,
         scheme=DEFAULT,
+        time_grid=DEFAULT,
         **settings,
     ) -> RunConfig:
         """A run from the case's dimensions and ``settings``; an unset (or None) kernel or
@@ -72,6 +72,7 @@ class RunConfig:
             truncation,
             DEFAULT if dt_growth is None else dt_growth,
             scheme,
+            time_grid,
         )
         return cls(case, **settings)
 
@@ -90,6 +91,7 @@ class RunConfig:
     truncation = property(lambda self: self.case.truncation)
     dt_growth = property(lambda self: self.case.dt_growth)
     scheme = property(lambda self: self.case.scheme)
+    time_grid = property(lambda self: self.case.time_grid)
 
     def resolved(self) -> RunConfig:
         """Fill the first step (first_step) and check every setting."""
@@ -121,8 +123,7 @@ class RunConfig:
                 f"a first step reaching t_final = {self.t_final:g} in at most {MAX_STEPS:,} steps with dt_growth = "
                 f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
             )
-        for name in ("time_grid", "transfer_method"):
-            check_setting(BY_NAME[name], getattr(self, name))
+        check_setting(BY_NAME["transfer_method"], self.transfer_method)
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2
@@ -150,4 +151,4 @@ class RunConfig:
 
     def case_columns(self) -> dict:
         """The case parameters written beside every row of a result table."""
-        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed), "time_grid": self.time_grid}
+        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed)}

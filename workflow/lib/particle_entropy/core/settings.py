@@ -94,15 +94,6 @@ SETTINGS = (
     Setting("fd_dt", "time.fd_dt", 0.05, "finite-difference fixed time step", "T", 0.0, open_low=True),
     Setting("fixed_dt", "time.fixed_dt", 1.0, "fixed step of particle cases with dt_growth 1", "T", 0.0, open_low=True),
     Setting(
-        "time_grid",
-        "time.grid",
-        "exact",
-        "particle time grid: exact = the last step is shortened to end at t_final; authors = whole growing "
-        "steps while t < t_final, as the authors' code (175 steps ending at t = 1021.1 for the paper's "
-        "settings); FD steps always end at t_final",
-        choices=TIME_GRIDS,
-    ),
-    Setting(
         "transfer_method",
         "numerics.transfer_method",
         "auto",
@@ -144,6 +135,15 @@ SETTINGS = (
         "symmetric",
         "mass-transfer scheme (mtpt only, registry.SCHEME_RECORDS)",
         choices=SCHEMES,
+    ),
+    Setting(
+        "time_grid",
+        "case_defaults.time_grid",
+        "exact",
+        "particle time grid: exact = the last step is shortened to end at t_final; authors = whole growing "
+        "steps while t < t_final, as the authors' code (175 steps ending at t = 1021.1 for the paper's "
+        "settings; pt and mtpt only); FD steps always end at t_final",
+        choices=TIME_GRIDS,
     ),
 )
 BY_NAME = {s.name: s for s in SETTINGS}

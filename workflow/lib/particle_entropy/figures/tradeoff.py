@@ -68,7 +68,8 @@ def tradeoff_styles(cases: list[Case]) -> dict[Case, dict]:
     family = {**TRADEOFF_FAMILY, **dict(zip(unknown, auto, strict=True))}
     out, seen = {}, {}
     for m in models:
-        base, keys = family[model_triple(m)], tuple(m.variant())
+        # the time grid varies no line: an authors'-grid model takes another marker (the repeat below)
+        base, keys = family[model_triple(m)], tuple(k for k in m.variant() if k != "time_grid")
         repeat = seen[model_triple(m), keys] = seen.get((model_triple(m), keys), -1) + 1
         style = {**base, "linestyle": VARIANT_LINES[keys], **({"open": True} if "scheme" in keys else {})}
         if repeat:  # same family and same varied dimensions, other values: another marker, hollow

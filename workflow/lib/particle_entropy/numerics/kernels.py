@@ -17,9 +17,12 @@ def h_de(n: int, D: float, t: float) -> float:
     return 1.06 * n ** (-0.2) * math.sqrt(2.0 * D * t)
 
 
-def h_sph(n: int, omega: float, D: float, t: float) -> float:
+SPH_CONSTANT = 0.82  # Eq. 26; the authors' script has 0.822 (registry.SCHEME_RECORDS["authors"])
+
+
+def h_sph(n: int, omega: float, D: float, t: float, constant: float = SPH_CONSTANT) -> float:
     """Adaptive SPH bandwidth h_SPH = 0.82 (2 D t)^(2/5) (N / Omega)^(-1/5) (Eq. 26)."""
-    return 0.82 * (2.0 * D * t) ** 0.4 * (n / omega) ** (-0.2)
+    return constant * (2.0 * D * t) ** 0.4 * (n / omega) ** (-0.2)
 
 
 def beta_sph(eta: float, D: float, dt: float, h: float) -> float:

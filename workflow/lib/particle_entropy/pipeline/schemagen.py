@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 from ..core.case import NONE
-from ..core.registry import ALL_KERNELS, METHODS, SHEAR_CASES
+from ..core.registry import ALL_KERNELS, METHODS, PRESETS, SHEAR_CASES
 from ..core.settings import SETTINGS, Setting
 from .configcheck import SCHEMA_PATH
 
@@ -83,6 +83,20 @@ def blocks() -> dict[str, list[tuple[str, dict]]]:
             {"type": "string", "enum": list(ALL_KERNELS), "description": "The method's kernel (registry.KERNELS)."},
         ),
     ]
+    presets = "; ".join(
+        f"{k}: {', '.join(f'{d} {v:g}' if isinstance(v, float) else f'{d} {v}' for d, v in dims.items())}"
+        for k, dims in PRESETS.items()
+    )
+    defs.append(
+        (
+            "preset",
+            {
+                "type": "string",
+                "enum": list(PRESETS),
+                "description": f"Named case dimensions (registry.PRESETS; a dimension the case sets wins): {presets}.",
+            },
+        )
+    )
     for s in SETTINGS:
         key = s.key.split(".", 1)[1]
         if s.section == "case_defaults":

@@ -157,7 +157,6 @@ def run_settings(case: Case, config: Mapping) -> dict:
     physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
     out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
     out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
-    out["time_grid"] = time.get("grid", PAPER["time_grid"])  # settings: time_grid is the key time.grid
     out["dt0"] = float(
         first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"], time.get("fixed_dt", PAPER["fixed_dt"]))
     )
@@ -191,7 +190,7 @@ def _first_step_key(case: Case) -> str:
 
 # RunConfig settings that come from a shared config key, not from the case: a SettingError about
 # them names that key (and the case it fails for)
-SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "numerics") or s.name == "time_grid"}
+SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "numerics")}
 SHARED_KEYS["dt0"] = _first_step_key
 
 
