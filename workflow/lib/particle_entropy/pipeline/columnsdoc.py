@@ -44,8 +44,6 @@ WIDTH = 100  # prose is wrapped to this many characters; table rows are one line
 RUN_SETTINGS = {  # run settings written beside the case columns (RunConfig.case_columns)
     "D": "diffusion coefficient [L²/T]",
     "seed": "seed of the realisation (realisation r has base_seed + r)",
-    "time_grid": "the config's time grid: `exact` (last step shortened to end at t_final) or `authors` (whole steps "
-    "past it). FD always runs the exact grid, whatever this says",
 }
 SNAPSHOT_COLUMNS = {  # the final state of simulate.run(..., want_state=True)
     "x": "final position (PT sorted) [L]",
