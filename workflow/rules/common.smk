@@ -45,12 +45,13 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 check_sweeps(config)
-LOCAL = workflow.is_main_process and workflow.local_exec  # jobs run here: each must fit in this machine's memory
-if LOCAL:
-    check_memory(config, available_bytes())
+# jobs run here: each must fit in this machine's memory (read once, for the sections and the searches)
+AVAILABLE = available_bytes() if workflow.is_main_process and workflow.local_exec else None
+if AVAILABLE is not None:
+    check_memory(config, AVAILABLE)
 # The adaptive COMIC searches (workflow/rules/optimum.smk), by name; each is checked when a
 # requested target first needs it, so a config layered over config.yaml's searches runs.
-OPTIMUM = optimum_searches(config, available_bytes() if LOCAL else None)
+OPTIMUM = optimum_searches(config, AVAILABLE)
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):

@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import Case, by_model, case_of_table
-from ..core.labels import case_label
-from ..core.registry import PRESETS, SCHEME_DOCS
+from ..core.labels import case_label, preset_of
+from ..core.registry import SCHEME_DOCS
 
 
 def _near(df: pd.DataFrame, t: float) -> pd.Series:
@@ -169,7 +169,7 @@ def _model_words(model: Case) -> tuple[str, str]:
     cut = f", kernel cut at {model.truncation:g} widths" if model.truncation is not None else ""
     if model.scheme == "symmetric" and model.truncation is None:
         return "the paper's Eqs. 16-21, whole Gaussian", "the equations give"
-    if model.variant() == PRESETS["authors"]:
+    if preset_of(model) == "authors":
         return "the authors' algorithm (their loop, SPH constant, kernel cut at 3 widths, time grid)", (
             "the authors' algorithm gives"
         )

@@ -48,12 +48,17 @@ def variant_parts(case: Case) -> list[str]:
     return parts
 
 
+def preset_of(case: Case) -> str | None:
+    """The preset (registry.PRESETS) whose dimensions are exactly the case's variant, or None."""
+    return next((p for p, dims in PRESETS.items() if case.variant() == dims), None)
+
+
 def case_label(case: Case, n: bool = True) -> str:
     """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
     parts = [f"{case.method.upper()} {KERNEL_NAMES[case.kernel]}"]
     if case.method == "mtpt":
         parts.append(f"η={case.eta:g}")
-    preset = next((p for p, dims in PRESETS.items() if case.variant() == dims), None)
+    preset = preset_of(case)
     parts += [PRESET_LABELS[preset]] if preset else variant_parts(case)
     if n and case.n is not None:
         parts.append(f"N={case.n:,}")

@@ -353,10 +353,7 @@ def check_sweeps(config: Mapping) -> None:
                     case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
                     run_config(case, config)
             except SettingError as e:
-                if e.name in SHARED_KEYS:  # a shared setting, wrong for this case: name both
-                    key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
-                    raise SettingError(key, e.value, f"{e.allowed} (for {where}, {case_label(case)})") from None
-                raise SettingError(f"{where}.{e.name}", e.value, e.allowed) from None
+                raise _case_error(e, where, case) from None  # a shared setting names its key and the case
         particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
         for n in spec["n"] if particles else []:
             try:
