@@ -53,13 +53,19 @@ def preset_of(case: Case) -> str | None:
     return next((p for p, dims in PRESETS.items() if case.variant() == dims), None)
 
 
+def variant_text(case: Case) -> str:
+    """Legend words for how the case differs from the paper's defaults: its preset's name when it
+    is one (registry.PRESETS), else its variant_parts joined ('' for the paper's own)."""
+    preset = preset_of(case)
+    return PRESET_LABELS[preset] if preset is not None else ", ".join(variant_parts(case))
+
+
 def case_label(case: Case, n: bool = True) -> str:
     """Legend text, e.g. 'MTPT collision, η=1, truncation 3, sequential loop, N=300'."""
     parts = [f"{case.method.upper()} {KERNEL_NAMES[case.kernel]}"]
     if case.method == "mtpt":
         parts.append(f"η={case.eta:g}")
-    preset = preset_of(case)
-    parts += [PRESET_LABELS[preset]] if preset else variant_parts(case)
+    parts += [variant_text(case)] if variant_text(case) else []
     if n and case.n is not None:
         parts.append(f"N={case.n:,}")
     return ", ".join(parts)

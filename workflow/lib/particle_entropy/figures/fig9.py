@@ -10,7 +10,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..core.case import Case, rows_of
-from ..core.labels import PRESET_LABELS, case_label, preset_of, variant_parts
+from ..core.labels import case_label, variant_text
 from .style import (
     BLUE,
     COLLISION,
@@ -43,10 +43,7 @@ def _family(case: Case) -> tuple:
 
 def _scheme_text(model: Case) -> str:
     """How a model differs from the paper's equations, for a Fig. 9 legend (a preset by its name)."""
-    preset = preset_of(model)
-    if preset is not None:
-        return PRESET_LABELS[preset]
-    return ", ".join(variant_parts(model)) or "paper's equations (whole Gaussian)"
+    return variant_text(model) or "paper's equations (whole Gaussian)"
 
 
 def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: float) -> list[Series]:

@@ -20,7 +20,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from ..core.case import Case, rows_of
-from ..core.labels import case_label, variant_parts
+from ..core.labels import case_label, variant_text
 from ..numerics.kernels import truncated_variance_fraction
 from .fig9 import PAPER_STYLES as FIG9_STYLES
 from .style import (
@@ -57,8 +57,8 @@ def truncation_floor(D: float, t: float, fraction: float, omega: float) -> float
 
 
 def _label(model: Case, equations: Case | None) -> str:
-    """A model by what it changes from the paper's equations."""
-    text = ", ".join(variant_parts(model))
+    """A model by what it changes from the paper's equations (a preset by its name)."""
+    text = variant_text(model)
     if model == equations:
         return "paper's equations (whole Gaussian)" + (f", {text}" if text else "")
     return text or case_label(model, n=False)
