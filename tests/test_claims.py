@@ -10,7 +10,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from particle_entropy.analysis.claims import comic_claims, ensemble_claims, flatness, single_run_claims, to_markdown
+from particle_entropy.analysis.claims import (
+    claims_table,
+    comic_claims,
+    ensemble_claims,
+    flatness,
+    single_run_claims,
+    to_markdown,
+)
 from particle_entropy.core.case import Case
 from particle_entropy.core.labels import case_label
 
@@ -31,6 +38,7 @@ def _minima(rows: list[tuple[Case, float, int, int]], **bootstrap) -> pd.DataFra
         [
             {"label": case_label(m), **m.columns(), "time": t, "n_opt": n, "n_opt_of_mean_SSE": k}
             | {"n_opt_share": 1.0, "n_opt_of_mean_SSE_share": 1.0, "n_resamples": 0}
+            | {"n_opt_ci_lo": n, "n_opt_ci_hi": n, "n_opt_of_mean_SSE_ci_lo": k, "n_opt_of_mean_SSE_ci_hi": k}
             | bootstrap
             for m, t, n, k in rows
         ]
@@ -38,11 +46,13 @@ def _minima(rows: list[tuple[Case, float, int, int]], **bootstrap) -> pd.DataFra
 
 
 def _comic(rows: list[tuple]) -> pd.DataFrame:
-    """(case with N, time, mean COMIC[, std of COMIC]) -> a COMIC table (std 0.5 unless given)."""
+    """(case with N, time, mean COMIC[, std of COMIC[, COMIC of mean SSE, std / mean of SSE]]) -> a
+    COMIC table (std 0.5, COMIC of mean SSE = mean COMIC and SSE std 0.1 x mean unless given)."""
     return pd.DataFrame(
         [
             {"label": case_label(r[0], n=False), **r[0].columns(), "time": r[1], "COMIC_mean": r[2]}
-            | {"COMIC_std": r[3] if len(r) > 3 else 0.5}
+            | {"COMIC_std": r[3] if len(r) > 3 else 0.5, "COMIC_of_mean_SSE": r[4] if len(r) > 4 else r[2]}
+            | {"SSE_mean": 1.0, "SSE_std": r[5] if len(r) > 5 else 0.1}
             for r in rows
         ]
     )
@@ -141,8 +151,8 @@ def test_fig9_rows_name_the_scheme_and_give_the_bootstrap_interval():
         assert c["passed"] is True  # judged by the optimum alone, though the interval reaches below 1000
     assert sum(c["claim"].startswith(case_label(COLL1) + ": COMIC minimum") for c in claims) == 2
     assert sum(c["claim"].startswith(case_label(seq) + ": COMIC minimum") for c in claims) == 2
-    md = to_markdown(pd.DataFrame(claims))
-    assert all(line.count(" | ") == 4 for line in md.splitlines() if line.startswith("| MTPT"))  # five cells
+    md = to_markdown(claims_table(claims))
+    assert all(line.count(" | ") == 6 for line in md.splitlines() if line.startswith("| MTPT"))  # seven cells
 
 
 def test_an_optimum_outside_its_range_fails_though_its_interval_reaches_in():
@@ -201,6 +211,61 @@ def test_sph_flatness_without_error_bars():
     assert uneven["flat"] is False and uneven["ratio"] == math.inf and uneven["n_worst"] == 300
 
 
+def _sph_realisations(model: Case, points: dict[int, tuple[float, float, int]], time: float = 1000.0):
+    """comic_realisations rows of ``model``: per N, ``count`` values with exactly the given mean and std."""
+    rows = []
+    for n, (mean, std, count) in points.items():
+        z = np.random.default_rng(n).standard_normal(count)
+        z = (z - z.mean()) / z.std(ddof=1)
+        rows += [{**model.at(n).columns(), "time": time, "seed": k, "COMIC": mean + std * v} for k, v in enumerate(z)]
+    return pd.DataFrame(rows)
+
+
+def test_the_three_rules_disagree_where_they_should_and_each_has_its_column():
+    # N = 100 lies 1 / sqrt(2) = 0.71 combined std above N_opt = 300: flat by the project's rule; its paper
+    # bar is unbounded below (SSE std > mean): flat as drawn; but 80 realisations each make the difference
+    # 6.3 standard errors: the test finds N = 100 worse.
+    comic = _comic([(SPH.at(100), 1000.0, 1.0, 1.0, 1.0, 1.2), (SPH.at(300), 1000.0, 0.0, 1.0, 0.0, 0.1)])
+    real = _sph_realisations(SPH, {100: (1.0, 1.0, 80), 300: (0.0, 1.0, 80)})
+    (row,) = [c for c in comic_claims(FD_MINIMA, comic, TOL, real) if "flat" in c["claim"]]
+    assert row["passed"] is True and row["passed_as_drawn"] is True and row["passed_test"] is False
+    assert "lower bar unbounded at N = 100" in row["as_drawn"]
+    assert "most significant N=100, worse" in row["test"] and "80 vs 80 realisations" in row["test"]
+    # five realisations each: the same means are not significantly apart (t = 1.6, Holm p = 0.08)
+    few = _sph_realisations(SPH, {100: (1.0, 1.0, 5), 300: (0.0, 1.0, 5)})
+    (row,) = [c for c in comic_claims(FD_MINIMA, comic, TOL, few) if "flat" in c["claim"]]
+    assert row["passed_test"] is True and "not significantly worse" in row["test"]
+    # without the realisations table the test is not judged, and the Markdown cell stays empty
+    (row,) = [c for c in comic_claims(FD_MINIMA, comic, TOL) if "flat" in c["claim"]]
+    assert row["passed_test"] is None and row["test"] is None
+    table = claims_table([row])
+    (line,) = [line for line in to_markdown(table).splitlines() if line.startswith("| MTPT")]
+    assert table["passed_test"].isna().all() and line.endswith(" |  |")
+
+
+def test_an_optimum_is_judged_from_its_drawn_bars_and_its_interval():
+    # COMIC of mean SSE least at N = 30000, outside [1000, 10000]; N = 10000's bar overlaps the minimum's
+    comic = _comic([(COLL1.at(n), 1000.0, c, 0.5, c, 0.5) for n, c in ((1000, 3.0), (10000, 0.3), (30000, 0.0))])
+    boot = {"n_resamples": 2000, "n_opt_of_mean_SSE_ci_lo": 10000, "n_opt_of_mean_SSE_ci_hi": 30000}
+    boot |= {"n_opt_ci_lo": 30000, "n_opt_ci_hi": 30000, "n_opt_share": 0.9, "n_opt_of_mean_SSE_share": 0.7}
+    claims = comic_claims(_minima([(COLL1, 1000.0, 30000, 30000)], **boot), comic, TOL)
+    by = {("mean SSE" in c["claim"]): c for c in claims}
+    sse, mean = by[True], by[False]
+    assert sse["passed"] is False and sse["passed_as_drawn"] is True and sse["passed_test"] is True
+    assert "bars overlapping it at N = 10000, 30000" in sse["as_drawn"]  # 1000's bar, 3 + ln 0.5 > ln 1.5
+    assert "interval of N_opt 10000-30000 overlaps the range" in sse["test"]
+    assert mean["passed_as_drawn"] is None  # the paper drew the COMIC of the mean SSE, not the mean COMIC
+    assert mean["passed_test"] is False and "30000-30000 misses" in mean["test"]
+    md = to_markdown(claims_table(claims))
+    assert "The rules disagree on:" in md and "mean SSE" in md.split("The rules disagree on:")[1]
+    assert "result FAIL, as drawn pass, test pass" in md
+    summary = md.splitlines()[2]
+    assert summary == (
+        "0 of 2 claims pass by the project's rule (as the paper drew them, 1 of 1 judged pass; by a test, 1 of 2 "
+        "judged pass)."
+    )
+
+
 # --------------------------------------------------------------------------- ensemble claims
 def _summary(case: Case, times, **columns) -> pd.DataFrame:
     df = pd.DataFrame({"time": times, "n_realisations": 4, **columns})
@@ -257,7 +322,7 @@ def test_single_run_claims_on_runs_built_to_pass():
 
 # --------------------------------------------------------------------------- markdown
 def test_markdown_counts_passes():
-    claims = pd.DataFrame(
+    claims = claims_table(
         [
             {"claim": f"c{k}", "paper": "p", "reproduced": "r", "tolerance": "t", "passed": ok}
             for k, ok in enumerate([True, False, True, True, False])
@@ -294,8 +359,8 @@ def test_single_run_claims_without_the_mtpt_case_skip_it():
 
 
 def test_markdown_escapes_bars_inside_cells():
-    claims = pd.DataFrame(
+    claims = claims_table(
         [{"claim": "c", "paper": "|d ln E| > 0", "reproduced": "|dH_C| 0.1", "tolerance": "t", "passed": True}]
     )
-    row = to_markdown(claims).splitlines()[-1]
-    assert row == r"| c | \|d ln E\| > 0 | \|dH_C\| 0.1 | t | pass |"
+    row = next(line for line in to_markdown(claims).splitlines() if line.startswith("| c |"))
+    assert row == r"| c | \|d ln E\| > 0 | \|dH_C\| 0.1 | t | pass |  |  |"  # no other rule: empty cells

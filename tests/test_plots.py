@@ -421,3 +421,54 @@ def test_save_figure_is_byte_stable(tmp_path):
         style.save_figure(figure, tmp_path / f"{k}.png", tmp_path / f"{k}.pdf")
         outputs.append([(tmp_path / f"{k}.{ext}").read_bytes() for ext in ("png", "pdf")])
     assert outputs[0] == outputs[1]
+
+
+def _consistent_comic(cases: list[Case], ratios: dict[int, float]) -> pd.DataFrame:
+    """A COMIC table whose mean-SSE columns follow Eq. 43 (aggregate.comic_of_mean_sse); SSE std =
+    ratio x mean per N."""
+    from particle_entropy.analysis.aggregate import comic_of_mean_sse
+
+    rows = []
+    for c in cases:
+        sse, std = 1e-4 * c.n**-0.5, 1e-4 * c.n**-0.5 * ratios[c.n]
+        rows.append(
+            {"label": case_label(c, n=False), **c.columns(), "time": 20.0, "time_step": 19.9}
+            | {"COMIC_mean": -9.0 - math.log(c.n), "COMIC_std": 0.3, "SSE_mean": sse, "SSE_std": std}
+            | comic_of_mean_sse(sse, std, c.n, 10.0 / c.n)
+            | {"n_realisations": 3}
+        )
+    return pd.DataFrame(rows)
+
+
+def test_fig9_draws_the_papers_bars_at_half_eq43s_width_when_asked():
+    ratios = {30: 1.5, 100: 0.6, 300: 0.2}  # std > mean at N = 30: the lower bar is unbounded either way
+    cases = [Case("mtpt", "sph", n) for n in ratios]
+    comic = _consistent_comic(cases, ratios)
+    _, eq43 = draw("fig9", cases, [comic])
+    figure, paper = figure_function("fig9")([comic], cases, **KW, bars="paper")
+    pick = lambda d: {k: v.to_numpy() for k, v in d[d["y_name"] == "COMIC of mean SSE"].sort_values("n").items()}
+    eq43, paper = pick(eq43), pick(paper)
+    assert (paper["y"] == eq43["y"]).all()
+    r = np.array([ratios[n] for n in paper["n"]])
+    # Eq. 43: 2 ln(SSE (1 +- r)) - ...: twice the script's ln(SSE +- std) - ln(SSE) about the same point
+    assert eq43["y_hi"] - eq43["y"] == pytest.approx(2 * (paper["y_hi"] - paper["y"]), rel=1e-12)
+    assert paper["y_hi"] - paper["y"] == pytest.approx(np.log1p(r), rel=1e-12)
+    assert paper["y_lo"][1:] - paper["y"][1:] == pytest.approx(np.log(1 - r[1:]), rel=1e-12)
+    assert np.isneginf(paper["y_lo"][0]) and np.isneginf(eq43["y_lo"][0])
+    legends = [t.get_text() for ax in figure.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert any("COMIC of mean SSE, the paper's bars" in t for t in legends)
+    with pytest.raises(ValueError, match=r"figures.fig9.bars = 'nosuch': expected one of eq43, paper"):
+        figure_function("fig9")([comic], cases, **KW, bars="nosuch")
+
+
+def test_figure_options_are_the_schemas_and_defaults_fill_in():
+    from particle_entropy.figures import FIGURE_OPTIONS, figure_options
+
+    schema = yaml.safe_load((Path(__file__).parents[1] / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    for fig, options in FIGURE_OPTIONS.items():
+        entries = schema["properties"]["figures"]["properties"][fig]["properties"]
+        for key, (choices, default) in options.items():
+            assert entries[key]["enum"] == list(choices) and entries[key]["default"] == default
+    assert figure_options("fig9", {"cases": [], "n": [30]}) == {"bars": "eq43"}
+    assert figure_options("fig9", {"bars": "paper"}) == {"bars": "paper"}
+    assert figure_options("fig1", {"bars": "paper"}) == {}  # no options: nothing passed on

@@ -82,6 +82,7 @@ rule paper_claims:
     input:
         minima="results/tables/comic_minima.parquet",
         comic="results/tables/comic.parquet",
+        realisations="results/tables/comic_realisations.parquet",
         summaries=summaries_of("fig3", "fig5"),
         runs=section_inputs("fig1") if "fig1" in FIGURES else [],
     output:

@@ -22,7 +22,7 @@ from particle_entropy.pipeline.codeversion import code_version
 from particle_entropy.core.verify import CORRUPT_SUFFIX, corrupt_tables, set_aside
 from particle_entropy.core.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
-from particle_entropy.figures import FIGURE_MODULES
+from particle_entropy.figures import FIGURE_MODULES, figure_options
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,

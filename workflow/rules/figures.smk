@@ -30,6 +30,7 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             cases=section_cases(_fig),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
+            options=figure_options(_fig, config.get("figures", {}).get(_fig, {})),
             code=PLOT_CODE[_fig],
         script:
             "../scripts/plot_figure.py"

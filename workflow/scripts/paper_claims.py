@@ -7,7 +7,6 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from particle_entropy.analysis import claims as C
@@ -18,7 +17,7 @@ inp, par = snakemake.input, snakemake.params
 tol, defaults = par.claims, par.case_defaults
 rows = C.single_run_claims([pd.read_parquet(p) for p in inp.runs], defaults)
 rows += C.ensemble_claims([pd.read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]), defaults)
-rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), tol)
+rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), tol, pd.read_parquet(inp.realisations))
 claims = C.claims_table(rows)
 write_parquet(claims, snakemake.output.table)
 Path(snakemake.output.md).write_text(C.to_markdown(claims))
@@ -28,11 +27,10 @@ STYLE = (
     "th,td{border:1px solid #ccc;padding:3px 6px;text-align:left;vertical-align:top}"
     "td.pass{color:#05612d}td.fail{color:#b00020;font-weight:bold}"
 )
-summary = C.to_markdown(claims).splitlines()[2]  # "k of n claims pass." (or why none is judged)
-shown = claims.assign(result=np.where(claims["passed"], "pass", "FAIL")).drop(columns="passed")
-table = shown.to_html(index=False, border=0, classes="claims")
-for verdict in ("pass", "FAIL"):
+table = C.display_table(claims).to_html(index=False, border=0, classes="claims")
+for verdict in ("pass", "FAIL"):  # the result cells, and the other rules' cells by their first word
     table = table.replace(f"<td>{verdict}</td>", f'<td class="{verdict.lower()}">{verdict}</td>')
-body = f"<p>{summary}</p>\n{table}\n"
+    table = table.replace(f"<td>{verdict}: ", f'<td class="{verdict.lower()}">{verdict}: ')
+body = f"<p>{C.summary_line(claims)}</p>\n{table}\n"
 Path(snakemake.output.html).write_text(page("Paper claims", body, STYLE, "Paper claims: reproduced values"))
 print(claims.to_string(), file=sys.stderr)

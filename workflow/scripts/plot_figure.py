@@ -18,7 +18,8 @@ from particle_entropy.figures.style import save_figure
 par, out = snakemake.params, snakemake.output
 tables = [pd.read_parquet(p) for p in snakemake.input]
 cases = [Case.from_wildcards(c) for c in par.cases]
-figure, data = figure_function(par.fig)(tables, cases, D=float(par.D), t_final=float(par.t_final))
+draw = figure_function(par.fig)
+figure, data = draw(tables, cases, D=float(par.D), t_final=float(par.t_final), **par.options)
 save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)
 print(f"drew {par.fig}: {len(cases)} cases from {len(tables)} tables, {len(data)} plotted points", file=sys.stderr)

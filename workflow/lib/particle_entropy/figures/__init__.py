@@ -25,7 +25,19 @@ FIGURE_MODULES = {
 }
 
 
+# figure -> {config key under figures.<fig>: (its choices, the default)}: drawing options a config
+# may set beside a figure's cases (the schema lists the same, tests/test_figure_options.py)
+FIGURE_OPTIONS = {
+    "fig9": {"bars": (("eq43", "paper"), "eq43")},
+}
+
+
+def figure_options(name: str, section: dict) -> dict:
+    """The drawing options of figure ``name`` from its config section, defaults filled in."""
+    return {key: section.get(key, default) for key, (_, default) in FIGURE_OPTIONS.get(name, {}).items()}
+
+
 def figure_function(name: str):
-    """The function drawing figure ``name``, ``(tables, cases, D=..., t_final=...) -> (Figure, source
-    data)``; imports only its module."""
+    """The function drawing figure ``name``, ``(tables, cases, D=..., t_final=..., **options) ->
+    (Figure, source data)``, options from ``figure_options``; imports only its module."""
     return getattr(importlib.import_module(f"{__name__}.{FIGURE_MODULES[name]}"), name)

@@ -9,8 +9,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from ..analysis.judging import paper_bars
 from ..core.case import Case, rows_of
 from ..core.labels import case_label, variant_text
+from . import FIGURE_OPTIONS
 from .style import (
     BLUE,
     COLLISION,
@@ -46,8 +48,21 @@ def _scheme_text(model: Case) -> str:
     return variant_text(model) or "paper's equations (whole Gaussian)"
 
 
-def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: float) -> list[Series]:
-    """Fig. 9 series of one model: mean COMIC +-1 std, and the COMIC of the mean SSE (dotted)."""
+# the bars about the COMIC of the mean SSE (config figures.fig9.bars): eq43, Eq. 43 applied to
+# SSE_mean -+ SSE_std; paper, ln(SSE_mean -+ SSE_std) - ln(SSE_mean) as the authors' script draws them
+BARS = FIGURE_OPTIONS["fig9"]["bars"][0]
+
+
+def _mean_sse_bars(g: pd.DataFrame, bars: str) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper ends of the bars about the COMIC of the mean SSE (-inf: std >= mean)."""
+    if bars == "paper":
+        return paper_bars(g["COMIC_of_mean_SSE"], g["SSE_mean"], g["SSE_std"])
+    return g["COMIC_of_mean_SSE_lo"].to_numpy(float), g["COMIC_of_mean_SSE_hi"].to_numpy(float)
+
+
+def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: float, bars: str) -> list[Series]:
+    """Fig. 9 series of one model: mean COMIC +-1 std, and the COMIC of the mean SSE (dotted) with
+    the ``bars`` of BARS."""
     n, mu, sd = (g[k].to_numpy(float) for k in ("n", "COMIC_mean", "COMIC_std"))
     common = dict(
         case=model,
@@ -59,6 +74,8 @@ def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: f
     )
     line = "--" if style.get("linestyle") == ":" else style.get("linestyle", "-")  # dotted: the mean-SSE series
     name, short = case_label(model, n=False), _scheme_text(model)
+    lo, hi = _mean_sse_bars(g, bars)
+    sse_legend = f"{short}: COMIC of mean SSE" + (", the paper's bars" if bars == "paper" else "")
     return [
         Series(
             letter,
@@ -75,11 +92,11 @@ def _fig9_panel(letter: str, model: Case, g: pd.DataFrame, style: dict, dodge: f
         Series(
             letter,
             f"{name}: COMIC of ensemble-mean SSE",
-            legend=f"{short}: COMIC of mean SSE",
+            legend=sse_legend,
             y_name="COMIC of mean SSE",
             y=g["COMIC_of_mean_SSE"],
-            y_lo=g["COMIC_of_mean_SSE_lo"].to_numpy(float),
-            y_hi=g["COMIC_of_mean_SSE_hi"].to_numpy(float),
+            y_lo=lo,
+            y_hi=hi,
             kind="errorbar",
             style={**style, "open": True, "linestyle": ":", "alpha": 0.7, "zorder": 2, "dodge": dodge * 1.04},
             **common,
@@ -117,10 +134,13 @@ def _minimum_text(row: pd.Series) -> str:
     return f"N_opt {int(row['n_opt']):,}, 95% CI {ci} ({row['n_opt_share']:.0%})"
 
 
-def fig9(tables, cases, *, D: float, t_final: float):
+def fig9(tables, cases, *, D: float, t_final: float, bars: str = "eq43"):
     """Fig. 9: ensemble COMIC +-1 std against N at the time nearest t_final, one panel per kernel
     and eta with every scheme side by side, minima starred; below each, how often each N is the
-    argmin when the realisations are resampled (bootstrap), with the minimum's 95% interval."""
+    argmin when the realisations are resampled (bootstrap), with the minimum's 95% interval. The
+    COMIC of the mean SSE carries the ``bars`` of BARS (``paper``: as the published panels)."""
+    if bars not in BARS:
+        raise ValueError(f"figures.fig9.bars = {bars!r}: expected one of {', '.join(BARS)}")
     empty = pd.DataFrame()
     comic, minima, argmin = (list(tables) + [empty] * 3)[:3]
     style, models = styles(cases, PAPER_STYLES), distinct_models(cases)
@@ -144,7 +164,7 @@ def fig9(tables, cases, *, D: float, t_final: float):
                 continue
             g = rows_nearest(g, t_final).sort_values("n")
             dodge = 1.0 + 0.1 * (k - (len(mine) - 1) / 2)
-            series = _fig9_panel(letter, model, g, style[model], dodge)
+            series = _fig9_panel(letter, model, g, style[model], dodge, bars)
             for s in series:
                 draw(ax, s)
             mean = series[0]

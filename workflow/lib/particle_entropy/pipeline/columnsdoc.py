@@ -94,7 +94,13 @@ CLAIM_COLUMNS = {  # claims.COLUMNS
     "paper": "what the paper states (text)",
     "reproduced": "what this run gives (text, numbers formatted)",
     "tolerance": "the criterion the claim is judged by (text; ranges from `claims` in the config)",
-    "passed": "the reproduced value meets the criterion",
+    "passed": "the reproduced value meets the criterion (the project's rule)",
+    "as_drawn": "(a) what the paper's own Fig. 9 bars show, ln(SSE +- std) - ln(SSE) about the COMIC of the mean "
+    "SSE (`judging.py`; empty where the rule does not apply)",
+    "passed_as_drawn": "verdict of (a), null where it does not apply",
+    "test": "(b) what a test at level 0.05 finds: the bootstrap interval of the argmin against the range, or "
+    "Holm-adjusted one-sided Welch t-tests of each N against the best (`judging.py`; empty where not judged)",
+    "passed_test": "verdict of (b), null where it does not apply or cannot be computed",
 }
 SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
     "dt": "the run's fixed time step (setting) [T]",
