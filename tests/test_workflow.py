@@ -724,6 +724,21 @@ def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
         assert expected(_planned_rules(proc)), (module, sorted(_planned_rules(proc)))
         assert planned_outputs(proc) == [], module  # no simulation
         (figures / module).write_text(original)
+    # a rules file: the summaries hash summarise.smk, which holds their rule alone, so an edit to
+    # the other aggregation rules reruns none of them
+    rules = src / "workflow/rules"
+    for name, expected in [
+        ("aggregate.smk", lambda planned: planned == set()),
+        (
+            "summarise.smk",
+            lambda planned: "summarise_case" in planned and not any(r.startswith("simulate") for r in planned),
+        ),
+    ]:
+        original = (rules / name).read_text()
+        (rules / name).write_text(original + "# an edit\n")
+        proc = plan()
+        assert expected(_planned_rules(proc)), (name, sorted(_planned_rules(proc)))
+        (rules / name).write_text(original)
 
 
 # --- what parsing imports -----------------------------------------------------------------------

@@ -233,7 +233,7 @@ SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {
     m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"]) for m in METHODS
 }
-SUMMARY_CODE = code_version("aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "aggregate.smk"])
+SUMMARY_CODE = code_version("aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"])
 COMIC_CODE = code_version("aggregate", "io", "htmlpage", files=[SCRIPTS / "comic_tables.py"])
 TRADEOFF_CODE = code_version("aggregate", "io", files=[SCRIPTS / "tradeoff_table.py"])
 CLAIMS_CODE = code_version("claims", "io", "htmlpage", files=[SCRIPTS / "paper_claims.py"])
