@@ -364,3 +364,18 @@ def test_markdown_escapes_bars_inside_cells():
     )
     row = next(line for line in to_markdown(claims).splitlines() if line.startswith("| c |"))
     assert row == r"| c | \|d ln E\| > 0 | \|dH_C\| 0.1 | t | pass |  |  |"  # no other rule: empty cells
+
+
+def test_a_model_on_its_own_time_grid_is_judged_at_its_own_step_and_says_which():
+    from particle_entropy.analysis.aggregate import comic_minima
+
+    authors = Case("mtpt", "collision", truncation=3, scheme="authors", time_grid="authors")
+    comic = _comic([(m.at(n), 1000.0, -float(n), 0.5) for m in (COLL1, authors) for n in (1000, 3000)])
+    comic["time_step"] = np.where(comic["time_grid"] == "authors", 1021.109409, 1000.0)
+    minima = comic_minima(comic)
+    assert dict(zip(minima["time_grid"], minima["time_step"])) == {"exact": 1000.0, "authors": 1021.109409}
+    claims = {c["claim"]: c for c in comic_claims(minima, comic, TOL)}
+    own = [k for k in claims if "authors' algorithm" in k]
+    assert len(own) == 2 and all("at t = 1000 (its step t = 1021.1)" in k for k in own)
+    assert all("at t = 1000 (" in k for k in claims if k not in own)
+    assert not any("its step" in k for k in claims if k not in own)

@@ -570,6 +570,10 @@ def test_a_config_without_figures_judges_no_claim(tmp_path):
         "reproduced",
         "tolerance",
         "passed",
+        "as_drawn",
+        "passed_as_drawn",
+        "test",
+        "passed_test",
     ]
 
 

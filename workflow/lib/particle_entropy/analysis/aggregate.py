@@ -195,6 +195,8 @@ MINIMA_COLUMN_DOCS = {
     "label": "legend label of the model (without N)",
     **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},
     "time": "requested time (the COMIC rows are at the nearest recorded step) [T]",
+    "time_step": "the recorded step of `n_opt`'s row, the model's own time (its last step for the final time: "
+    "t = 1021.1 on the authors' time grid) [T]",
     "n_opt": "N of least mean COMIC, the ensemble mean of per-realisation COMIC (the smallest N among ties)",
     "COMIC_opt": "mean COMIC at `n_opt` (Eq. 43)",
     "COMIC_opt_std": "ensemble standard deviation of COMIC at `n_opt` (ddof = 1; 0 for one realisation)",
@@ -228,6 +230,7 @@ def _minimum(model, time: float, g: pd.DataFrame) -> dict:
         "label": case_label(model),
         **model.columns(),
         "time": time,
+        "time_step": float(g["time_step"][k]) if "time_step" in g else float(time),
         "n_opt": int(g["n"][k]),
         "COMIC_opt": g["COMIC_mean"][k],
         "COMIC_opt_std": g["COMIC_std"][k],

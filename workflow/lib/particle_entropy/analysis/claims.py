@@ -224,6 +224,13 @@ def flatness(rows: pd.DataFrame, min_n: int) -> dict:
     }
 
 
+def _at(time: float, step: float | None) -> str:
+    """'t = 1000', or 't = 1000 (its last step, t = 1021.1)' for a model whose steps miss it."""
+    if step is None or pd.isna(step) or abs(step - time) <= 1e-9 * max(1.0, abs(time)):
+        return f"t = {time:g}"
+    return f"t = {time:g} (its step t = {step:.5g})"
+
+
 def _ns(ns) -> str:
     """'100, 300' or 'none'."""
     return ", ".join(str(int(n)) for n in ns) or "none"
@@ -314,7 +321,8 @@ def comic_claims(
                 drawn = _drawn_optimum(drawn_rows, lo, hi) if col == "n_opt_of_mean_SSE" else (None, None)
                 out.append(
                     _claim(
-                        f"{case_label(model)}: COMIC minimum at t = {row['time']:g} ({how}; {_model_words(model)[0]})",
+                        f"{case_label(model)}: COMIC minimum at {_at(row['time'], row.get('time_step'))} "
+                        f"({how}; {_model_words(model)[0]})",
                         f"{paper}, the authors' code",
                         f"{_model_words(model)[1]} {_optimum_text(row, col)}",
                         f"N_opt in [{lo}, {hi}]",
@@ -334,7 +342,7 @@ def comic_claims(
                 f"{case_label(model)}: COMIC roughly flat for N >= {min_n} ({_model_words(model)[0]})",
                 "flat, worse only for N < 100",
                 f"largest distance from the minimum {f['ratio']:.2f} combined std, at N={f['n_worst']} "
-                f"(N_opt={f['n_opt']}, t = {time:g})",
+                f"(N_opt={f['n_opt']}, {_at(time, sph['time_step'].iloc[0] if 'time_step' in sph else None)})",
                 f"<= 1 combined std, sqrt(std(N)^2 + std(N_opt)^2), for every N >= {min_n}",
                 f["flat"],
                 as_drawn=_drawn_flat(sph, min_n),
