@@ -9,8 +9,12 @@ min_version("8.0")
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
 from particle_entropy.pipeline.configcheck import load_yaml
 
-if Path("config.yaml").exists():  # Snakemake's loader does not say where a YAML error is
-    load_yaml("config.yaml")
+# Snakemake's loader does not say where a YAML error is, keeps the last of two equal keys and runs
+# a file with __use_yte__ as a template (code): config.yaml is checked before it is loaded; a
+# --configfile was loaded (and any template run) before this file, so it is refused here after
+# the fact (the README: a --configfile is trusted like the Snakefile).
+for _config_file in (["config.yaml"] if Path("config.yaml").exists() else []) + list(workflow.overwrite_configfiles):
+    load_yaml(_config_file)
 
 
 configfile: "config.yaml"

@@ -39,6 +39,16 @@ def _add_case(section, case, n=None):
     return change
 
 
+def _rename_in(path, old, new):
+    def change(cfg):
+        node = cfg
+        for k in path:
+            node = node[k]
+        node[new] = node.pop(old)
+
+    return change
+
+
 def _rename_top(old, new):
     return lambda cfg: cfg.update({new: cfg.pop(old)})
 
@@ -122,6 +132,13 @@ BAD = [
         ["optimum.collision_eta1.case.kernel='sph'", "bins, fixed, adaptive"],
     ),
     ("optimum time past t_final", _set(("optimum", "fd_t250", "time"), 2000), ["optimum.fd_t250.time=2000", "t_final"]),
+    # `$` in a schema pattern also matches before a final newline: a key "fig1\n" was accepted and ignored
+    (
+        "figure key ending in a newline",
+        _rename_in(("figures",), "fig1", "fig1\n"),
+        ["figures['fig1\\n']", "fig1 ... fig9"],
+    ),
+    ("optimum name ending in a newline", _rename_in(("optimum",), "fd_t250", "x\n"), ["optimum['x\\n']", "letters"]),
 ]
 
 
@@ -168,3 +185,64 @@ def test_check_config_command(tmp_path, capsys):
     broken.write_text("physics: {D: 1.0e-3\n")
     assert main(["check-config", str(broken)]) == 2
     assert "line 2" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "text,expected",
+    [
+        (
+            "physics:\n  D: 1.0e-3\n  t_final: 1000\n  D: 2.0e-3\n",
+            "line 4: key 'D' given twice in one mapping (first at line 2)",
+        ),
+        ("__use_yte__: true\n?if True:\n  physics: {D: 1.0e-3}\n", "line 1: __use_yte__ makes Snakemake run this file"),
+        ("figures:\n  fig1: {__use_yte__: true}\n", "line 2: __use_yte__"),
+    ],
+    ids=["duplicate key", "yte template", "yte key nested"],
+)
+def test_config_is_data_a_duplicate_key_or_a_template_is_refused_by_line(tmp_path, text, expected):
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigFileError) as err:
+        load_yaml(path)
+    assert str(err.value).startswith(f"{path}: ") and expected in str(err.value)
+
+
+def test_equal_keys_in_different_mappings_are_fine(tmp_path):
+    path = tmp_path / "c.yaml"
+    path.write_text("a: {n: 1}\nb: {n: 2}\nc: [{n: 1}, {n: 2}]\n")
+    assert load_yaml(path) == {"a": {"n": 1}, "b": {"n": 2}, "c": [{"n": 1}, {"n": 2}]}
+
+
+def test_check_config_refuses_a_non_utf8_file_and_a_template_in_one_line(tmp_path, capsys):
+    binary = tmp_path / "latin1.yaml"
+    binary.write_bytes("physics: {D: 1.0e-3}  # caf\xe9\n".encode("latin-1"))
+    assert main(["check-config", str(binary)]) == 2
+    err = capsys.readouterr().err
+    assert "latin1.yaml: not UTF-8 text at line 1 (byte 27 is 0xe9)" in err and len(err.splitlines()) == 1
+    template = tmp_path / "template.yaml"
+    template.write_text("__use_yte__: true\n")
+    assert main(["check-config", str(ROOT / "config.yaml"), str(template)]) == 2
+    assert "__use_yte__" in capsys.readouterr().err
+
+
+def test_nested_command_line_overrides_are_typed_as_a_file_types_them():
+    from particle_entropy.pipeline.configcheck import retype_overrides, typed
+
+    # what Snakemake's parse_config hands on for --config physics={D: 0.002, t_final: 1e3} comic_times=[250, 1000]
+    assert typed({"D": "0.002", "t_final": "1e3", "tag": "none", "flag": "true"}) == {
+        "D": 0.002,
+        "t_final": 1000.0,
+        "tag": "none",
+        "flag": True,
+    }
+    assert typed(["250", "1000"]) == [250, 1000]
+    cfg = copy.deepcopy(BASE)
+    overrides = {"physics": {"D": "0.002"}, "comic_times": ["250", "1000"]}
+    cfg["physics"]["D"], cfg["comic_times"] = "0.002", ["250", "1000"]  # as Snakemake merged them
+    retype_overrides(cfg, overrides)
+    assert cfg["physics"] == {**BASE["physics"], "D": 0.002} and cfg["comic_times"] == [250, 1000]
+    check_config(cfg)  # accepted
+    cfg["physics"]["D"] = "abc"
+    retype_overrides(cfg, {"physics": {"D": "abc"}})
+    with pytest.raises(SettingError, match=r"physics.D='abc'"):
+        check_config(cfg)

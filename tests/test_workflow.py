@@ -593,6 +593,36 @@ def test_a_yaml_error_in_config_yaml_names_its_line(tmp_path):
     assert proc.returncode != 0 and "config.yaml: not valid YAML at line" in proc.stdout + proc.stderr
 
 
+# a yte template whose condition runs a command when Snakemake renders it
+TEMPLATE = '__use_yte__: true\n?if __import__("pathlib").Path("{mark}").touch() is None:\n  extra: 1\n'
+
+
+def test_a_template_in_config_yaml_is_refused_before_it_runs(tmp_path):
+    mark = tmp_path / "ran"
+    (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\n" + TEMPLATE.format(mark=mark))
+    proc = snakemake(tmp_path, "-n", check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "config.yaml: line" in out and "__use_yte__ makes Snakemake run" in out
+    assert not mark.exists()  # checked before Snakemake loads it: the code never ran
+
+
+def test_a_template_configfile_is_refused_though_snakemake_ran_it(tmp_path):
+    mark, template = tmp_path / "ran", tmp_path / "template.yaml"
+    template.write_text(TEMPLATE.format(mark=mark))
+    proc = snakemake(tmp_path, "-n", configfile=template, check=False)
+    assert proc.returncode != 0 and "template.yaml: line 1: __use_yte__" in proc.stdout + proc.stderr
+    # Snakemake loads a --configfile before the Snakefile: the README says it is trusted as code
+    assert mark.exists()
+    assert "trust a `--configfile`" in (ROOT / "README.md").read_text()
+
+
+def test_nested_command_line_overrides_of_numbers_and_lists_work(tmp_path):
+    ok = snakemake(tmp_path, "-n", "--config", "physics={D: 0.002}", "comic_times=[5, 20]", configfile=TINY)
+    assert "physics.D" not in ok.stdout + ok.stderr
+    bad = snakemake(tmp_path, "-n", "--config", "physics={D: -1}", configfile=TINY, check=False)
+    assert bad.returncode != 0 and "physics.D=-1 is not allowed" in bad.stdout + bad.stderr
+
+
 # --- docs/columns.md: every column of every derived table is documented ----------------------
 
 COLUMN_DOCS_PAGE = ROOT / "docs" / "columns.md"

@@ -11,9 +11,10 @@ sys.path.insert(0, LIB)
 from particle_entropy.pipeline.codeversion import export_library_path
 
 export_library_path(LIB)  # jobs import this checkout's library in any software environment
-from particle_entropy.pipeline.configcheck import check_schema, load_schema
+from particle_entropy.pipeline.configcheck import check_schema, load_schema, retype_overrides
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
+retype_overrides(config, workflow.config_settings.config)  # --config physics={D: 0.002}: a number
 check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
 validate(config, str(SCHEMA))  # fills the schema's defaults
 

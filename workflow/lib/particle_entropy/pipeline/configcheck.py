@@ -23,17 +23,56 @@ _NUMBER_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
 SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, where PyYAML has it: 10x faster
+YTE_KEY = "__use_yte__"  # Snakemake runs a config file holding this key as a yte template: Python code
 
 
 class ConfigFileError(ValueError):
     """A config file that cannot be read as YAML; the message names the file, line and column."""
 
 
+class _StrictLoader(SAFE_LOADER):
+    """The safe loader, refusing a key given twice in one mapping (YAML keeps the last one
+    silently) and the yte switch (Snakemake would run the file's templates as Python code)."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            line = key_node.start_mark.line + 1
+            if key == YTE_KEY:
+                raise ConfigFileError(
+                    f"line {line}: {YTE_KEY} makes Snakemake run this file as a yte template, Python code; "
+                    "a config of this workflow is data: remove the key and write the values out"
+                )
+            try:
+                first = seen.setdefault(key, line)
+            except TypeError:  # an unhashable key: the base loader says so
+                break
+            if first != line:
+                raise ConfigFileError(f"line {line}: key {key!r} given twice in one mapping (first at line {first})")
+        return super().construct_mapping(node, deep=deep)
+
+
+_StrictLoader.add_constructor("tag:yaml.org,2002:map", _StrictLoader.construct_yaml_map)
+
+
 def load_yaml(path: str | Path) -> Mapping:
-    """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error."""
+    """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error, of
+    a key given twice or of the yte switch, and a file that is not UTF-8 text."""
     try:
         with open(path, encoding="utf-8") as f:
-            data = yaml.load(f, Loader=SAFE_LOADER)
+            data = yaml.load(f, Loader=_StrictLoader)
+    except ConfigFileError as e:
+        raise ConfigFileError(f"{path}: {e}") from None
+    except UnicodeDecodeError:
+        raw = Path(path).read_bytes()
+        try:
+            raw.decode("utf-8")
+        except UnicodeDecodeError as e:  # the whole file: the offset counts from its start
+            line = raw[: e.start].count(b"\n") + 1
+            where = f"line {line} (byte {e.start} is 0x{raw[e.start]:02x})"
+            raise ConfigFileError(f"{path}: not UTF-8 text at {where}") from None
+        raise
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark is not None else "somewhere"
@@ -49,11 +88,51 @@ def load_yaml(path: str | Path) -> Mapping:
     return data
 
 
+def typed(value):
+    """A value of a nested ``--config`` override with its scalars typed as a config file types them.
+    Snakemake reads the nested part of ``--config physics={D: 0.002}`` with YAML's BaseLoader, so
+    every scalar arrives as text; 1e-3, a number on a command line, is a number here too."""
+    if isinstance(value, Mapping):
+        return {k: typed(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [typed(v) for v in value]
+    if not isinstance(value, str):
+        return value
+    try:
+        out = yaml.load(value, Loader=SAFE_LOADER)
+    except yaml.YAMLError:
+        return value
+    if isinstance(out, str) and _NUMBER_TEXT.match(out.strip()):
+        return float(out)
+    return out if isinstance(out, (bool, int, float, str)) or out is None else value
+
+
+def retype_overrides(config: dict, overrides: Mapping) -> None:
+    """Type, in ``config``, the nested values that came from ``--config`` (``overrides``, as
+    Snakemake parsed them); top-level values Snakemake has typed itself."""
+    for key, value in overrides.items():
+        if isinstance(value, (Mapping, list)) and config.get(key) is not None:
+            _merge_typed(config, key, typed(value))
+
+
+def _merge_typed(into: dict, key, value) -> None:
+    if isinstance(value, Mapping) and isinstance(into.get(key), dict):
+        for k, v in value.items():
+            _merge_typed(into[key], k, v)
+    else:
+        into[key] = value
+
+
 def key_path(parts) -> str:
     """('figures', 'fig9', 'cases', 3, 'eta') -> 'figures.fig9.cases[3].eta'."""
     out = ""
     for p in parts:
-        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+        if isinstance(p, int):
+            out += f"[{p}]"
+        elif not re.fullmatch(r"[A-Za-z0-9_.-]+", str(p)):  # a newline, a space: shown, not printed
+            out += f"[{str(p)!r}]"
+        else:
+            out += f".{p}" if out else str(p)
     return out or "(top level)"
 
 
@@ -80,7 +159,10 @@ def _schema_error_to_setting(error) -> SettingError:
         unexpected = [k for k in error.instance if k not in known]
         unexpected = [k for k in unexpected if not any(re.match(p, k) for p in schema.get("patternProperties", {}))]
         key = unexpected[0] if unexpected else "?"
-        allowed = "a known key: " + ", ".join(known) if known else schema.get("description", "a known key")
+        if schema.get("patternProperties") or not known:  # keys by pattern: the description says which
+            allowed = schema.get("description", "a known key")
+        else:
+            allowed = "a known key: " + ", ".join(known)
         near = difflib.get_close_matches(str(key), known, n=1)
         return SettingError(
             key_path([*path, key]), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else "")
