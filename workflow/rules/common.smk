@@ -3,6 +3,7 @@ import re
 import sys
 from pathlib import Path
 
+from snakemake.exceptions import WorkflowError
 from snakemake.io import regex_from_filepattern
 from snakemake.utils import validate
 
@@ -64,26 +65,72 @@ def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemak
     it changed; beside Snakemake's own state, not in results/, which may be copied elsewhere.
     Deleting it makes the next run read every table."""
     if not look_only:
-        for path, problem in corrupt_tables(root, digests).items():
-            moved = set_aside(path)
+        for path, problem in corrupt_tables(root, digests, expected=named_columns).items():
+            try:
+                moved = set_aside(path)
+            except OSError as e:  # a read-only results/: say so, change nothing, stop
+                raise WorkflowError(
+                    f"corrupt table {path}: {problem}; it cannot be moved aside ({e.strerror}): "
+                    "make its folder writable, or delete it, and rerun"
+                ) from None
             print(
                 f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it",
                 file=sys.stderr,
             )
     aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
-    missing = [m for m in missing if not Path(m).exists()]
-    # runs and case summaries are intermediate: name them as targets; every other table is a
-    # target or an output of a job that a target reruns. A path of an older layout is left.
-    rebuildable = [re.compile(regex_from_filepattern(p)) for p in (RUN_PATTERN, SUMMARY_PATTERN)]
-    return sorted(m for m in missing if any(r.match(m) for r in rebuildable))
+    return sorted(m for m in missing if not Path(m).exists())
+
+
+NAMED_BY_PATH = [(re.compile(regex_from_filepattern(p)), p) for p in (RUN_PATTERN, SUMMARY_PATTERN)]
+
+
+def named_columns(path):
+    """The column values a run or summary table's path names (its case, and its block of seeds),
+    or None for another table: verify.content_problem holds the table to them."""
+    for regex, pattern in NAMED_BY_PATH:
+        m = regex.match(Path(path).as_posix())
+        if m:
+            w = m.groupdict()
+            named = Case.from_wildcards(w).columns()
+            return named | ({"seed": (int(w["first"]), int(w["last"]))} if "first" in w else {})
+    return None
+
+
+def rebuildable(tables):
+    """The set-aside ``tables`` that a rule of this workflow writes, each made a target: Snakemake
+    does not rerun a job for a missing output when the output a target asked for exists (a
+    figure's source data beside its PNG, a section's bootstrap table beside its COMIC table).
+    A path of an older layout, which no rule writes, is left. Called once every rule is defined."""
+    return [t for t in tables if any(r.is_producer(t) for r in workflow.rules)]
 
 
 # Only the main Snakemake process checks: a job re-parsing this file on a cluster node must not
-# judge tables that other jobs are writing at that moment. A dry run only looks: it changes no
-# file (the run that follows checks the tables before it plans).
+# judge tables that other jobs are writing at that moment. A run that will not hold the lock only
+# looks, changing no file: a dry run, a command that runs no job (the run that follows checks the
+# tables before it plans), and any run while a lock is held, which Snakemake then refuses (another
+# run is writing these tables; a stale lock needs --unlock, which also only looks). Snakemake
+# takes its lock after this file is read, so two runs started in the same instant may both check.
 DRY_RUN = bool(getattr(workflow.output_settings, "dryrun", False))
-CORRUPT = set_aside_corrupt_tables(look_only=DRY_RUN) if workflow.is_main_process else []
+NO_JOB_FLAGS = {  # Snakemake options after which it runs no job
+    *("--unlock", "--summary", "-S", "--detailed-summary", "-D", "--list-rules", "--list", "-l"),
+    *("--list-target-rules", "--lt", "--dag", "--rulegraph", "--filegraph", "--d3dag", "--lint"),
+    *("--list-changes", "--lc", "--list-input-changes", "--li", "--list-params-changes", "--lp"),
+    *("--list-code-changes", "--list-untracked", "--lu", "--cleanup-metadata", "--cm"),
+    *("--cleanup-shadow", "--report", "--archive", "--containerize", "--export-cwl"),
+    *("--generate-unit-tests", "--delete-all-output", "--delete-temp-output", "--conda-create-envs-only"),
+    *("--conda-cleanup-envs", "--conda-list-envs"),
+}
+
+
+def looks_only():
+    """Whether this invocation must change no table (see above)."""
+    flags = {a.split("=", 1)[0] for a in sys.argv[1:]}
+    locks = Path(".snakemake/locks")
+    return DRY_RUN or bool(flags & NO_JOB_FLAGS) or (locks.is_dir() and any(locks.iterdir()))
+
+
+CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
 FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 
@@ -109,7 +156,7 @@ def all_targets():
     if "tradeoff" in config:
         figs += ["figures/tradeoff.png", "figures/tradeoff.pdf", "results/tables/tradeoff.parquet"]
     return (
-        CORRUPT
+        rebuildable(CORRUPT)
         + figs
         + [
             "results/tables/comic.parquet",

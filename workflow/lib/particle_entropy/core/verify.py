@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
 import time
 from pathlib import Path
@@ -29,19 +30,32 @@ def file_sha256(path: str | os.PathLike) -> str:
         return hashlib.file_digest(f, "sha256").hexdigest()
 
 
+def recorded_digest(path: str | os.PathLike) -> str | None:
+    """The SHA-256 recorded beside the table at ``path``, or None when there is no usable record:
+    none, a folder or pipe in its place, unreadable, not ASCII, or not a 64-digit hex digest.
+    A record that is not one is treated as missing, never as a crash."""
+    recorded = checksum_path(path)
+    try:
+        if not recorded.is_file():
+            return None
+        words = recorded.read_bytes()[:4096].decode("ascii").split()
+    except (OSError, UnicodeDecodeError):
+        return None
+    return words[0] if words and re.fullmatch(r"[0-9a-f]{64}", words[0]) else None
+
+
 def table_problem(path: str | os.PathLike, digest: str | None = None) -> str | None:
     """Why the table at ``path`` cannot be trusted, or None: its bytes differ from its recorded
-    checksum, or (without one) it lacks the Parquet magic bytes at either end. ``digest``: the
+    checksum, or (without a usable one, ``recorded_digest``) it cannot be read whole as Parquet:
+    footer, schema and every page, with page checksums where they were written. ``digest``: the
     SHA-256 of its bytes when already known (corrupt_tables' cache); else they are read."""
     path = Path(path)
     if not path.is_file():  # never read a pipe (it would block) or a folder
         return "it is a folder, not a table" if path.is_dir() else "it is not a regular file"
-    recorded = checksum_path(path)
-    if recorded.exists():
-        text = recorded.read_text()
-        want = text.split()[0] if text.strip() else ""
+    want = recorded_digest(path)
+    if want is not None:
         got = digest or file_sha256(path)
-        return None if got == want else f"its SHA-256 {got[:12]}... differs from the recorded {want[:12] or 'nothing'}"
+        return None if got == want else f"its SHA-256 {got[:12]}... differs from the recorded {want[:12]}"
     with path.open("rb") as f:
         size = os.fstat(f.fileno()).st_size
         head = f.read(4)
@@ -49,6 +63,38 @@ def table_problem(path: str | os.PathLike, digest: str | None = None) -> str | N
         tail = f.read(4)
     if size < 12 or head != MAGIC or tail != MAGIC:
         return f"it is not a whole Parquet file ({size} bytes, no PAR1 at both ends)"
+    import pyarrow.parquet as pq  # only for a table without a usable checksum: rare
+
+    try:
+        pq.read_table(path, page_checksum_verification=True)
+    except Exception as e:  # noqa: BLE001 - any reader error means the table cannot be used
+        return f"it has no checksum and cannot be read whole as Parquet ({type(e).__name__}: {str(e)[:120]})"
+    return None
+
+
+def content_problem(path: str | os.PathLike, expected: dict) -> str | None:
+    """Why the rows of the table at ``path`` are not those its path names, or None. ``expected``:
+    column -> the one value every row holds (None: a missing value), or a (low, high) pair
+    bounding an integer column (a block of seeds); columns the table lacks are not judged."""
+    import pyarrow.parquet as pq
+
+    try:
+        names = set(pq.read_schema(path).names)
+        columns = [c for c in expected if c in names]
+        table = pq.read_table(path, columns=columns)
+    except Exception as e:  # noqa: BLE001
+        return f"it cannot be read as Parquet ({type(e).__name__})"
+    for column in columns:
+        values = table.column(column).unique().to_pylist()
+        want = expected[column]
+        if isinstance(want, tuple):
+            bad = [v for v in values if v is None or not want[0] <= v <= want[1]]
+            if bad:
+                return f"its column {column} holds {bad[0]!r}, outside the {want[0]}-{want[1]} its path names"
+            continue
+        same = lambda v: (v is None or v != v) if want is None else v == want  # noqa: E731 - NaN is missing
+        if not values or not all(same(v) for v in values):
+            return f"its column {column} holds {values[:3]!r}, its path names {want!r}: another case's table"
     return None
 
 
@@ -58,7 +104,9 @@ DIGESTS_VERSION = 1
 SETTLED_NS = 2 * 10**9
 
 
-def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = None) -> dict[Path, str]:
+def corrupt_tables(
+    root: str | os.PathLike, digests: str | os.PathLike | None = None, expected=None
+) -> dict[Path, str]:
     """Every table below ``root`` that cannot be trusted, with the reason (a folder, pipe or device
     with a table's name included).
 
@@ -67,7 +115,11 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
     file renamed into place) always does; the checksum beside it is read every time, and a table
     that seems not to match is read before it is condemned. The accepted limit: bytes changed with
     all three kept (rewritten in place with the mtime set back, or decayed on the disk) go unseen
-    until the digests file is deleted. A missing or unreadable digests file is rebuilt."""
+    until the digests file is deleted. A missing or unreadable digests file is rebuilt.
+
+    ``expected``: a function of a table's path (as found below ``root``) giving the column values
+    its path names (``content_problem``), or None for a path that names none; every table read
+    again is also checked against it, so another case's valid table put in its place is found."""
     root = Path(root)
     if not root.exists():
         return {}
@@ -77,7 +129,7 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
         key = path.relative_to(root).as_posix()
         stamp = digest = None
         remembered = False
-        if path.is_file() and checksum_path(path).exists():
+        if path.is_file() and recorded_digest(path) is not None:
             st = path.stat()
             stamp = [st.st_size, st.st_mtime_ns, st.st_ino]
             remembered = known.get(key, [])[:3] == stamp
@@ -92,6 +144,9 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
         if problem and remembered:  # a remembered digest may spare a read, never condemn
             digest = file_sha256(path)
             problem = table_problem(path, digest)
+        if not problem and not remembered and expected is not None:
+            names = expected(path)
+            problem = content_problem(path, names) if names else None
         if problem:
             out[path] = problem
         elif stamp:
