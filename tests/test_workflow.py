@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import re
 import shutil
 import subprocess
@@ -515,6 +516,66 @@ def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run):
     proc = snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0
+
+
+def test_set_aside_derived_tables_are_rebuilt_by_the_next_run(tiny_run):
+    # Snakemake reruns no job for a missing output when the output a target asked for exists: a
+    # figure's source data beside its PNG, a section's bootstrap table beside its COMIC table
+    derived = [
+        tiny_run / "results/figures/fig4.parquet",
+        tiny_run / "results/tables/comic_realisations.parquet",
+        tiny_run / "results/tables/fig9/comic_argmin.parquet",
+    ]
+    before = {p: p.read_bytes() for p in derived}
+    for p in derived:
+        p.write_bytes(before[p][:100])
+    proc = snakemake(tiny_run, configfile=TINY)
+    for p in derived:
+        assert f"corrupt table {p.relative_to(tiny_run)}" in proc.stderr
+        assert p.read_bytes() == before[p], p  # rebuilt, byte for byte
+    again = snakemake(tiny_run, "-n", configfile=TINY)
+    assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run):
+    cfg = load(TINY)
+    run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]
+    good = run.read_bytes()
+    run.write_bytes(good[:100])
+    other = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
+    record = other.with_name(other.name + ".sha256")
+    record.unlink()
+    record.mkdir()  # a checksum file that is a folder: treated as missing, never a crash
+    locks = tiny_run / ".snakemake" / "locks"  # another run holds the lock (Snakemake's file format)
+    locks.mkdir(parents=True, exist_ok=True)
+    outputs = [p.relative_to(tiny_run).as_posix() for p in (tiny_run / "results").rglob("*.parquet")]
+    (locks / "0.output.lock").write_text("\n".join(outputs) + "\n")
+    files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
+    snakemake(tiny_run, configfile=TINY, check=False)
+    assert run.read_bytes() == good[:100] and not (run.parent / (run.name + ".corrupt")).exists()
+    assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
+    unlock = snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
+    assert unlock.returncode == 0, unlock.stderr[-2000:]
+    assert not (locks.exists() and any(locks.iterdir())) and run.read_bytes() == good[:100]  # only looked
+    proc = snakemake(tiny_run, configfile=TINY)  # the lock gone: checked, set aside, rebuilt
+    assert f"corrupt table {run.relative_to(tiny_run)}" in proc.stderr and pd.read_parquet(run).shape[0] > 0
+    assert f"corrupt table {other.relative_to(tiny_run)}" not in proc.stderr  # read whole: sound
+    record.rmdir()  # the module's run as it was, for the tests after this one
+    record.write_text(f"{hashlib.sha256(other.read_bytes()).hexdigest()}  {other.name}\n")
+
+
+def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run):
+    cfg = load(TINY)
+    ensembles = figure_ensembles(cfg, "fig9")
+    here, there = (tiny_run / case_run_paths(e, cfg)[0] for e in (ensembles[0], ensembles[1]))
+    assert pd.read_parquet(here)["n"].iloc[0] != pd.read_parquet(there)["n"].iloc[0] or here.parent != there.parent
+    before = pd.read_parquet(here).drop(columns=list(TIMING_COLUMNS))
+    for suffix in ("", ".sha256"):  # a valid table and its matching checksum: whole, but the wrong case
+        Path(str(here) + suffix).write_bytes(Path(str(there) + suffix).read_bytes())
+    (here.parent / (here.name + ".sha256")).write_text((there.parent / (there.name + ".sha256")).read_text())
+    proc = snakemake(tiny_run, configfile=TINY)
+    assert f"corrupt table {here.relative_to(tiny_run)}" in proc.stderr and "another case's table" in proc.stderr
+    pd.testing.assert_frame_equal(pd.read_parquet(here).drop(columns=list(TIMING_COLUMNS)), before)
 
 
 # --- two runs, a failing job, a full disk ---------------------------------------------------

@@ -21,7 +21,7 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case
 from particle_entropy.pipeline.codeversion import code_version
-from particle_entropy.core.verify import CORRUPT_SUFFIX, corrupt_tables, set_aside
+from particle_entropy.core.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
 from particle_entropy.core.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.figures import FIGURE_MODULES, figure_options
@@ -65,18 +65,10 @@ def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemak
     it changed; beside Snakemake's own state, not in results/, which may be copied elsewhere.
     Deleting it makes the next run read every table."""
     if not look_only:
-        for path, problem in corrupt_tables(root, digests, expected=named_columns).items():
-            try:
-                moved = set_aside(path)
-            except OSError as e:  # a read-only results/: say so, change nothing, stop
-                raise WorkflowError(
-                    f"corrupt table {path}: {problem}; it cannot be moved aside ({e.strerror}): "
-                    "make its folder writable, or delete it, and rerun"
-                ) from None
-            print(
-                f"corrupt table {path}: {problem}; moved to {moved.name}; the default target rebuilds it",
-                file=sys.stderr,
-            )
+        try:
+            set_aside_corrupt(root, digests, named_columns, report=lambda line: print(line, file=sys.stderr))
+        except TableError as e:  # a read-only results/: one line, and stop
+            raise WorkflowError(str(e)) from None
     aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     return sorted(m for m in missing if not Path(m).exists())

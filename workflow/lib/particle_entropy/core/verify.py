@@ -92,8 +92,9 @@ def content_problem(path: str | os.PathLike, expected: dict) -> str | None:
             if bad:
                 return f"its column {column} holds {bad[0]!r}, outside the {want[0]}-{want[1]} its path names"
             continue
-        same = lambda v: (v is None or v != v) if want is None else v == want  # noqa: E731 - NaN is missing
-        if not values or not all(same(v) for v in values):
+        missing = [v is None or v != v for v in values]  # None or NaN: a missing value
+        same = all(missing) if want is None else all(v == want for v in values)
+        if not values or not same:
             return f"its column {column} holds {values[:3]!r}, its path names {want!r}: another case's table"
     return None
 
@@ -104,9 +105,7 @@ DIGESTS_VERSION = 1
 SETTLED_NS = 2 * 10**9
 
 
-def corrupt_tables(
-    root: str | os.PathLike, digests: str | os.PathLike | None = None, expected=None
-) -> dict[Path, str]:
+def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = None, expected=None) -> dict[Path, str]:
     """Every table below ``root`` that cannot be trusted, with the reason (a folder, pipe or device
     with a table's name included).
 
@@ -198,6 +197,28 @@ def set_aside(path: str | os.PathLike) -> Path:
     os.replace(path, target)
     checksum_path(path).unlink(missing_ok=True)
     return target
+
+
+class TableError(RuntimeError):
+    """A corrupt table that cannot be set aside; the message says which and what to do."""
+
+
+def set_aside_corrupt(root, digests=None, expected=None, report=print) -> list[Path]:
+    """Set aside every table ``corrupt_tables`` finds, reporting each on one line; returns the
+    tables moved. A table that cannot be moved (a read-only folder) raises TableError before any
+    further change."""
+    moved = []
+    for path, problem in corrupt_tables(root, digests, expected).items():
+        try:
+            target = set_aside(path)
+        except OSError as e:
+            raise TableError(
+                f"corrupt table {path}: {problem}; it cannot be moved aside ({e.strerror or e}): "
+                "make its folder writable, or delete it, and rerun"
+            ) from None
+        report(f"corrupt table {path}: {problem}; moved to {target.name}; the default target rebuilds it")
+        moved.append(path)
+    return moved
 
 
 MIN_FREE_MB_ENV = "PARTICLE_ENTROPY_MIN_FREE_MB"  # a test sets it high to see the message
