@@ -6,6 +6,7 @@ import math
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -33,7 +34,7 @@ def finite_after_start(table):
     assert not bad.any(), rest.columns[bad].tolist()
 
 
-@pytest.mark.parametrize("n", [1, 2, 10])
+@pytest.mark.parametrize("n", [2, 3, 10])
 @pytest.mark.parametrize(
     "method,kernel", [("pt", "bins"), ("pt", "fixed"), ("pt", "adaptive"), ("mtpt", "collision"), ("mtpt", "sph")]
 )
@@ -46,11 +47,40 @@ def test_tiny_particle_numbers(n, method, kernel):
     assert (tab["mass_min"] >= 0).all()
     if method == "mtpt":
         assert tab["H_D"].iloc[0] == 0.0
-        if n == 1:  # one particle keeps the whole mass: no entropy, E = dV
-            assert (tab["H_D"] == 0.0).all()
-            assert np.allclose(tab["E"], 10.0)
     else:
         assert np.allclose(tab["H_D"], math.log(n))
+
+
+@pytest.mark.parametrize("method,kernel", [("pt", "bins"), ("mtpt", "collision"), ("mtpt", "sph")])
+def test_one_particle_is_refused_it_would_score_a_perfect_comic(method, kernel):
+    """One particle holds the whole mass at its own position: its SSE against the normalised
+    Gaussian at that position is 0 and COMIC -inf, which would win every Fig. 9 panel."""
+    with pytest.raises(SettingError, match=r"n=1 is not allowed: an integer >= 2"):
+        RunConfig.of(method=method, kernel=kernel, n=1, t_final=10.0)
+
+
+def test_one_particle_and_a_huge_growth_are_refused_by_the_config_and_the_cli(tmp_path):
+    import copy
+
+    import yaml
+
+    from particle_entropy.cli import main
+    from particle_entropy.pipeline.configcheck import check_config
+
+    base = yaml.safe_load((Path(__file__).parents[1] / "config.yaml").read_text())
+    one = copy.deepcopy(base)
+    one["figures"]["fig9"]["n"] = [1, 100]
+    with pytest.raises(SettingError, match=r"figures.fig9.n\[0\]=1 is not allowed"):
+        check_config(one)
+    huge = copy.deepcopy(base)
+    huge["case_defaults"]["dt_growth"] = 1e308  # an OverflowError naming no key, before
+    with pytest.raises(SettingError, match=r"case_defaults.dt_growth=1e\+308 is not allowed: .*10"):
+        check_config(huge)
+    out = tmp_path / "t.parquet"
+    for option in (["--n", "1"], ["--dt-growth", "1e308"]):
+        with pytest.raises(SystemExit):
+            main(["simulate", "--method", "mtpt", "--kernel", "collision", *option, "--out", str(out)])
+    assert not out.exists()
 
 
 def test_one_step_with_300k_particles():

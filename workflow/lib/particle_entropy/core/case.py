@@ -22,7 +22,9 @@ if TYPE_CHECKING:
     import pandas as pd
 
 from .registry import KERNELS, METHODS, PRESETS, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES, TIME_GRIDS
-from .settings import PAPER
+from .settings import BY_NAME, PAPER
+
+N_MIN = 2  # one particle (or one FD interval) is a delta against itself: SSE 0, COMIC -inf
 
 # Case field -> (wildcard name, path segment); the path of a case is these segments in order.
 PATH_SEGMENTS = {
@@ -127,15 +129,16 @@ class Case:
             )
         if self.n is not None:
             integral = isinstance(self.n, (int, np.integer)) or (isinstance(self.n, float) and self.n.is_integer())
-            if isinstance(self.n, bool) or not integral or self.n < 1:
-                raise SettingError("n", self.n, "an integer >= 1")
+            if isinstance(self.n, bool) or not integral or self.n < N_MIN:
+                raise SettingError("n", self.n, f"an integer >= {N_MIN} (one particle scores a perfect COMIC -inf)")
             object.__setattr__(self, "n", int(self.n))
         object.__setattr__(self, "eta", check_range("eta", self.eta, 0.0, 1.0))
         if self.truncation is not None:
             object.__setattr__(
                 self, "truncation", check_range("truncation", self.truncation, 0.0, math.inf, open_low=True)
             )
-        object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, 1.0, math.inf))
+        growth = BY_NAME["dt_growth"]
+        object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, growth.low, growth.high))
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         if SCHEME_RECORDS[self.scheme].compensated and self.truncation is None:

@@ -126,8 +126,10 @@ SETTINGS = (
         "dt_growth",
         "case_defaults.dt_growth",
         1.05,
-        "time-step growth factor dt_{n+1} = dt_growth dt_n (1 = fixed step time.fixed_dt; pt and mtpt only)",
+        "time-step growth factor dt_{n+1} = dt_growth dt_n (1 = fixed step time.fixed_dt; pt and mtpt only; at "
+        "most 10: a larger factor reaches t_final in a few steps and overflows at 1e308)",
         low=1.0,
+        high=10.0,
     ),
     Setting(
         "scheme",
