@@ -90,7 +90,7 @@ def named_columns(path):
 
 
 def rebuildable(tables):
-    """The set-aside ``tables`` that a rule of this workflow writes, each made a target: Snakemake
+    """The set-aside ``tables`` that this workflow can write, each made a target. Snakemake
     does not rerun a job for a missing output when the output a target asked for exists (a
     figure's source data beside its PNG, a section's bootstrap table beside its COMIC table).
     A path of an older layout, which no rule writes, is left. Called once every rule is defined."""
