@@ -301,9 +301,8 @@ def test_the_time_step_in_the_sampling_volume_shifts_every_n_alike():
     assert steps == 175
     assert (b["COMIC_mean"] - a["COMIC_mean"]).to_numpy() == pytest.approx(-math.log(1000 / steps), abs=1e-12)
     assert opt_a == opt_b
-    fd_search = Search.from_config(
-        "f", {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 3000], "budget_runs": 9,
-              "time_volume": True}, config)  # fmt: skip
+    fd_spec = {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 3000], "budget_runs": 9}
+    fd_search = Search.from_config("f", {**fd_spec, "initial_points": 5, "time_volume": True}, config)
     assert fd_search.steps["fd_dt"] == 0.05 and fd_search.time_volume
 
 
@@ -447,3 +446,18 @@ def test_a_lucky_new_point_is_replicated_before_it_wins():
 
     _, opt = evaluate(search, table)
     assert opt["best"] == 400 and opt["ci_lo"] == 300 and opt["ci_hi"] == 533
+
+
+def test_a_coarse_grid_finer_than_the_stopping_width_is_refused():
+    """optimum.*.initial_points had no upper bound: 1,000,000 points over 30-30,000 put round 0's
+    three lowest points within 30-32, whose bracket is 'narrow enough' at once (the search reported
+    64 where the optimum is ~600). Two coarse steps must span at least `width`: 1 + 2 ln(1000) /
+    ln(10) = 7 points over 30-30,000 at width 10, the shipped default."""
+    config = {"physics": {"t_final": 1000}, "time": {"dt0": 0.01, "fd_dt": 0.05, "fixed_dt": 1.0}}
+    spec = {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 30000], "budget_runs": 50}
+    assert Search.from_config("s", {**spec, "initial_points": 7}, config).max_initial_points == 7
+    for points in (8, 50, 1_000_000):
+        with pytest.raises(SettingError, match=r"optimum.s.initial_points=\d+ is not allowed: an integer in \[3, 7\]"):
+            Search.from_config("s", {**spec, "initial_points": points}, config)
+    wide = Search.from_config("s", {**spec, "initial_points": 13, "width": math.sqrt(10)}, config)
+    assert wide.max_initial_points == 13  # a narrower stopping width allows a finer grid

@@ -164,6 +164,13 @@ class Search:
         """The simulated case at searched value ``x``."""
         return replace(self.model, dt_growth=float(x)) if self.over == "dt_growth" else self.model.at(int(x))
 
+    @property
+    def max_initial_points(self) -> int:
+        """The finest coarse grid that keeps the search honest: two of its steps (the bracket round
+        0 may stop on) at least ``width`` wide, 1 + 2 (u(hi) - u(lo)) / ln(width) points."""
+        span = float(self.u(self.hi) - self.u(self.lo)) if self.hi > self.lo else 0.0
+        return max(3, int(math.floor(1.0 + 2.0 * span / math.log(self.width) + 1e-9))) if self.width > 1 else 3
+
     def grid(self, count: int) -> list:
         """``count`` values spaced evenly in ``u`` from lo to hi, each once."""
         return sorted({self.x(v) for v in np.linspace(float(self.u(self.lo)), float(self.u(self.hi)), count)})
@@ -245,8 +252,15 @@ class Search:
             raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
         if self.measure not in MEASURES:
             raise SettingError(f"{where}.measure", self.measure, f"one of {', '.join(MEASURES)}")
-        if self.initial_points < 3:
-            raise SettingError(f"{where}.initial_points", self.initial_points, "an integer >= 3 (a minimum needs 3)")
+        most = self.max_initial_points
+        if not 3 <= self.initial_points <= most:
+            raise SettingError(
+                f"{where}.initial_points",
+                self.initial_points,
+                f"an integer in [3, {most}] (a minimum needs 3; with more, two steps of the coarse grid span "
+                f"less than width = {self.width:g}, and round 0 would stop on a bracket among the lowest points "
+                "before the range is walked)",
+            )
         if not 3 <= self.start_points <= self.initial_points:
             raise SettingError(
                 f"{where}.start_points", self.start_points, f"an integer in [3, initial_points = {self.initial_points}]"
