@@ -684,6 +684,28 @@ def test_nested_command_line_overrides_of_numbers_and_lists_work(tmp_path):
     assert bad.returncode != 0 and "physics.D=-1 is not allowed" in bad.stdout + bad.stderr
 
 
+CASE_PATH = "mtpt/collision/n~100/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact"
+
+
+@pytest.mark.parametrize(
+    "target,expected",
+    [
+        (f"results/runs/{CASE_PATH}/seeds~5-2.parquet", "seeds~5-2: first <= last"),
+        (f"results/runs/{CASE_PATH}/seeds~0-99999999999.parquet", "at most 10,000 seeds"),
+        (f"results/tables/cases/{CASE_PATH}/r~0.parquet", "r~0: an ensemble of at least 1"),
+        (f"results/runs/{CASE_PATH.replace('eta~1/', 'eta~1e/')}/seeds~0-1.parquet", "expected results/{kind}/"),
+        (f"results/runs/{CASE_PATH.replace('n~100', 'n~1')}/seeds~0-1.parquet", "n=1 is not allowed"),
+        ("figures/optimum_nosuch.png", "no optimum search 'nosuch' in config optimum: one of"),
+    ],
+    ids=["seeds reversed", "seeds huge", "r 0", "eta 1e", "n 1", "unknown search"],
+)
+def test_a_hand_written_target_that_names_no_valid_run_is_refused_by_its_pattern(tmp_path, target, expected):
+    proc = snakemake(tmp_path, "-n", target, configfile=ROOT / "config.yaml", check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "WorkflowError" in out and expected in out, out[-1500:]
+    assert not (tmp_path / "results").exists()
+
+
 # --- docs/columns.md: every column of every derived table is documented ----------------------
 
 COLUMN_DOCS_PAGE = ROOT / "docs" / "columns.md"

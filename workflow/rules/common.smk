@@ -19,7 +19,7 @@ retype_overrides(config, workflow.config_settings.config)  # --config physics={D
 check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
-from particle_entropy.core.case import Case
+from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import code_version
 from particle_entropy.core.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
 from particle_entropy.core.memory import available_bytes, estimate_mb
@@ -187,8 +187,29 @@ def section_cases(section):
     return [e.case.wildcards() for e in ensembles(section)]
 
 
+MAX_TARGET_SEEDS = 10_000  # seeds of one hand-written run table: more is a typo, not a job
+
+
+def target_case(wildcards, pattern):
+    """The case a (perhaps hand-written) table path names, checked: one line naming the pattern
+    expected where it names none (eta~1e, n~1, seeds~5-2, r~0), never a traceback from a job."""
+    example = pattern.format(**Case("mtpt", "collision", 1000).wildcards(), kind="runs", first=0, last=3, nreal=20)
+    try:
+        case = Case.from_wildcards(wildcards)
+        seeds = (int(wildcards.first), int(wildcards.last)) if "first" in wildcards.keys() else (0, 0)
+        if "nreal" in wildcards.keys() and int(wildcards.nreal) < 1:
+            raise ValueError(f"r~{wildcards.nreal}: an ensemble of at least 1 realisation")
+        if not 0 <= seeds[0] <= seeds[1] or seeds[1] - seeds[0] >= MAX_TARGET_SEEDS:
+            raise ValueError(f"seeds~{seeds[0]}-{seeds[1]}: first <= last, at most {MAX_TARGET_SEEDS:,} seeds")
+        run_config(case, config)
+    except (ValueError, SettingError) as e:
+        raise WorkflowError(f"a table path names no valid run ({e}); expected {pattern}, e.g. {example}") from None
+    return case
+
+
 def summary_runs(wildcards):
     """The run tables that one case summary averages."""
+    target_case(wildcards, SUMMARY_PATTERN)
     return case_run_paths(Ensemble.from_wildcards(wildcards), config)
 
 
@@ -226,6 +247,8 @@ def optimum_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
     import pandas as pd  # here, not at parse: only a search's DAG reads its plans
 
+    if wildcards.name not in OPTIMUM:
+        raise WorkflowError(f"no optimum search {wildcards.name!r} in config optimum: one of {', '.join(OPTIMUM)}")
     OPTIMUM[wildcards.name]  # builds and checks the search (sweeps.check_search) before its first job
     k = int(wildcards.k)
     if k == 0:
@@ -254,7 +277,7 @@ def optimum_final_inputs(wildcards):
 def sim_mem_mb(wildcards):
     """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
     seeds = int(wildcards.last) - int(wildcards.first) + 1
-    return estimate_mb(run_config(Case.from_wildcards(wildcards), config), seeds)
+    return estimate_mb(run_config(target_case(wildcards, RUN_PATTERN), config), seeds)
 
 
 def sim_runtime_min(wildcards):
@@ -264,7 +287,7 @@ def sim_runtime_min(wildcards):
 
 def sim_settings(wildcards):
     """Physics and numerics of a run (config.physics, config.time, config.numerics)."""
-    return run_settings(Case.from_wildcards(wildcards), config)
+    return run_settings(target_case(wildcards, RUN_PATTERN), config)
 
 
 # The code each task runs (its script, the library modules it uses and what they import), hashed:
