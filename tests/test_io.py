@@ -341,3 +341,31 @@ def test_a_nearly_full_disk_is_named(tmp_path, monkeypatch):
     assert message.startswith("No space left on device?") and "50 MB free" in message and str(tmp_path) in message
     monkeypatch.setattr(verify.shutil, "disk_usage", lambda path: usage(10 * 2**30, 2**30, 9 * 2**30))
     assert verify.disk_space_problem(tmp_path) is None
+
+
+@pytest.mark.parametrize("length", [200, 240, 248])
+def test_a_long_table_name_is_written_with_temporaries_that_fit(tmp_path, length):
+    path = tmp_path / ("x" * (length - len(".parquet")) + ".parquet")
+    write_parquet(DF, path)  # its temporary and its checksum's must fit 255 bytes
+    assert len(path.name) == length and pd.read_parquet(path).equals(DF)
+    assert checksum_path(path).exists() and len(checksum_path(path).name) == length + 7
+    assert not list(tmp_path.glob("*.tmp")) and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_a_name_or_path_past_the_file_systems_limits_is_refused_before_anything_is_written(tmp_path):
+    too_long = tmp_path / ("x" * 241 + ".parquet")  # 249 bytes: its .sha256 would be 256
+    with pytest.raises(OutputError, match=r"a name of 249 bytes; at most 248 here"):
+        check_output_path(too_long)
+    deep = tmp_path.joinpath(*["d" * 200] * 21, "t.parquet")  # past PATH_MAX (4096)
+    with pytest.raises(OutputError, match=r"a path of \d+ bytes; at most 4088 here"):
+        check_output_path(deep)
+    assert not too_long.exists() and not (tmp_path / ("d" * 200)).exists()
+
+
+def test_the_cli_refuses_a_too_long_output_name_before_it_runs(tmp_path, capsys):
+    from particle_entropy.cli import main
+
+    out = tmp_path / ("r" * 245 + ".parquet")
+    with pytest.raises(SystemExit):
+        main(["simulate", "--method", "fd", "--n", "100", "--t-final", "1", "--out", str(out)])
+    assert "a name of 253 bytes" in capsys.readouterr().err and not out.exists()

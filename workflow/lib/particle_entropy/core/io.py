@@ -9,6 +9,7 @@ an existing directory, device or pipe at the target is refused.
 
 from __future__ import annotations
 
+import glob
 import hashlib
 import os
 import stat
@@ -33,6 +34,11 @@ def check_output_path(path: str | os.PathLike) -> Path:
     """``path`` as a Path if a table may be written there: a new path or an existing regular
     file, in a folder that exists or can be made and is writable. Else OutputError."""
     p = Path(path)
+    full = len(os.fsencode(os.path.abspath(p))) + len(CHECKSUM_SUFFIX)  # first: a stat of it would fail
+    path_max = _limits(Path("/"))[1]
+    if full >= path_max:
+        most = path_max - 1 - len(CHECKSUM_SUFFIX)
+        raise OutputError(f"{p}: a path of {full - len(CHECKSUM_SUFFIX)} bytes; at most {most} here")
     if p.exists():
         mode = p.stat().st_mode  # follows links: a link to /dev/null is a device
         if not stat.S_ISREG(mode):
@@ -43,7 +49,31 @@ def check_output_path(path: str | os.PathLike) -> Path:
         folder = folder.parent
     if not folder.is_dir() or not os.access(folder, os.W_OK | os.X_OK):
         raise OutputError(f"{p}: cannot write in {folder} (not a writable folder)")
+    name_max = _limits(folder)[0]
+    longest = len(p.name.encode()) + len(CHECKSUM_SUFFIX)  # the checksum beside it; temporaries fit (_temp_prefix)
+    if longest > name_max:
+        raise OutputError(
+            f"{p}: a name of {len(p.name.encode())} bytes; at most {name_max - len(CHECKSUM_SUFFIX)} here, so that "
+            f"its {CHECKSUM_SUFFIX} file fits the file system's {name_max}-byte names"
+        )
     return p
+
+
+def _limits(folder: Path) -> tuple[int, int]:
+    """The longest file name and path of the file system holding ``folder`` (255 and 4096 on Linux)."""
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX"), os.pathconf(folder, "PC_PATH_MAX")
+    except (OSError, ValueError):
+        return 255, 4096
+
+
+def _temp_prefix(path: Path) -> str:
+    """The prefix of ``path``'s temporaries: ``.<name>.``, or a digest of the name where that and
+    mkstemp's 8 random characters and ``.tmp`` would pass the file system's name limit."""
+    prefix = f".{path.name}."
+    if len(prefix.encode()) + 12 <= _limits(path.parent)[0]:
+        return prefix
+    return f".{hashlib.sha256(path.name.encode()).hexdigest()[:16]}."
 
 
 def _fsync_dir(folder: Path) -> None:
@@ -55,7 +85,7 @@ def _fsync_dir(folder: Path) -> None:
 
 
 def write_bytes_atomically(data: bytes, path: Path, sync: bool = True) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
@@ -72,7 +102,8 @@ def write_bytes_atomically(data: bytes, path: Path, sync: bool = True) -> None:
 def _remove_stale_temporaries(path: Path) -> None:
     """Temporaries left by an interrupted write of this table (one writer per table)."""
     for name in (path.name, path.name + CHECKSUM_SUFFIX):
-        for tmp in path.parent.glob(f".{name}.*.tmp"):
+        prefix = _temp_prefix(path.with_name(name))
+        for tmp in path.parent.glob(f"{glob.escape(prefix)}*.tmp"):
             tmp.unlink(missing_ok=True)
 
 
