@@ -40,8 +40,7 @@ rule all:
 
 
 onerror:
-    from particle_entropy.core.verify import disk_space_problem
+    from particle_entropy.core.verify import disk_space_problems
 
-    problem = disk_space_problem(".")
-    if problem:
+    for problem in disk_space_problems((".", "results", ".snakemake")):
         print(problem, file=sys.stderr)

@@ -343,6 +343,28 @@ def test_a_nearly_full_disk_is_named(tmp_path, monkeypatch):
     assert verify.disk_space_problem(tmp_path) is None
 
 
+def test_a_full_file_system_is_named_wherever_results_lives(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    usage = namedtuple("usage", "total used free")
+    work, results = tmp_path / "work", tmp_path / "elsewhere" / "results"
+    work.mkdir()
+    results.mkdir(parents=True)
+    (work / "results").symlink_to(results)
+    full = {str(results.resolve())}  # only the file system behind the link is full
+    monkeypatch.setattr(
+        verify.shutil,
+        "disk_usage",
+        lambda p: usage(2**30, 2**30, 2**19) if str(Path(p).resolve()) in full else usage(2**30, 0, 2**30),
+    )
+    device = lambda p: {str(results.resolve()): -1}.get(str(Path(p).resolve()), os.stat(p).st_dev)  # a mount
+    monkeypatch.chdir(work)
+    (problem,) = verify.disk_space_problems((".", "results", ".snakemake"), device)  # each file system once
+    assert str(results.resolve()) in problem and "0 MB free" in problem
+    full.add(str(work.resolve()))
+    assert len(verify.disk_space_problems((".", "results", "missing"), device)) == 2
+
+
 @pytest.mark.parametrize("length", [200, 240, 248])
 def test_a_long_table_name_is_written_with_temporaries_that_fit(tmp_path, length):
     path = tmp_path / ("x" * (length - len(".parquet")) + ".parquet")

@@ -238,3 +238,22 @@ def disk_space_problem(path: str | os.PathLike = ".") -> str | None:
         f"(below {limit:.0f} MB); a job that fails on a full disk may leave an empty log. "
         "Free some space and rerun the same command: finished tables are kept."
     )
+
+
+def disk_space_problems(paths=(".", "results", ".snakemake"), device_of=lambda p: os.stat(p).st_dev) -> list[str]:
+    """``disk_space_problem`` of each file system holding one of ``paths`` (each once, the first
+    path naming it; a missing path is skipped): results/ may live on another file system than
+    the working directory, through a link or a mount. ``device_of``: a path's file system."""
+    out, seen = [], set()
+    for path in paths:
+        try:
+            device = device_of(path)
+        except OSError:
+            continue
+        if device in seen:
+            continue
+        seen.add(device)
+        problem = disk_space_problem(path)
+        if problem:
+            out.append(problem)
+    return out
