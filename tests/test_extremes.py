@@ -214,3 +214,20 @@ def test_entropy_before_the_settling_time_is_flagged_not_nan():
     assert tab[tab["time"] > t_settle]["settled"].all()
     assert (early["H_C_analytic"] < 0).all() and np.isfinite(early["H_C_analytic"]).all()
     finite_after_start(tab)
+
+
+def test_a_plume_that_overflows_or_outgrows_the_fd_grid_is_refused_by_its_setting():
+    """D = 1e300 wrote FD tables with -inf entropy and zero mass; fd_length = 1e-300 NaN tables.
+    sqrt(2 D t_final) = sqrt(2) at the paper's settings: the FD domain must be >= 2 sqrt(2)."""
+    with pytest.raises(SettingError, match=r"D=1e\+306 is not allowed: a number with 2 D t_final finite"):
+        RunConfig.of(method="mtpt", kernel="collision", n=100, D=1e306).resolved()
+    for length in (1e-300, 2.8):
+        with pytest.raises(
+            SettingError, match=rf"fd_length={length:g} is not allowed: a domain >= 2 sqrt\(2 D t_final\) = 2\.82843"
+        ):
+            RunConfig.of(method="fd", kernel="implicit", n=100, fd_length=length).resolved()
+    assert (
+        RunConfig.of(method="fd", kernel="implicit", n=100, fd_length=2.9).resolved().fd_length == 2.9
+    )  # holds the plume
+    with pytest.raises(SettingError, match=r"fd_length=12.0 is not allowed: .* = 89\.4427 for D = 1, t_final = 1000"):
+        RunConfig.of(method="fd", kernel="implicit", n=100, D=1.0).resolved()  # D 1e300 in the issue: the same rule

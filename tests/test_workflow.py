@@ -552,7 +552,7 @@ def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_r
     (locks / "0.output.lock").write_text("\n".join(outputs) + "\n")
     files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
     snakemake(tiny_run, configfile=TINY, check=False)
-    assert run.read_bytes() == good[:100] and not (run.parent / (run.name + ".corrupt")).exists()
+    assert run.read_bytes() == good[:100]  # not set aside: no file under results/ added, moved or changed
     assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
     unlock = snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
     assert unlock.returncode == 0, unlock.stderr[-2000:]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import zlib
 from dataclasses import dataclass, replace
 
@@ -124,6 +125,7 @@ class RunConfig:
                 f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
             )
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
+        self._check_reference()
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2
@@ -140,6 +142,22 @@ class RunConfig:
                 "transfer_method",
                 self.transfer_method,
                 "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)",
+            )
+
+    def _check_reference(self) -> None:
+        """Refuse settings under which the Gaussian reference (Eq. 2) cannot be computed or an FD
+        grid cannot hold it: 2 D t_final must be finite, and the FD domain at least 2 sqrt(2 D
+        t_final) long (a plume wider than the grid leaves it: zero mass, -inf entropy)."""
+        variance = 2.0 * self.D * self.t_final
+        if not math.isfinite(4.0 * math.pi * math.e * variance):  # E = sqrt(2 pi e variance)
+            raise SettingError("D", self.D, f"a number with 2 D t_final finite (t_final = {self.t_final:g})")
+        width = 2.0 * math.sqrt(variance)
+        if self.method == "fd" and self.fd_length < width:
+            raise SettingError(
+                "fd_length",
+                self.fd_length,
+                f"a domain >= 2 sqrt(2 D t_final) = {width:.6g} for D = {self.D:g}, t_final = {self.t_final:g}: "
+                "the plume would outgrow the grid",
             )
 
     def rng(self, stream: int = 0) -> np.random.Generator:
