@@ -132,6 +132,13 @@ BAD = [
         ["optimum.collision_eta1.case.kernel='sph'", "bins, fixed, adaptive"],
     ),
     ("optimum time past t_final", _set(("optimum", "fd_t250", "time"), 2000), ["optimum.fd_t250.time=2000", "t_final"]),
+    # the dry run built every seed block of 10**12 realisations (7.3 GB in 60 s) and hung
+    ("realisations count 10**12", _set(("realisations", 0, "count"), 10**12), ["realisations[0].count=", "10000"]),
+    (
+        "max_realisations 10**9",
+        _set(("mechanism", "sweeps", 0, "max_realisations"), 10**9),
+        ["mechanism.sweeps[0].max_realisations=", "10000"],
+    ),
     # `$` in a schema pattern also matches before a final newline: a key "fig1\n" was accepted and ignored
     (
         "figure key ending in a newline",
@@ -246,3 +253,21 @@ def test_nested_command_line_overrides_are_typed_as_a_file_types_them():
     retype_overrides(cfg, {"physics": {"D": "abc"}})
     with pytest.raises(SettingError, match=r"physics.D='abc'"):
         check_config(cfg)
+
+
+def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
+    from particle_entropy.core.case import Case
+    from particle_entropy.pipeline.sweeps import MAX_REALISATIONS, Ensemble, block_size, seed_blocks
+
+    for n, count in [(30, 80), (300, 7), (3000, 1), (30000, 4), (100, 33)]:
+        ens = Ensemble(Case("mtpt", "collision", n), count)
+        assert block_size(ens, BASE) == max(b - a + 1 for a, b in seed_blocks(ens, BASE))
+    # arithmetic: building the 10**12 / size blocks would exhaust memory here
+    assert block_size(Ensemble(Case("mtpt", "collision", 30), 10**12), BASE) == BASE["seed_blocks"]["size"]
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    caps = [
+        schema["properties"]["realisations"]["items"]["properties"]["count"]["maximum"],
+        schema["$defs"]["realisations"]["oneOf"][0]["maximum"],
+        schema["$defs"]["max_realisations"]["maximum"],
+    ]
+    assert caps == [MAX_REALISATIONS] * 3

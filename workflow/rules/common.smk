@@ -29,6 +29,7 @@ from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,
     FIGURE_READS,
+    MAX_REALISATIONS,
     PAPER_FIGURES,
     RUN_PATTERN,
     SUMMARY_PATTERN,
@@ -187,7 +188,7 @@ def section_cases(section):
     return [e.case.wildcards() for e in ensembles(section)]
 
 
-MAX_TARGET_SEEDS = 10_000  # seeds of one hand-written run table: more is a typo, not a job
+MAX_TARGET_SEEDS = MAX_REALISATIONS  # seeds of one hand-written run table: more is a typo, not a job
 
 
 def target_case(wildcards, pattern):

@@ -138,6 +138,16 @@ def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
     return spec_ensembles(config["figures"][fig], config)
 
 
+MAX_REALISATIONS = 10_000  # realisations of one case (schema and hand-written targets): more is a typo
+
+
+def block_size(ens: Ensemble, config: Mapping) -> int:
+    """Seeds in the largest job of an ensemble (``seed_blocks``), without building the blocks."""
+    blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
+    size = int(blocks["size"]) if ens.case.n <= int(blocks["max_n"]) else 1
+    return min(size, ens.realisations)
+
+
 def seed_blocks(ens: Ensemble, config: Mapping) -> list[tuple[int, int]]:
     """Inclusive seed ranges of the jobs behind an ensemble: blocks aligned to multiples of the
     block size (config seed_blocks.size, for N <= seed_blocks.max_n; else one seed a job)."""
@@ -265,7 +275,7 @@ def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
     of its seed block; an adaptive search's jobs: check_search)."""
     jobs = [
-        (f"{name}.n", ens, max(b - a + 1 for a, b in seed_blocks(ens, config)))
+        (f"{name}.n", ens, block_size(ens, config))
         for name, spec in case_sections(config).items()
         for ens in spec_ensembles(spec, config)
     ]
