@@ -139,6 +139,12 @@ BAD = [
         _set(("mechanism", "sweeps", 0, "max_realisations"), 10**9),
         ["mechanism.sweeps[0].max_realisations=", "10000"],
     ),
+    # an optimum search's cap: reported under n_range by the dry run's memory check, before
+    (
+        "optimum max_realisations 10**12",
+        _set(("optimum", "collision_eta1", "max_realisations"), 10**12),
+        ["optimum.collision_eta1.max_realisations=", "10000"],
+    ),
     # `$` in a schema pattern also matches before a final newline: a key "fig1\n" was accepted and ignored
     (
         "figure key ending in a newline",
@@ -269,5 +275,8 @@ def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
         schema["properties"]["realisations"]["items"]["properties"]["count"]["maximum"],
         schema["$defs"]["realisations"]["oneOf"][0]["maximum"],
         schema["$defs"]["max_realisations"]["maximum"],
+        schema["properties"]["optimum"]["patternProperties"]["^[A-Za-z0-9_]+(?![\\s\\S])"]["properties"][
+            "max_realisations"
+        ]["maximum"],
     ]
-    assert caps == [MAX_REALISATIONS] * 3
+    assert caps == [MAX_REALISATIONS] * 4
