@@ -6,6 +6,7 @@ from __future__ import annotations
 import inspect
 import math
 from collections.abc import Callable
+from functools import cache
 
 import numpy as np
 import pandas as pd
@@ -371,6 +372,15 @@ def argmin_bootstrap(
     return shares, int(math.floor(lo)), int(math.ceil(hi)), len(dist)
 
 
+@cache
+def scipy_rng_keyword() -> str:
+    """scipy's name for the Generator argument of its resampling functions (bootstrap,
+    permutation_test): ``rng`` from scipy 1.15, ``random_state`` before. Read once."""
+    from scipy import stats
+
+    return "rng" if "rng" in inspect.signature(stats.bootstrap).parameters else "random_state"
+
+
 def bootstrap_of_means(
     samples: list[np.ndarray],
     of_means: Callable[[np.ndarray], np.ndarray],
@@ -396,7 +406,7 @@ def bootstrap_of_means(
 
     from scipy import stats  # 1 s to import: only the jobs that resample pay it, not the workflow's parse
 
-    rng = "rng" if "rng" in inspect.signature(stats.bootstrap).parameters else "random_state"  # scipy < 1.15
+    rng = scipy_rng_keyword()
     return stats.bootstrap(
         [samples[i] for i in free],
         statistic,

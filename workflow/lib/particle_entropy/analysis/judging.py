@@ -4,14 +4,12 @@ combined standard deviation. claims.py writes each verdict in its own column (do
 
 from __future__ import annotations
 
-import inspect
 import math
-from functools import cache
 
 import numpy as np
 import pandas as pd
 
-from .aggregate import BOOTSTRAP_SEED, CONFIDENCE
+from .aggregate import BOOTSTRAP_SEED, CONFIDENCE, scipy_rng_keyword
 
 LEVEL = round(1.0 - CONFIDENCE, 12)  # 0.05: the tests' family-wise level, the complement of the bootstrap intervals
 N_PERMUTATIONS = 9999  # random permutations per comparison (fewer when every split can be enumerated)
@@ -61,14 +59,6 @@ def welch_t(x: np.ndarray, y: np.ndarray, axis: int = -1) -> np.ndarray:
     return (np.mean(x, axis=axis) - np.mean(y, axis=axis)) / np.sqrt(vx / x.shape[axis] + vy / y.shape[axis])
 
 
-@cache
-def _rng_keyword() -> str:
-    """scipy's name for the Generator argument of its resampling functions (rng from 1.15)."""
-    from scipy import stats
-
-    return "rng" if "rng" in inspect.signature(stats.permutation_test).parameters else "random_state"
-
-
 def worse_p(worse, best) -> float:
     """One-sided p-value that ``worse`` has the larger mean: Welch's t-test (unequal variances,
     Welch-Satterthwaite degrees of freedom), the verdict's test. It keeps its level where a
@@ -95,7 +85,7 @@ def permutation_p(worse, best, seed: int = BOOTSTRAP_SEED) -> float:
         vectorized=True,
         n_resamples=N_PERMUTATIONS,
         alternative="greater",
-        **{_rng_keyword(): np.random.default_rng(seed)},
+        **{scipy_rng_keyword(): np.random.default_rng(seed)},
     )
     return 1.0 if math.isnan(res.pvalue) else float(res.pvalue)
 

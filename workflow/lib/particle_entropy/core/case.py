@@ -132,13 +132,10 @@ class Case:
             if isinstance(self.n, bool) or not integral or self.n < N_MIN:
                 raise SettingError("n", self.n, f"an integer >= {N_MIN} (one particle scores a perfect COMIC -inf)")
             object.__setattr__(self, "n", int(self.n))
-        object.__setattr__(self, "eta", check_range("eta", self.eta, 0.0, 1.0))
-        if self.truncation is not None:
-            object.__setattr__(
-                self, "truncation", check_range("truncation", self.truncation, 0.0, math.inf, open_low=True)
-            )
-        growth = BY_NAME["dt_growth"]
-        object.__setattr__(self, "dt_growth", check_range("dt_growth", self.dt_growth, growth.low, growth.high))
+        for dim in ("eta", "truncation", "dt_growth"):  # ranges from their settings (settings.SETTINGS)
+            s = BY_NAME[dim]
+            if getattr(self, dim) is not None:
+                object.__setattr__(self, dim, check_range(dim, getattr(self, dim), s.low, s.high, s.open_low))
         if self.scheme not in SCHEMES:
             raise SettingError("scheme", self.scheme, f"one of {', '.join(SCHEMES)}")
         if SCHEME_RECORDS[self.scheme].compensated and self.truncation is None:
