@@ -194,7 +194,6 @@ MAX_TARGET_SEEDS = MAX_REALISATIONS  # seeds of one hand-written run table: more
 def target_case(wildcards, pattern):
     """The case a (perhaps hand-written) table path names, checked: one line naming the pattern
     expected where it names none (eta~1e, n~1, seeds~5-2, r~0), never a traceback from a job."""
-    example = pattern.format(**Case("mtpt", "collision", 1000).wildcards(), kind="runs", first=0, last=3, nreal=20)
     try:
         case = Case.from_wildcards(wildcards)
         seeds = (int(wildcards.first), int(wildcards.last)) if "first" in wildcards.keys() else (0, 0)
@@ -204,6 +203,7 @@ def target_case(wildcards, pattern):
             raise ValueError(f"seeds~{seeds[0]}-{seeds[1]}: first <= last, at most {MAX_TARGET_SEEDS:,} seeds")
         run_config(case, config)
     except (ValueError, SettingError) as e:
+        example = pattern.format(**Case("mtpt", "collision", 1000).wildcards(), kind="runs", first=0, last=3, nreal=20)
         raise WorkflowError(f"a table path names no valid run ({e}); expected {pattern}, e.g. {example}") from None
     return case
 

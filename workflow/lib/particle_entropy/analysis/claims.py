@@ -29,7 +29,6 @@ def _pick(tables, case: Case) -> pd.DataFrame:
 # of the claims table: `passed` by the project's rule; (a) as the paper drew it and (b) by a test,
 # each a text and a verdict, None where the rule does not apply (judging.py)
 COLUMNS = ("claim", "paper", "reproduced", "tolerance", "passed", "as_drawn", "passed_as_drawn", "test", "passed_test")
-VERDICTS = ("passed", "passed_as_drawn", "passed_test")
 
 
 def _claim(claim, paper, reproduced, tolerance, passed, as_drawn=(None, None), test=(None, None)):

@@ -65,7 +65,8 @@ def case_label(case: Case, n: bool = True) -> str:
     parts = [f"{case.method.upper()} {KERNEL_NAMES[case.kernel]}"]
     if case.method == "mtpt":
         parts.append(f"η={case.eta:g}")
-    parts += [variant_text(case)] if variant_text(case) else []
+    variant = variant_text(case)
+    parts += [variant] if variant else []
     if n and case.n is not None:
         parts.append(f"N={case.n:,}")
     return ", ".join(parts)

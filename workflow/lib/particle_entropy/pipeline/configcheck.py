@@ -53,9 +53,6 @@ class _StrictLoader(SAFE_LOADER):
         return super().construct_mapping(node, deep=deep)
 
 
-_StrictLoader.add_constructor("tag:yaml.org,2002:map", _StrictLoader.construct_yaml_map)
-
-
 def load_yaml(path: str | Path) -> Mapping:
     """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error, of
     a key given twice or of the yte switch, and a file that is not UTF-8 text."""
