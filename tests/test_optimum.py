@@ -47,11 +47,14 @@ def costs_of(table, power=1.0):
     return table.assign(core_s=1e-3 * table["n"].astype(float) ** power)[["n", "seed", "core_s"]]
 
 
+LINEAR_COST = ((30.0, 0.03), (30000.0, 30.0))  # a calibrated cost model of 1e-3 N s a run
+
+
 def run_search(search, noise, base_seed=0):
     plan = initial_plan(search, base_seed)
     while not plan["done"].any():
         table = realisations_of(plan, noise)
-        plan = next_plan(search, plan, table, costs_of(table))
+        plan = next_plan(search, plan, table)
         assert (plan["last"] >= plan["first"]).all(), "an empty seed block"
     return plan
 
@@ -160,7 +163,11 @@ def test_full_sweep_estimate_is_a_grid_giving_the_same_bracket():
         ({"width": 1.0}, "width"),
         ({"initial_points": 2}, "initial_points"),
         ({"initial_points": 4, "start_points": 5}, "start_points"),
-        ({"budget_core_s": 0}, "budget_core_s"),
+        ({"budget_core_s": 0, "cost": [[30, 1]]}, "budget_core_s"),
+        ({"budget_core_s": 60}, "cost"),  # a core-second budget needs a cost model
+        ({"budget_core_s": 60, "cost": [[30, 1], [30, 2]]}, "cost"),
+        ({"budget_core_s": 60, "cost": [[30, 0]]}, "cost"),
+        ({"budget_core_s": 60, "cost": [[0.5, 1]]}, "cost"),
         ({"case": {"method": "pt", "kernel": "sph"}}, "case.kernel"),
     ],
 )
@@ -258,11 +265,15 @@ def test_cost_model_is_exact_for_a_power_law_and_extrapolates_its_slope():
 
 
 def test_a_core_seconds_budget_is_never_exceeded_and_stops_the_search():
-    search = mtpt(width=1.2, budget_runs=10_000, budget_core_s=60.0)  # costs 1e-3 N s a run
+    search = mtpt(width=1.2, budget_runs=10_000, budget_core_s=60.0, cost=LINEAR_COST)  # 1e-3 N s a run
     plan = run_search(search, noise=0.5)
     table = realisations_of(plan, 0.5)
     assert plan["reason"].iloc[-1] == "budget spent"
     assert costs_of(table)["core_s"].sum() <= 60.0
+    out = result_table(search, plan, table, costs_of(table, power=2.0))  # measured: other timings
+    assert out["cost_s_spent"].iloc[0] == pytest.approx(costs_of(table)["core_s"].sum(), rel=1e-9)
+    assert out["cost_s"].sum() == pytest.approx(out["cost_s_spent"].iloc[0], rel=1e-9)
+    assert out["core_s_spent"].iloc[0] == pytest.approx(costs_of(table, power=2.0)["core_s"].sum(), rel=1e-9)
 
 
 def test_replication_goes_to_the_cheapest_unresolved_n_first():
@@ -276,11 +287,12 @@ def test_replication_goes_to_the_cheapest_unresolved_n_first():
     search = Search(
         name="t", model=Case("mtpt", "collision", None), time=1.0, lo=100, hi=10000,
         width=1.5, min_step=4.0, budget_core_s=spent + 1.5,  # no midpoints; 1.5 s pays 300's doubling only
+        cost=LINEAR_COST,
     )  # fmt: skip
-    out = next_plan(search, plan, table, costs_of(table))
+    out = next_plan(search, plan, table)
     added = out[out["round"] == 1]
     assert added[["n", "first", "last"]].values.tolist() == [[300, 4, 7]]
-    roomy = next_plan(replace(search, budget_core_s=1e9), plan, table, costs_of(table))
+    roomy = next_plan(replace(search, budget_core_s=1e9), plan, table)
     assert sorted(roomy.loc[roomy["round"] == 1, "n"]) == [300, 1000, 3000]  # all three when affordable
 
 
@@ -353,7 +365,7 @@ def test_a_search_over_the_dt_growth_finds_its_minimum():
         ]
         table = pd.DataFrame(rows, columns=["n", "dt_growth", "seed", "COMIC"])
         costs = table.assign(core_s=1.0 / (table["dt_growth"] - 1.0))[["n", "dt_growth", "seed", "core_s"]]
-        plan = next_plan(search, plan, table, costs)
+        plan = next_plan(search, plan, table)
     out = result_table(search, plan, table, costs)
     row = out.iloc[0]
     assert row["bracket_lo"] <= G_STAR <= row["bracket_hi"]
@@ -405,7 +417,7 @@ def test_an_end_point_within_the_noise_is_replicated_not_walked_past():
     rows = [(n, s, level[n] + d) for n in level for s, d in enumerate(spread)]
     table = pd.DataFrame(rows, columns=["n", "seed", "COMIC"])
     plan = pd.DataFrame([(0, n, 1.05, 0, 3, False, "") for n in level], columns=PLAN_COLUMNS)
-    out = next_plan(mtpt(width=1.5, budget_runs=1000), plan, table, costs_of(table))
+    out = next_plan(mtpt(width=1.5, budget_runs=1000), plan, table)
     added = out[out["round"] == 1]
     assert added["n"].max() <= 300  # no walk beyond the visited N
     assert 300 in added.loc[added["first"] == 4, "n"].tolist()  # the end point is replicated
@@ -461,3 +473,87 @@ def test_a_coarse_grid_finer_than_the_stopping_width_is_refused():
             Search.from_config("s", {**spec, "initial_points": points}, config)
     wide = Search.from_config("s", {**spec, "initial_points": 13, "width": math.sqrt(10)}, config)
     assert wide.max_initial_points == 13  # a narrower stopping width allows a finer grid
+
+
+def test_a_search_takes_the_same_path_under_different_timings(tmp_path):
+    """Issue 23: a core-second budget decided from measured wall times, so one config gave
+    different optima on different machines. Real runs, written as run tables twice: as on a fast
+    machine and as on one 1,000 times slower (wall_s scaled, with jitter). The search reads them
+    as the workflow does (advance, result_table) and must take the same path to the same table;
+    only the measured columns differ."""
+    from particle_entropy.analysis.optimum import advance, read_runs
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.core.runconfig import RunConfig
+    from particle_entropy.models.simulate import run_seeds_arrow
+    from particle_entropy.pipeline.sweeps import run_settings
+
+    config = {"physics": {"t_final": 20.0}, "time": {"dt0": 0.1, "fd_dt": 0.05, "fixed_dt": 1.0}}
+    search = Search(
+        name="t", model=Case("mtpt", "collision", None), time=20.0, lo=30, hi=3000,
+        width=1.2, budget_core_s=3.0, cost=LINEAR_COST, max_realisations=16,
+    )  # fmt: skip
+    tables = {}
+
+    def block(n, first, last):
+        if (n, first, last) not in tables:
+            case = search.model.at(int(n))
+            cfg = RunConfig.for_case(case, **run_settings(case, config)).resolved()
+            tables[n, first, last] = run_seeds_arrow(cfg, range(first, last + 1)).to_pandas()
+        return tables[n, first, last]
+
+    def machine(slowdown):
+        rng, folder = np.random.default_rng(int(slowdown)), tmp_path / f"x{slowdown}"
+        folder.mkdir()
+
+        def paths(plan):
+            out = []
+            for r in plan.itertuples():
+                path = folder / f"n{r.n}_{r.first}-{r.last}.parquet"
+                if not path.exists():
+                    t = block(r.n, int(r.first), int(r.last))
+                    write_parquet(t.assign(wall_s=t["wall_s"] * slowdown * rng.uniform(0.5, 2.0, len(t))), str(path))
+                out.append(str(path))
+            return out
+
+        plan = initial_plan(search, 0)
+        while not plan["done"].any():
+            plan = advance(search, plan, paths(plan))
+        realisations, costs = read_runs(paths(plan), search.time)
+        return plan, result_table(search, plan, realisations, costs)
+
+    fast, slow = machine(1), machine(1000)
+    pd.testing.assert_frame_equal(fast[0], slow[0])
+    assert fast[0]["reason"].iloc[-1] == "budget spent" and fast[0]["round"].max() >= 2
+    measured = ["core_s", "core_s_spent", "full_sweep_core_s"]
+    pd.testing.assert_frame_equal(fast[1].drop(columns=measured), slow[1].drop(columns=measured))
+    assert (slow[1]["core_s_spent"] > 100 * fast[1]["core_s_spent"]).all()  # the timings did differ
+    assert fast[1]["cost_s_spent"].iloc[0] <= search.budget_core_s
+
+
+def test_the_result_says_when_the_optimum_sits_at_a_visited_end():
+    """A search stopped by its budget while walking up has its lowest mean at the highest visited
+    N, not at the range's end: the table says so (at_end), and so does the figure's text."""
+    import matplotlib.pyplot as plt
+
+    from particle_entropy.figures.plots_optimum import optimum_figure
+
+    search = fd(width=1.5, budget_runs=4, start_points=3)  # walks up one step, then the budget is spent
+    global N_STAR
+    saved, N_STAR = N_STAR, 20000.0
+    try:
+        plan = run_search(search, noise=0.0)
+        table = realisations_of(plan, 0.0)
+    finally:
+        N_STAR = saved
+    out = result_table(search, plan, table, costs_of(table))
+    assert plan["reason"].iloc[-1] == "budget spent"
+    assert out["best"].iloc[0] == out["n"].max() < search.hi
+    assert (out["at_end"] == "high").all()
+    fig = optimum_figure(out)
+    text = " ".join(t.get_text() for t in fig.texts)
+    plt.close(fig)
+    assert "lowest mean at the highest visited N: the minimum may lie above it" in text
+    bracketed = fd(width=1.5, budget_runs=40)
+    plan = run_search(bracketed, noise=0.0)
+    table = realisations_of(plan, 0.0)
+    assert (result_table(bracketed, plan, table, costs_of(table))["at_end"] == "").all()

@@ -20,8 +20,11 @@ A search over the dt growth (``over``) does the same in log(dt_growth - 1) at a 
 starting at the cheap end (the largest growth, fewest steps).
 The search stops when the bracket (the visited N around the interval) is no wider than
 ``width``, when nothing is left to add, or when the next runs would exceed the budget of runs
-or of core-seconds (predicted from the measured cost per run, ``cost_model``). FD is
-deterministic: one run per N, a bracketing search.
+or of core-seconds. Core-seconds are counted by the search's calibrated cost model
+(``Search.cost``, ``calibrated_cost``: seconds per run written in the config), never measured:
+a search's path depends only on its config and the seeds, on any machine. The measured
+core-seconds are reported beside it (``core_s``). FD is deterministic: one run per N, a
+bracketing search.
 
 A plan is a table of seed blocks, one row per (N, block of seeds) added in some round; every
 block is an ordinary simulation job (sweeps.run_path), so its results are cached and shared.
@@ -88,8 +91,13 @@ RESULT_COLUMN_DOCS = {
     "COMIC_std": "its standard deviation over realisations (NaN for one realisation)",
     "COMIC_se": "standard error of the mean, std / sqrt(realisations) (0 for FD)",
     "share": "fraction of bootstrap resamples whose lowest visited point is this one",
-    "core_s": "wall time of this point's runs, the sum of their steps' `wall_s` over realisations [s]",
+    "core_s": "measured wall time of this point's runs, the sum of their steps' `wall_s` over realisations "
+    "(differs between machines and runs; reported, never used to decide) [s]",
+    "cost_s": "the cost model's core-seconds of this point's runs: realisations x the calibrated seconds per run "
+    "(`cost`; NaN for a search without one) [s]",
     "best": "the visited value (N or dt growth) with the lowest value of the search's convention",
+    "at_end": "`low` or `high` when `best` is the lowest or highest visited value: the minimum may lie beyond it "
+    "(beyond the range when that end is the range's), else empty",
     "optimum": "the fitted optimum: vertex of a quadratic in log N (log(dt_growth - 1)), weighted by "
     "realisations, through the visited values within two of `best`; `best` at an end of the visited values",
     "ci_lo": "lower end of the 95 % bootstrap percentile interval of `optimum`, widened to every visited value whose "
@@ -100,12 +108,14 @@ RESULT_COLUMN_DOCS = {
     "reason": "why the search stopped: " + ", ".join(f"`{r}`" for r in REASONS),
     "rounds": "rounds evaluated",
     "runs_spent": "runs (realisations × N) the search used",
-    "core_s_spent": "sum of `core_s` over the visited points [s]",
+    "core_s_spent": "sum of `core_s` over the visited points (measured) [s]",
+    "cost_s_spent": "sum of `cost_s`: the core-seconds the budget counted [s]",
+    "budget_core_s": "the search's budget of model core-seconds (inf: none) [s]",
     "full_sweep_core_s": "estimated cost of a full grid sweep giving the same bracket: every value of a "
     "grid even in log N (log(dt_growth - 1)) over the range, with the step half the bracket's width in "
     "that log (a grid brackets its minimum "
     "between the argmin's neighbours), each with the search's largest realisation count, at the "
-    "measured cost per run (`cost_model`) [s]",
+    "measured cost per run (`cost_model`; differs between machines and runs) [s]",
 }
 RESULT_COLUMNS = list(RESULT_COLUMN_DOCS)
 
@@ -123,7 +133,8 @@ class Search:
     over: str = "n"
     width: float = 10.0  # stop when bracket_hi / bracket_lo <= width (dt growth: of dt_growth - 1)
     budget_runs: float = math.inf  # runs (realisations x N); a config sets this, budget_core_s or both
-    budget_core_s: float = math.inf  # stop before the predicted core-seconds would exceed this
+    budget_core_s: float = math.inf  # stop before the cost model's core-seconds would exceed this
+    cost: tuple = ()  # calibrated ((searched value, seconds per run), ...): the cost model (calibrated_cost)
     initial_points: int = 7  # the coarse grid over the range (7 over 30 ... 30,000: half decades)
     start_points: int = 3  # round 0 visits the lowest of them; later rounds walk up only as needed
     initial_realisations: int = 4
@@ -220,6 +231,7 @@ class Search:
             width=float(spec.get("width", cls.width)),
             budget_runs=int(spec["budget_runs"]) if "budget_runs" in spec else math.inf,
             budget_core_s=float(spec.get("budget_core_s", cls.budget_core_s)),
+            cost=tuple((float(x), float(c)) for x, c in spec.get("cost", ())),
             initial_points=int(spec.get("initial_points", cls.initial_points)),
             start_points=int(spec.get("start_points", cls.start_points)),
             initial_realisations=int(spec.get("realisations", cls.initial_realisations)),
@@ -267,6 +279,7 @@ class Search:
             )
         if not self.budget_core_s > 0:
             raise SettingError(f"{where}.budget_core_s", self.budget_core_s, "a number of core-seconds > 0")
+        self._check_cost(where)
         if not self.fd and self.max_realisations < self.initial_realisations:
             raise SettingError(
                 f"{where}.max_realisations", self.max_realisations, f">= realisations ({self.initial_realisations})"
@@ -279,6 +292,22 @@ class Search:
                 self.budget_runs,
                 f"at least the first round's {first} runs ({points} N x {self.realisations})",
             )
+
+    def _check_cost(self, where: str) -> None:
+        """A core-second budget needs a calibrated cost model: points at distinct valid values, seconds > 0."""
+        wanted = f"[[{'N' if self.over == 'n' else 'dt_growth'}, seconds per run], ...], seconds > 0 at distinct values"
+        if math.isfinite(self.budget_core_s) and not self.cost:
+            raise SettingError(
+                f"{where}.cost",
+                None,
+                f"{wanted}, needed with budget_core_s (the budget counts modelled, not measured, seconds: "
+                "print them with benchmarks/calibrate_search_costs.py)",
+            )
+        xs = [x for x, _ in self.cost]
+        low = 1.0 if self.over == "n" else 1.0 + 1e-12
+        bad = len(set(xs)) != len(xs) or any(not (math.isfinite(c) and c > 0) for _, c in self.cost)
+        if bad or any(not (math.isfinite(x) and x >= low) for x in xs):
+            raise SettingError(f"{where}.cost", [list(p) for p in self.cost], wanted)
 
 
 def _block(search: Search, k: int, x, first: int, count: int) -> tuple:
@@ -301,16 +330,47 @@ def runs_in(plan: pd.DataFrame) -> int:
 
 def cost_model(costs: pd.DataFrame, search: Search | None = None) -> Callable[[float], float]:
     """Predicted core-seconds of one run at a searched value from measured runs (columns of the
-    searched dimension, seed, core_s): the mean per value interpolated in u (log N) - log cost,
-    extrapolated with the end segments' slopes (kept in [-2, 2]: no run here costs more than N^2
-    or steps^2); one measured value: cost proportional to N (to steps for a growth search)."""
+    searched dimension, seed, core_s), for the report only (the full-sweep estimate): the mean
+    per value, interpolated (_interpolated)."""
     column = search.over if search else "n"
-    to_u = search.u if search else np.log
     per_run = costs.groupby(column)["core_s"].mean()
     if per_run.empty:
         return lambda x: 0.0
-    u = np.asarray(to_u(per_run.index.to_numpy(np.float64)), dtype=np.float64)
-    c = np.log(np.maximum(per_run.to_numpy(np.float64), 1e-9))
+    return _interpolated(per_run.index.to_numpy(np.float64), per_run.to_numpy(np.float64), search)
+
+
+def calibrated_cost(search: Search) -> Callable[[float], float] | None:
+    """The search's cost model: core-seconds of one run at a searched value from its calibrated
+    points (``Search.cost``), interpolated (_interpolated); None without points."""
+    if not search.cost:
+        return None
+    xs, seconds = zip(*sorted(search.cost))
+    return _interpolated(np.array(xs), np.array(seconds), search)
+
+
+def cost_order(search: Search) -> Callable[[float], float]:
+    """A key that orders runs by cost: the cost model, or without one N (the steps, for a growth
+    search) in arbitrary units."""
+    return calibrated_cost(search) or _interpolated(np.array([float(search.lo)]), np.array([1.0]), search)
+
+
+def planned_cost_s(search: Search, plan: pd.DataFrame) -> float:
+    """Core-seconds of every run of ``plan`` by the cost model (NaN without one): what the budget counts."""
+    model = calibrated_cost(search)
+    if model is None:
+        return math.nan
+    counts = plan["last"] - plan["first"] + 1
+    return float(sum(c * model(x) for x, c in zip(plan[search.over], counts)))
+
+
+def _interpolated(xs: np.ndarray, seconds: np.ndarray, search: Search | None) -> Callable[[float], float]:
+    """Seconds per run at searched values ``xs`` (increasing), interpolated in u (log N) - log
+    cost and extrapolated with the end segments' slopes (kept in [-2, 2]: no run here costs more
+    than N^2 or steps^2); one value: cost proportional to N (to steps for a growth search)."""
+    column = search.over if search else "n"
+    to_u = search.u if search else np.log
+    u = np.asarray(to_u(xs), dtype=np.float64)
+    c = np.log(np.maximum(seconds, 1e-9))
     alone = -1.0 if column == "dt_growth" else 1.0
 
     def slope(i, j):
@@ -475,14 +535,11 @@ def _walk(search: Search, table: pd.DataFrame, opt: dict) -> tuple[list, list]:
     return [x for x in out if x not in xs], replicate
 
 
-def next_plan(
-    search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame | None = None
-) -> pd.DataFrame:
+def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) -> pd.DataFrame:
     """The plan after one more round: ``plan`` plus the blocks this round adds, or ``plan``
-    with `done` set and the reason (REASONS) when the search stops. ``costs`` (columns n,
-    dt_growth, seed, core_s: the measured runs so far) predicts what new runs cost, for the
-    core-seconds budget and to replicate the cheapest first; without it every run counts as free."""
-    costs = pd.DataFrame(columns=["n", "dt_growth", "seed", "core_s"]) if costs is None else costs
+    with `done` set and the reason (REASONS) when the search stops. The cost model
+    (calibrated_cost) counts the core-seconds budget and orders replication cheapest first:
+    the plan depends on the config and the runs' values, never on how long they took."""
     k = int(plan["round"].max()) + 1
     table, opt = evaluate(search, realisations)
     xs = table[search.over].tolist()
@@ -523,16 +580,16 @@ def next_plan(
             if a < mid < b and mid not in xs:
                 new.append(mid)
     new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
-    predict = cost_model(costs, search)
+    model, order = calibrated_cost(search), cost_order(search)
     unresolved = [x for x in rivals if x in inside]
-    more = sorted(set(ends) | set(unresolved) | set([] if walk else lucky), key=predict)
+    more = sorted(set(ends) | set(unresolved) | set([] if walk else lucky), key=order)
     base = int(plan["first"].min())
     added = []
-    spent, spent_s = runs_in(plan), float(costs["core_s"].sum())
+    spent, spent_s = runs_in(plan), planned_cost_s(search, plan) if model else 0.0
 
     def add(x, first, count):
         nonlocal spent, spent_s
-        cost = count * predict(x)
+        cost = count * model(x) if model else 0.0
         if spent + count > search.budget_runs or spent_s + cost > search.budget_core_s:
             return
         added.append(_block(search, k, x, first, count))
@@ -573,6 +630,19 @@ def read_runs(paths: list[str], time: float) -> tuple[pd.DataFrame, pd.DataFrame
     return realisations_table(frames, [time]), _costs(frames)
 
 
+def _visited_end(table: pd.DataFrame, search: Search, best) -> str:
+    """`low` / `high` when ``best`` is the lowest / highest visited value (the minimum may lie beyond), else ''."""
+    xs = table[search.over]
+    return "low" if best == xs.min() else "high" if best == xs.max() else ""
+
+
+def advance(search: Search, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
+    """The next plan (next_plan) from the run tables of ``plan``'s seed blocks at ``paths``: their
+    values at the search's time; their measured wall times are not read."""
+    frames = [pd.read_parquet(p, columns=RUN_COLUMNS) for p in paths]
+    return next_plan(search, plan, realisations_table(frames, [search.time]))
+
+
 def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame) -> pd.DataFrame:
     """Every visited point of a finished search with its statistics, the optimum, the cost spent
     and the estimated cost of the full sweep (RESULT_COLUMN_DOCS). ``costs``: columns n,
@@ -582,6 +652,8 @@ def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame,
     cost_x = costs.groupby(search.over)["core_s"].sum()
     table["round_added"] = table[search.over].map(first_round).astype(int)
     table["core_s"] = table[search.over].map(cost_x).astype(float)
+    model = calibrated_cost(search)
+    table["cost_s"] = table["realisations"] * table[search.over].map(model) if model else math.nan
     other = "dt_growth" if search.over == "n" else "n"
     table[other] = getattr(search.model, other)
     # a grid brackets its minimum between the argmin's two neighbours: to give the same bracket
@@ -605,6 +677,9 @@ def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame,
         rounds=int(plan["round"].max()) + 1,
         runs_spent=runs_in(plan),
         core_s_spent=float(table["core_s"].sum()),
+        cost_s_spent=planned_cost_s(search, plan),
+        budget_core_s=search.budget_core_s,
+        at_end=_visited_end(table, search, opt["best"]),
         full_sweep_core_s=full,
     )
     return out[RESULT_COLUMNS]

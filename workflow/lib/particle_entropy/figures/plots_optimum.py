@@ -42,13 +42,26 @@ def _seconds(s: float) -> str:
 
 
 def cost_text(row: pd.Series) -> str:
-    """'38 runs, 12.3 core-s (9% of a full sweep's ~137 core-s); 4 rounds; stopped: budget spent'."""
+    """'38 runs, 12.3 core-s measured (9% of a full sweep's ~137 core-s); 4 rounds; stopped: budget
+    spent', then on a second line what the budget counted (modelled core-seconds) and, when the
+    lowest mean is at an end of the visited values, that the minimum may lie beyond."""
     spent, full = float(row["core_s_spent"]), float(row["full_sweep_core_s"])
     share = f"{spent / full:.0%} of" if full > 0 else "vs"
-    return (
-        f"{int(row['runs_spent'])} runs, {_seconds(spent)} core-s ({share} a full sweep's ~{_seconds(full)} core-s); "
-        f"{int(row['rounds'])} round{'s' if int(row['rounds']) != 1 else ''}; stopped: {row['reason']}"
+    first = (
+        f"{int(row['runs_spent'])} runs, {_seconds(spent)} core-s measured ({share} a full sweep's "
+        f"~{_seconds(full)} core-s); {int(row['rounds'])} round{'s' if int(row['rounds']) != 1 else ''}; "
+        f"stopped: {row['reason']}"
     )
+    second = []
+    if np.isfinite(float(row["cost_s_spent"])):
+        budget = float(row["budget_core_s"])
+        of = f" of the budget's {_seconds(budget)}" if np.isfinite(budget) else ""
+        second.append(f"the cost model counted {_seconds(float(row['cost_s_spent']))} core-s{of}")
+    if row["at_end"]:
+        name = "dt growth" if row["over"] == "dt_growth" else "N"
+        where, side = ("lowest", "below") if row["at_end"] == "low" else ("highest", "above")
+        second.append(f"lowest mean at the {where} visited {name}: the minimum may lie {side} it")
+    return first + ("\n" + "; ".join(second) if second else "")
 
 
 def _value(v, growth: bool) -> str:
@@ -142,6 +155,7 @@ def optimum_figure(table: pd.DataFrame):
     ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}" if growth else f"{v:,.0f}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
-    fig.text(0.01, 0.005, cost_text(first), fontsize=8, ha="left", va="bottom", color="0.2")
-    fig.get_layout_engine().set(rect=(0, 0.04, 1, 0.96))
+    text = cost_text(first)
+    fig.text(0.01, 0.005, text, fontsize=8, ha="left", va="bottom", color="0.2")
+    fig.get_layout_engine().set(rect=(0, 0.04 * (1 + text.count("\n")), 1, 0.96))
     return fig
