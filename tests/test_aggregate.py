@@ -462,3 +462,66 @@ def test_minima_carry_the_bootstrap_interval_and_share():
     # a bootstrap missing one N of the COMIC table is refused
     with pytest.raises(ValueError, match="same ensembles"):
         comic_minima(comic, argmin[argmin["n"] != 300])
+
+
+# --------------------------------------------------------------------------- unscored COMIC (issue 23)
+def test_a_zero_or_overflowed_sse_is_unscored_never_minus_inf():
+    """Eq. 43 of SSE = 0 is -inf and won every minimum (N = 1, t_final 1e-300); an overflowed SSE
+    (omega 1e-300) is inf. Both are NaN with their reason, in every scoring table."""
+    from particle_entropy.analysis.aggregate import UNSCORED, unscored
+
+    got = unscored([0.0, np.inf, np.nan, 1e-3, 1e-3], [1.0, 1.0, 1.0, 0.0, 1.0])
+    assert list(got) == [UNSCORED["zero"], UNSCORED["overflow"], UNSCORED["overflow"], UNSCORED["volume"], ""]
+    assert all(np.isnan(v) for v in comic_of_mean_sse(0.0, 0.0, 10, 1.0).values())
+
+
+def test_an_n_with_zero_sse_is_never_the_comic_minimum():
+    summaries = _summaries(VARIANTS[0])
+    degenerate = _summary(PAPER.at(2), [5.0, -np.inf, -np.inf, -np.inf], [1.0, 0.0, 0.0, 0.0])
+    table = comic_table([*summaries, degenerate], TIMES[1:])
+    rows = table[table["n"] == 2]
+    assert rows["COMIC_mean"].isna().all() and rows["COMIC_of_mean_SSE"].isna().all()
+    assert (rows["COMIC_reason"].str.startswith("SSE = 0")).all()
+    assert not np.isinf(table[["COMIC_mean", "COMIC_of_mean_SSE"]].to_numpy(float)).any()
+    minima = comic_minima(table)
+    paper = minima[minima["label"] == case_label(PAPER)]
+    assert dict(zip(paper["time"], paper["n_opt"])) == OPT["paper"]  # as without N = 2
+    assert (paper["n_opt_of_mean_SSE"] != 2).all()
+    assert paper["unscored"].str.startswith("N = 2: SSE = 0").all()
+    assert (minima.loc[minima["label"] != case_label(PAPER), "unscored"] == "").all()
+    trade = tradeoff_table([*summaries, degenerate], TIMES[1:])
+    assert not trade.loc[trade["n"] == 2, "is_comic_optimum"].any()
+
+
+def test_a_model_with_no_scored_n_has_no_minimum():
+    table = comic_table(
+        [_summary(PAPER.at(n), [0.0, -np.inf, -np.inf, -np.inf], [1.0, 0.0, 0.0, 0.0]) for n in NS], [10.0]
+    )
+    minima = comic_minima(table)
+    assert minima["n_opt"].tolist() == [-1] and minima["n_opt_of_mean_SSE"].tolist() == [-1]
+    assert np.isnan(minima["COMIC_opt"]).all()
+
+
+def test_an_unscored_realisation_is_never_the_bootstrap_argmin():
+    """Per-realisation COMIC -inf (SSE = 0) at one N: that N is NaN in the realisations table and
+    takes no share of the argmin, under either convention."""
+    from particle_entropy.analysis.aggregate import realisations_table
+
+    values = {MODEL.at(300): [1.0, 1.2, 0.8, 1.1], MODEL.at(1000): [2.0, 2.1, 1.9, 2.2]}
+    table = _realisations(values)
+    frames = []
+    for case, g in table.groupby("n"):
+        run_like = g.assign(step=0, SSE_points=g["SSE"], COMIC_points=g["COMIC"]).drop(columns=["label", "time_step"])
+        if case == 300:
+            run_like = run_like.assign(SSE=0.0, COMIC=-np.inf, SSE_points=0.0, COMIC_points=-np.inf)
+        frames.append(run_like)
+    real = realisations_table(frames, [10.0])
+    at300 = real[real["n"] == 300]
+    assert at300["COMIC"].isna().all() and at300["COMIC_points"].isna().all()
+    assert (at300["COMIC_reason"] == at300["COMIC_points_reason"]).all() and at300["COMIC_reason"].str.startswith(
+        "SSE = 0"
+    ).all()
+    assert (real.loc[real["n"] == 1000, "COMIC_reason"] == "").all()
+    argmin = comic_argmin(real, n_resamples=200)
+    for convention in ("mean_COMIC", "COMIC_of_mean_SSE"):
+        assert _shares(argmin, convention) == {300: 0.0, 1000: 1.0}

@@ -218,3 +218,18 @@ def test_memory_estimate_is_above_a_measured_peak(tmp_path):
     estimate = estimate_bytes(RunConfig.of(method="fd", n=100, t_final=1000.0, dt0=0.005).resolved())
     assert peak > 400e6  # the steps do cost memory (~1.9 kB each): the check is not vacuous
     assert peak < estimate < 2 * peak
+
+
+@pytest.mark.parametrize(
+    "option,value,reason",
+    [("--t-final", "1e-300", "SSE = 0"), ("--omega", "1e-300", "SSE not finite")],
+)
+def test_a_run_comic_cannot_score_says_so(tmp_path, option, value, reason):
+    """A meaningful run (mass conserved) whose COMIC is -inf (t_final 1e-300: SSE = 0) or inf
+    (omega 1e-300: the densities overflow) ended with exit 0 and no word; it now warns, naming why."""
+    out = tmp_path / "x.parquet"
+    res = _cli("simulate", "--method", "mtpt", "--n", "100", option, value, "--quiet", "--out", str(out))
+    assert res.returncode == 0 and out.exists()
+    assert "warning: COMIC at t=" in res.stderr and f"does not score this run: {reason}" in res.stderr
+    good = _small_run("--out", str(out))
+    assert good.returncode == 0 and "warning" not in good.stderr

@@ -557,3 +557,19 @@ def test_the_result_says_when_the_optimum_sits_at_a_visited_end():
     plan = run_search(bracketed, noise=0.0)
     table = realisations_of(plan, 0.0)
     assert (result_table(bracketed, plan, table, costs_of(table))["at_end"] == "").all()
+
+
+def test_an_unscored_point_is_never_the_optimum_and_none_scored_is_said():
+    """N = 30 with SSE = 0 (COMIC NaN in the realisations table, aggregate.UNSCORED) must not win:
+    before, its -inf was the search's minimum."""
+    from particle_entropy.analysis.optimum import evaluate
+
+    plan = pd.DataFrame([(0, n, 1.05, 0, 3, False, "") for n in (30, 95, 300)], columns=PLAN_COLUMNS)
+    table = realisations_of(plan, 0.1)
+    table.loc[table["n"] == 30, "COMIC"] = np.nan
+    table["COMIC_reason"] = np.where(table["n"] == 30, "SSE = 0: ...", "")
+    _, opt = evaluate(mtpt(budget_runs=100), table)
+    assert opt["best"] == 300
+    table["COMIC"] = np.nan
+    with pytest.raises(ValueError, match=r"search t: no visited point scores a COMIC \(SSE = 0: ...\)"):
+        evaluate(mtpt(budget_runs=100), table)

@@ -185,4 +185,9 @@ def main(argv=None) -> int:
             f"done: {len(table) - 1} steps, t={last['time']:.6g}, H_C={last['H_C']:.6g}, "
             f"mass error={abs(last['mass_total'] - 1):.3g}, wall={table['wall_s'].sum():.2f}s"
         )
+    from .analysis.aggregate import unscored
+
+    why = unscored(last["SSE"], last["dV"]).item()
+    if why:  # a valid run that COMIC cannot score: said, even with --quiet (the tables hold COMIC NaN)
+        print(f"warning: COMIC at t={last['time']:.6g} does not score this run: {why}", file=sys.stderr)
     return 0 if math.isfinite(last["mass_total"]) else 1

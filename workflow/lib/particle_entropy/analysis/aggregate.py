@@ -15,6 +15,33 @@ from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, ro
 from ..core.labels import case_label
 from ..core.measures import comic
 
+# why a COMIC (Eq. 43) does not score a model: it is NaN in every scoring table, never -inf, never a minimum
+UNSCORED = {
+    "zero": "SSE = 0: the model equals the reference at every point (t = 0, or a reference narrower than the "
+    "points), COMIC would be -inf",
+    "overflow": "SSE not finite: the densities overflowed (a sampling volume dV too small)",
+    "volume": "dV not a finite number > 0",
+    "realisation": "a realisation's SSE is 0 or not finite",
+}
+
+
+def unscored(sse, dV) -> np.ndarray:
+    """Why COMIC (Eq. 43) of each ``sse`` with ``dV`` cannot score a model (UNSCORED), '' where it can."""
+    sse = np.asarray(sse, dtype=np.float64)
+    dV = np.broadcast_to(np.asarray(dV, dtype=np.float64), sse.shape)
+    out = np.full(sse.shape, "", dtype=object)
+    out[sse == 0] = UNSCORED["zero"]
+    out[~np.isfinite(sse)] = UNSCORED["overflow"]
+    out[~(np.isfinite(dV) & (dV > 0))] = UNSCORED["volume"]
+    return out
+
+
+def lowest(values) -> int:
+    """Index of the lowest value, NaN never (-1 when every value is NaN)."""
+    v = np.asarray(values, dtype=np.float64)
+    return int(np.argmin(np.where(np.isnan(v), np.inf, v))) if not np.isnan(v).all() else -1
+
+
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
 SUMMARY_COLUMNS = {
     "step": "time-step index",
@@ -107,16 +134,26 @@ def tradeoff_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.Data
                 "rmse": float(np.sqrt(r["SSE_mean"] / r["n_sse"])),
                 "H_C_error": r["H_C_mean"] - r["H_C_analytic"],
                 "E_rel_error": r["E_mean"] / r["E_analytic"] - 1.0,
-                "COMIC_mean": r["COMIC_mean"],
-                "COMIC_std": r["COMIC_std"],
+                **_scored_mean(r),
                 "n_realisations": int(r["n_realisations"]),
             }
         )
     df = _sorted(pd.DataFrame(rows))
-    # one optimum per model and time, the smallest N among ties, as comic_minima reports it
-    best = df.groupby([*MODEL_COLUMNS, "time"])["COMIC_mean"].idxmin()
+    # one optimum per model and time, the smallest N among ties, as comic_minima reports it (never unscored)
+    best = df[df["COMIC_mean"].notna()].groupby([*MODEL_COLUMNS, "time"])["COMIC_mean"].idxmin()
     df["is_comic_optimum"] = df.index.isin(best.to_numpy())
     return df
+
+
+def _scored_mean(summary_row) -> dict:
+    """COMIC_mean, COMIC_std and COMIC_reason of a summary row: NaN with the reason (UNSCORED) when
+    the mean SSE or a realisation's cannot score, never -inf."""
+    reason = unscored(summary_row["SSE_mean"], summary_row["dV"]).item()
+    if not reason and not np.isfinite(summary_row["COMIC_mean"]):
+        reason = UNSCORED["realisation"]
+    if reason:
+        return {"COMIC_mean": np.nan, "COMIC_std": np.nan, "COMIC_reason": reason}
+    return {"COMIC_mean": summary_row["COMIC_mean"], "COMIC_std": summary_row["COMIC_std"], "COMIC_reason": ""}
 
 
 def at_times(summary: pd.DataFrame, times: list[float]) -> pd.DataFrame:
@@ -136,8 +173,7 @@ def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFra
             {
                 **case,
                 "time_step": float(r["time"]),
-                "COMIC_mean": r["COMIC_mean"],
-                "COMIC_std": r["COMIC_std"],
+                **_scored_mean(r),
                 **comic_of_mean_sse(r["SSE_mean"], r["SSE_std"], int(r["n_sse"]), float(r["dV"])),
                 "SSE_mean": r["SSE_mean"],
                 "SSE_std": r["SSE_std"],
@@ -151,6 +187,7 @@ def comic_table(summaries: list[pd.DataFrame], times: list[float]) -> pd.DataFra
         "time_step",
         "COMIC_mean",
         "COMIC_std",
+        "COMIC_reason",
         "COMIC_of_mean_SSE",
         "COMIC_of_mean_SSE_lo",
         "COMIC_of_mean_SSE_hi",
@@ -171,7 +208,10 @@ def _sorted(df: pd.DataFrame) -> pd.DataFrame:
 
 def comic_of_mean_sse(sse_mean: float, sse_std: float, n: int, dV: float) -> dict:
     """COMIC of the ensemble-mean SSE (Eq. 43), as the authors' code plots Fig. 9, with the
-    band 2 ln((SSE_mean -+ SSE_std) / n) - ln dV (-inf below when the std exceeds the mean)."""
+    band 2 ln((SSE_mean -+ SSE_std) / n) - ln dV (-inf below when the std exceeds the mean); all
+    three NaN when the mean SSE cannot score (unscored)."""
+    if unscored(sse_mean, dV).item():
+        return {"COMIC_of_mean_SSE": np.nan, "COMIC_of_mean_SSE_lo": np.nan, "COMIC_of_mean_SSE_hi": np.nan}
     return {
         "COMIC_of_mean_SSE": comic(sse_mean, n, dV),
         "COMIC_of_mean_SSE_lo": comic(max(sse_mean - sse_std, 0.0), n, dV),
@@ -218,29 +258,35 @@ MINIMA_COLUMN_DOCS = {
     "n_opt_of_mean_SSE_share": "fraction of resamples in which `n_opt_of_mean_SSE` has the least COMIC of the mean SSE",
     "n_resamples": "bootstrap resamples drawn (`N_RESAMPLES`; 0 when every N has one realisation, e.g. FD: the "
     "optimum is then certain and its share 1)",
+    "unscored": "the N whose mean COMIC is NaN, never a minimum, with the reason (`COMIC_reason`); empty when "
+    "every N scored (every N unscored: `n_opt` -1)",
 }
 MINIMA_COLUMNS = list(MINIMA_COLUMN_DOCS)
 
 
 def _minimum(model, time: float, g: pd.DataFrame) -> dict:
-    """The minimum of mean COMIC over N (rows ``g`` sorted by N) and its neighbours."""
-    k = int(np.argmin(g["COMIC_mean"].to_numpy()))
+    """The minimum of mean COMIC over N (rows ``g`` sorted by N) and its neighbours; an N whose
+    COMIC is NaN (unscored) is never the minimum."""
+    k, k_sse = lowest(g["COMIC_mean"]), lowest(g["COMIC_of_mean_SSE"])
     below = g.iloc[k - 1] if k > 0 else None
-    above = g.iloc[k + 1] if k + 1 < len(g) else None
+    above = g.iloc[k + 1] if 0 <= k < len(g) - 1 else None
+    reasons = g["COMIC_reason"] if "COMIC_reason" in g else pd.Series("", index=g.index)
+    at = g.iloc[k] if k >= 0 else pd.Series({"time_step": time, "n": -1, "COMIC_mean": np.nan, "COMIC_std": np.nan})
     return {
         "label": case_label(model),
         **model.columns(),
         "time": time,
-        "time_step": float(g["time_step"][k]) if "time_step" in g else float(time),
-        "n_opt": int(g["n"][k]),
-        "COMIC_opt": g["COMIC_mean"][k],
-        "COMIC_opt_std": g["COMIC_std"][k],
-        "n_opt_of_mean_SSE": int(g["n"][int(np.argmin(g["COMIC_of_mean_SSE"].to_numpy()))]),
+        "time_step": float(at["time_step"]) if "time_step" in g else float(time),
+        "n_opt": int(at["n"]),
+        "COMIC_opt": at["COMIC_mean"],
+        "COMIC_opt_std": at["COMIC_std"],
+        "n_opt_of_mean_SSE": int(g["n"][k_sse]) if k_sse >= 0 else -1,
         "n_below": int(below["n"]) if below is not None else -1,
         "COMIC_below": below["COMIC_mean"] if below is not None else np.nan,
         "n_above": int(above["n"]) if above is not None else -1,
         "COMIC_above": above["COMIC_mean"] if above is not None else np.nan,
         "interior": below is not None and above is not None,
+        "unscored": "; ".join(f"N = {int(n)}: {why}" for n, why in zip(g["n"], reasons) if why),
     }
 
 
@@ -258,6 +304,8 @@ REALISATION_COLUMN_DOCS = {
     "SSE_points": "SSE of this realisation at the 15 measurement points common to all models (the run tables' "
     "`SSE_points`; Section 6, point 1) [1/L²]",
     "COMIC_points": "2 ln(SSE_points / 15) - ln dV of this realisation, Eq. 43 at the measurement points",
+    "COMIC_reason": "why `COMIC` is NaN (UNSCORED: SSE = 0, SSE not finite, dV not > 0); empty when it scores",
+    "COMIC_points_reason": "why `COMIC_points` is NaN (the same reasons, of `SSE_points`); empty when it scores",
 }
 REALISATION_COLUMNS = list(REALISATION_COLUMN_DOCS)
 # the run-table columns they are read from
@@ -299,6 +347,10 @@ def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataF
     if not parts:
         return pd.DataFrame(columns=REALISATION_COLUMNS)
     df = pd.concat(parts, ignore_index=True).drop_duplicates([*CASE_COLUMNS, "time", "seed"])
+    for column, sse in (("COMIC", "SSE"), ("COMIC_points", "SSE_points")):
+        reason = unscored(df[sse], df["dV"])
+        df[column] = np.where(reason != "", np.nan, df[column])  # never -inf: never a minimum
+        df[f"{column}_reason"] = reason.astype(str)
     parts = [g.sort_values(["time", "n", "seed"]) for _, g in by_model(df)]
     return pd.concat(parts, ignore_index=True)[REALISATION_COLUMNS]
 
@@ -345,25 +397,30 @@ def argmin_bootstrap(
     percentile interval of the bootstrap argmin index (2.5 and 97.5 percentiles, linear
     interpolation) widened outward to grid points: low = floor, high = ceil. Being a set of
     grid points bounded by order statistics, it is the same whether the argmin is counted in
-    index, N or log N. An N with a single realisation cannot be resampled meaningfully (every
-    resample would repeat it): it is held fixed at its value; when every N has one realisation
-    (FD, deterministic) nothing is resampled, the share is 1 at the point estimate and the
-    interval that point. Every call draws from its own Generator seeded with ``seed``, so equal
-    inputs give equal results and two conventions of one model see the same resamples."""
+    index, N or log N. An N whose statistic is NaN (unscored) is never the argmin; when every N's
+    is, the shares are NaN and the interval (-1, -1). An N with a single realisation cannot be
+    resampled meaningfully (every resample would repeat it): it is held fixed at its value;
+    when every N has one realisation (FD, deterministic) nothing is resampled, the share is 1
+    at the point estimate and the interval that point. Every call draws from its own Generator
+    seeded with ``seed``, so equal inputs give equal results and two conventions of one model
+    see the same resamples."""
     samples = [np.asarray(s, dtype=np.float64) for s in samples]
     if not samples or any(len(s) == 0 for s in samples):
         raise ValueError("every N needs at least one realisation")
     means = np.array([s.mean() for s in samples])
     with np.errstate(divide="ignore", invalid="ignore"):
-        point = int(np.argmin(value(means[:, None])[:, 0]))
+        point = lowest(value(means[:, None])[:, 0])
     free = [i for i, s in enumerate(samples) if len(s) > 1]
     shares = np.zeros(len(samples))
+    if point < 0:  # no N scores (every COMIC NaN): no minimum, no interval
+        return shares * np.nan, -1, -1, 0
     if not free:
         shares[point] = 1.0
         return shares, point, point, 0
 
-    def argmin(stacked):
-        return np.argmin(value(stacked), axis=0).astype(np.float64)  # float: scipy casts its levels
+    def argmin(stacked):  # an N whose mean is NaN (an unscored realisation) is never the argmin
+        v = value(stacked)
+        return np.argmin(np.where(np.isnan(v), np.inf, v), axis=0).astype(np.float64)  # float: scipy casts
 
     res = bootstrap_of_means(samples, argmin, n_resamples, seed)
     dist = np.asarray(res.bootstrap_distribution).astype(np.int64)
@@ -427,7 +484,13 @@ def convention_samples(per_n: list[pd.DataFrame], convention: str) -> tuple[list
         return [s["COMIC"].to_numpy() for s in per_n], lambda means: means
     n_sse = np.array([float(s["n_sse"].iloc[0]) for s in per_n])[:, None]
     dV = np.array([float(s["dV"].iloc[0]) for s in per_n])[:, None]
-    return [s["SSE"].to_numpy() for s in per_n], lambda means: 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)
+
+    def of_mean_sse(means):  # Eq. 43 of the mean SSE, NaN where it cannot score (unscored)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            value = 2.0 * (np.log(means) - np.log(n_sse)) - np.log(dV)
+        return np.where(unscored(means, dV) != "", np.nan, value)
+
+    return [s["SSE"].to_numpy() for s in per_n], of_mean_sse
 
 
 def comic_argmin(
@@ -456,8 +519,8 @@ def comic_argmin(
                             "share": float(share),
                             "n_realisations": len(sample),
                             "n_resamples": drawn,
-                            "ci_lo": ns[lo],
-                            "ci_hi": ns[hi],
+                            "ci_lo": ns[lo] if lo >= 0 else -1,
+                            "ci_hi": ns[hi] if hi >= 0 else -1,
                         }
                     )
     return pd.DataFrame(rows, columns=ARGMIN_COLUMNS)
@@ -476,6 +539,8 @@ def _bootstrap_columns(model, time: float, minimum: dict, g: pd.DataFrame, argmi
                 f"{case_label(model)}, t = {time:g}: the bootstrap has N = {sorted(rows['n'].tolist())}, "
                 f"the COMIC table N = {sorted(g['n'].tolist())}; they must come from the same ensembles"
             )
+        if minimum[prefix] < 0:  # no N scored
+            continue
         at_opt = rows[rows["n"] == minimum[prefix]].iloc[0]
         out.update(
             {

@@ -53,6 +53,7 @@ from .aggregate import (
     argmin_bootstrap,
     bootstrap_of_means,
     convention_samples,
+    lowest,
     realisations_table,
 )
 
@@ -435,6 +436,8 @@ def judged(search: Search, realisations: pd.DataFrame) -> pd.DataFrame:
     r = realisations
     if search.measure == "points":
         r = r.assign(COMIC=r["COMIC_points"], SSE=r["SSE_points"], n_sse=MEASUREMENT_POINTS)
+        if "COMIC_points_reason" in r:
+            r = r.assign(COMIC_reason=r["COMIC_points_reason"])
     if search.time_volume:
         s, method = search.steps, search.model.method
         times = r["time_step"].to_numpy(np.float64)
@@ -460,9 +463,12 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
     shares, lo, hi, _ = argmin_bootstrap(resampled, objective)
     counts = np.array([len(s) for s in samples])
     u = np.asarray(search.u(xs), dtype=np.float64)
-    with np.errstate(divide="ignore"):  # a zero SSE: COMIC -inf, a valid minimum
-        minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
-    best = int(np.argmin(minimised))
+    minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
+    best = lowest(minimised)  # an unscored point (COMIC NaN: aggregate.UNSCORED) is never the best
+    if best < 0:
+        why = judged(search, realisations).get("COMIC_reason", pd.Series(["COMIC NaN"]))
+        reasons = sorted(set(why) - {""})
+        raise ValueError(f"search {search.name}: no visited point scores a COMIC ({'; '.join(reasons)})")
     x_opt = search.x(float(fitted_minimum(u, minimised, counts)[0]))
     means = np.array([s.mean() for s in samples])
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])

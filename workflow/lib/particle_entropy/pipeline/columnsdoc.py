@@ -64,10 +64,13 @@ COMIC_COLUMNS = {  # aggregate.comic_table: case summaries at the step nearest e
     "time_step": "time of the recorded step nearest to it [T]",
     "COMIC_mean": SUMMARY_COLUMNS["COMIC_mean"],
     "COMIC_std": SUMMARY_COLUMNS["COMIC_std"],
+    "COMIC_reason": "why `COMIC_mean` (and `COMIC_std`) is NaN: the mean SSE is 0 or not finite, dV is not > 0, or a "
+    "realisation's SSE is 0 or not finite (aggregate.UNSCORED); empty when it scores. An unscored N is never a "
+    "minimum",
     "COMIC_of_mean_SSE": "COMIC of the ensemble-mean SSE, 2 ln(SSE_mean / n_sse) - ln dV (Eq. 43 applied to the "
     "mean, as the authors' script plots Fig. 9)",
     "COMIC_of_mean_SSE_lo": "the same with SSE_mean - SSE_std (-inf when the standard deviation reaches the mean)",
-    "COMIC_of_mean_SSE_hi": "the same with SSE_mean + SSE_std",
+    "COMIC_of_mean_SSE_hi": "the same with SSE_mean + SSE_std (all three NaN when the mean SSE is 0 or not finite)",
     "SSE_mean": SUMMARY_COLUMNS["SSE_mean"],
     "SSE_std": SUMMARY_COLUMNS["SSE_std"],
     "n_realisations": "realisations behind the row",
