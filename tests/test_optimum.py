@@ -161,6 +161,7 @@ def test_full_sweep_estimate_is_a_grid_giving_the_same_bracket():
         ({"budget_runs": 10}, "budget_runs"),
         ({"time": 5000}, "time"),
         ({"width": 1.0}, "width"),
+        ({"width": 1001.0}, "width"),  # wider than the range 30-30,000: round 0 would stop on any bracket
         ({"initial_points": 2}, "initial_points"),
         ({"initial_points": 4, "start_points": 5}, "start_points"),
         ({"budget_core_s": 0, "cost": [[30, 1]]}, "budget_core_s"),

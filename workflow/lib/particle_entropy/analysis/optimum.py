@@ -259,8 +259,13 @@ class Search:
             raise SettingError(f"{where}.n_range", [self.lo, self.hi], "for fd a low end >= 2 (even intervals)")
         if not 0 < self.time <= t_final:
             raise SettingError(f"{where}.time", self.time, f"a time in (0, physics.t_final = {t_final:g}]")
-        if not self.width > self.min_step:
-            raise SettingError(f"{where}.width", self.width, f"a ratio high / low > {self.min_step}")
+        span = math.exp(float(self.u(self.hi) - self.u(self.lo)))  # the range as a ratio (growth: of dt_growth - 1)
+        if not self.min_step < self.width <= span:
+            raise SettingError(
+                f"{where}.width",
+                self.width,
+                f"a ratio high / low in ({self.min_step}, {span:.4g}]: a bracket wider than the range stops at once",
+            )
         if self.convention not in CONVENTIONS:
             raise SettingError(f"{where}.convention", self.convention, f"one of {', '.join(CONVENTIONS)}")
         if self.measure not in MEASURES:
