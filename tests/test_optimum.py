@@ -552,6 +552,8 @@ def test_the_result_says_when_the_optimum_sits_at_a_visited_end():
     assert (out["at_end"] == "high").all()
     fig = optimum_figure(out)
     text = " ".join(t.get_text() for t in fig.texts)
+    left, bottom, width, height = fig.get_layout_engine().get()["rect"]  # two lines below: the title still fits
+    assert bottom >= 0.08 and bottom + height <= 1.0
     plt.close(fig)
     assert "lowest mean at the highest visited N: the minimum may lie above it" in text
     bracketed = fd(width=1.5, budget_runs=40)

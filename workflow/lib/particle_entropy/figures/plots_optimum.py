@@ -157,5 +157,6 @@ def optimum_figure(table: pd.DataFrame):
     ax.xaxis.set_minor_formatter(NullFormatter())
     text = cost_text(first)
     fig.text(0.01, 0.005, text, fontsize=8, ha="left", va="bottom", color="0.2")
-    fig.get_layout_engine().set(rect=(0, 0.04 * (1 + text.count("\n")), 1, 0.96))
+    bottom = 0.04 * (1 + text.count("\n"))  # room for the text's lines; rect is (left, bottom, width, height)
+    fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))
     return fig
