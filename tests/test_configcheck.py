@@ -152,6 +152,20 @@ BAD = [
         ["figures['fig1\\n']", "fig1 ... fig9"],
     ),
     ("optimum name ending in a newline", _rename_in(("optimum",), "fd_t250", "x\n"), ["optimum['x\\n']", "letters"]),
+    # issue 23: accepted by the dry run, failing in the job (or after removing the good tables)
+    ("fd_domain odd grid", _set(("mechanism", "fd_domain", "n"), [31]), ["mechanism.fd_domain.n=31", "even whole"]),
+    (
+        "fd_domain grid not fitting a length",
+        _set(("mechanism", "fd_domain", "lengths"), [12, 13]),
+        ["mechanism.fd_domain.n=1000", "fits an even whole number (>= 2) of times in 13"],
+    ),
+    (
+        "fd_domain length below the plume",
+        _set(("mechanism", "fd_domain", "lengths"), [12, 1e-6]),
+        ["mechanism.fd_domain.lengths=1e-06", "2 sqrt(2 D t_final)"],
+    ),
+    ("comic_times twice", _set(("comic_times",), [5, 5, 20]), ["comic_times=[5, 5, 20]", "each once"]),
+    ("tradeoff times twice", _set(("tradeoff", "times"), [250, 250.0]), ["tradeoff.times=[250, 250.0]", "each once"]),
 ]
 
 
@@ -280,3 +294,33 @@ def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
         ]["maximum"],
     ]
     assert caps == [MAX_REALISATIONS] * 4
+
+
+def test_shear_n_is_checked_against_memory_by_arithmetic():
+    """shear.n = 10**12 had no memory check (the job failed or thrashed). The estimate is
+    arithmetic, so a dry run and check-config refuse it at once, naming shear.n."""
+    import time
+
+    from particle_entropy.pipeline.sweeps import shear_memory_mb
+
+    cfg = copy.deepcopy(BASE)
+    check_config(cfg, available=24e9)
+    cfg["shear"]["n"] = 10**12
+    start = time.perf_counter()
+    with pytest.raises(SettingError, match=r"shear.n=1000000000000 is not allowed: an N whose shear job fits"):
+        check_config(cfg, available=24e9)
+    assert time.perf_counter() - start < 5.0
+    # pairs grow as N^2: four times the particles, about sixteen times the pair memory
+    small, large = (shear_memory_mb({**BASE, "shear": {**BASE["shear"], "n": n}}) for n in (10**6, 4 * 10**6))
+    assert 14 < (large - 300) / (small - 300) < 17
+    no_mt = {**BASE, "shear": {**BASE["shear"], "n": 10**6, "cases": ["rw_drift"]}}
+    assert shear_memory_mb(no_mt) < 1000  # random walks only: no pairs
+
+
+def test_check_config_command_runs_the_dry_runs_memory_check(tmp_path):
+    """check-config accepted configs the dry run refused for memory."""
+    overlay = tmp_path / "big.yaml"
+    overlay.write_text("shear:\n  n: 1000000000000\n")
+    assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2
+    overlay.write_text("figures:\n  fig1:\n    n: [1000000000]\n")
+    assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2

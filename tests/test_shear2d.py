@@ -246,3 +246,28 @@ def test_bad_settings_name_the_setting(kw, name):
     with pytest.raises(SettingError) as err:
         ShearConfig(**kw)
     assert err.value.name == name
+
+
+def test_shear_memory_estimate_is_above_a_measured_peak():
+    """The mt shear job at 4x the paper's N, two steps: sweeps.shear_memory_mb must bound the
+    peak resident memory a fresh process reaches (its pairs grow as N^2)."""
+    import os
+    import subprocess
+    import sys
+
+    import yaml
+
+    from particle_entropy.pipeline.sweeps import shear_memory_mb
+
+    shear = {**yaml.safe_load(open("config.yaml"))["shear"], "n": 80_000, "t_final": 2, "cases": ["mt"]}
+    code = (
+        "from particle_entropy.experiments.shear2d import ShearConfig, run_shear; "
+        f"run_shear(ShearConfig(case='mt', **{ {k: v for k, v in shear.items() if k != 'cases'}!r}))"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code])
+    _, status, usage = os.wait4(proc.pid, 0)
+    assert status == 0
+    peak = usage.ru_maxrss * 1024  # Linux reports kB
+    estimate = shear_memory_mb({"shear": shear}) * 2**20
+    assert peak > 350e6  # the pairs do cost memory: the check is not vacuous
+    assert peak < estimate < 3 * peak

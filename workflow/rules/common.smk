@@ -44,6 +44,7 @@ from particle_entropy.pipeline.sweeps import (
     run_config,
     run_path,
     run_settings,
+    shear_memory_mb,
     spec_ensembles,
 )
 

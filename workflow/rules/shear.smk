@@ -18,7 +18,7 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
         conda:
             "../../envs/particle-entropy.yaml"
         resources:
-            mem_mb=2000,
+            mem_mb=max(2000, shear_memory_mb(config)),
             runtime=10,
         params:
             **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},

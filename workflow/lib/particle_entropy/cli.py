@@ -109,13 +109,14 @@ def check_config_files(files: list[str]) -> int:
     """The check-config command: merge the files, check them, print one line."""
     from snakemake.utils import update_config
 
+    from .core.memory import available_bytes
     from .pipeline.configcheck import ConfigFileError, check_config, load_yaml
 
     config: dict = {}
     try:
         for f in files:
             update_config(config, dict(load_yaml(f)))
-        check_config(config)
+        check_config(config, available=available_bytes())  # the dry run's checks, memory on this machine too
     except (ConfigFileError, SettingError, OSError) as e:
         print(f"check-config: {e}", file=sys.stderr)
         return 2

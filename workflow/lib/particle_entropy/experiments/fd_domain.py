@@ -12,14 +12,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from ..core import measures as M
+from ..core.case import SettingError
 from ..core.runconfig import RunConfig
 from ..core.settings import PAPER
-from ..models import fd
+
+if TYPE_CHECKING:  # pandas and the FD model (numba) load when the experiment runs, not when a config is checked
+    import pandas as pd
 
 REFERENCES = ("unit", "exact", "fd_mass", "images")
 DEFAULT_TIMES = tuple(float(t) for t in range(100, 1001, 50))
@@ -65,11 +68,15 @@ def reference(
     return g
 
 
-def _grid_n(n: int, length: float, ref_length: float) -> int:
-    """Intervals on ``length`` with the spacing dx = ref_length / n of the paper's grid n."""
+def grid_intervals(n: int, length: float, ref_length: float) -> int:
+    """Intervals on a domain of ``length`` at the spacing dx = ref_length / n of grid n; SettingError
+    (named `n`) unless an even whole number >= 2, so that a node sits at x = 0."""
     m = n * length / ref_length
-    if abs(m - round(m)) > 1e-9 or round(m) % 2:
-        raise ValueError(f"length {length} with dx = {ref_length}/{n} needs an even whole number of intervals")
+    whole = math.isfinite(m) and abs(m - round(m)) <= 1e-9 * max(1.0, abs(m))
+    if not whole or round(m) < 2 or round(m) % 2:
+        raise SettingError(
+            "n", n, f"a grid whose dx = {ref_length:g} / n fits an even whole number (>= 2) of times in {length:g}"
+        )
     return int(round(m))
 
 
@@ -93,7 +100,9 @@ def run_case(
 ) -> list[dict]:
     """Implicit FD (backward Euler, fd.ImplicitSolver) of grid ``n`` (dx = ref_length / n) on
     [-fd_length/2, fd_length/2] with zero end nodes; the measures at ``times`` per reference."""
-    n_int = _grid_n(n, fd_length, ref_length)
+    from ..models import fd
+
+    n_int = grid_intervals(n, fd_length, ref_length)
     cfg = RunConfig.of(method="fd", kernel="implicit", n=n_int, D=D, fd_length=fd_length, dt0=fd_dt).resolved()
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
@@ -149,6 +158,8 @@ def domain_experiment(
 ) -> pd.DataFrame:
     """Tidy table of SSE (Eq. 44), ln(SSE/N) and COMIC = -ln dx + 2 ln(SSE/N) (Eq. 43) and the FD
     mass, per grid n (dx = ref_length / n, fixed across lengths), domain length, step and time."""
+    import pandas as pd
+
     times = tuple(times)
     references = tuple(references)
     rows = []

@@ -193,11 +193,15 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
-def check_config(config: Mapping, schema: Mapping | None = None) -> None:
+def check_config(config: Mapping, schema: Mapping | None = None, available: float | None = None) -> None:
     """Everything a dry run checks: the schema, then every rule between fields (sweeps.check_sweeps),
-    and every adaptive search, which a dry run checks only when a target needs it."""
-    from .sweeps import check_optimum, check_sweeps
+    with ``available`` bytes (the machine's, for the check-config command) that every job fits
+    (sweeps.check_memory), and every adaptive search, which a dry run checks only when a target
+    needs it."""
+    from .sweeps import check_memory, check_optimum, check_sweeps
 
     check_schema(config, load_schema() if schema is None else schema)
     check_sweeps(config)
-    check_optimum(config)
+    if available is not None:
+        check_memory(config, available)
+    check_optimum(config, available)

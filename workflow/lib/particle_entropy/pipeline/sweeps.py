@@ -104,6 +104,30 @@ def check_lattice(config: Mapping) -> None:
             )
 
 
+def check_fd_domain(config: Mapping) -> None:
+    """Every grid of `mechanism.fd_domain` runs on every length: an even whole number of intervals
+    at dx = physics.fd_length / n (fd_domain.grid_intervals), on a domain the plume fits (RunConfig)."""
+    spec = config.get("mechanism", {}).get("fd_domain")
+    if not spec:
+        return
+    from ..experiments.fd_domain import grid_intervals
+
+    physics, fd_dt = config["physics"], float(config["time"]["fd_dt"])
+    ref = float(physics.get("fd_length", PAPER["fd_length"]))
+    settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
+    for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
+        try:
+            RunConfig.of(method="fd", kernel="implicit", n=2, fd_length=float(length), **settings).check()
+        except SettingError as e:
+            raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
+    for n in spec["n"]:
+        for length in spec["lengths"]:
+            try:
+                grid_intervals(int(n), float(length), ref)
+            except SettingError as e:
+                raise SettingError("mechanism.fd_domain.n", n, e.allowed) from None
+
+
 def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
     """Realisations of one N in a section: an integer, or the `realisations` table (capped)."""
     r = spec.get("realisations", 1)
@@ -271,15 +295,49 @@ def optimum_largest_jobs(search) -> list[Ensemble]:
     return [Ensemble(search.case_at(x), seeds) for x in search.grid(2)]
 
 
+# measured on one mt transfer step (N = 20,000 and 80,000): 16-18 B a pair in numpy arrays, about
+# 35 B a pair of resident memory with the KD tree's; rounded up, as memory.py's per-particle bytes
+SHEAR_PAIR_BYTES = 64.0
+SHEAR_PARTICLE_BYTES = 400.0
+
+
+def shear_memory_mb(config: Mapping) -> int:
+    """Estimated peak memory of the largest shear job (Fig. 10), in MB, by arithmetic: the base of
+    every run (memory.BASE_BYTES), its particles' arrays and, for mass transfer, its neighbour pairs:
+    N^2 / 2 x the kernel's share of the domain, pi s_c^2 / (L / sqrt(alpha_L) / sqrt(alpha_T)) in
+    scaled distance (2 s_c / (L / sqrt(alpha_L)) for alpha_T = 0; shear2d.kernel_cutoff)."""
+    from ..core.memory import BASE_BYTES
+    from ..experiments.shear2d import ShearConfig, kernel_cutoff
+
+    shear = config["shear"]
+    n = float(shear.get("n", ShearConfig.n))
+    need = BASE_BYTES + SHEAR_PARTICLE_BYTES * n
+    if "mt" in shear["cases"]:
+        cfg = ShearConfig(case="mt", **{k: v for k, v in shear.items() if k not in ("cases", "n")})
+        cut, width = kernel_cutoff(cfg), cfg.length / math.sqrt(cfg.alpha_L)
+        share = math.pi * cut**2 / (width / math.sqrt(cfg.alpha_T)) if cfg.alpha_T > 0 else 2.0 * cut / width
+        need += SHEAR_PAIR_BYTES * n * n / 2.0 * min(share, 1.0)
+    return int(need / 2**20) + 1
+
+
 def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
-    of its seed block; an adaptive search's jobs: check_search)."""
+    of its seed block; the shear jobs: shear_memory_mb; an adaptive search's jobs: check_search)."""
     jobs = [
         (f"{name}.n", ens, block_size(ens, config))
         for name, spec in case_sections(config).items()
         for ens in spec_ensembles(spec, config)
     ]
     _check_jobs_fit(jobs, config, available)
+    if "shear" in config:
+        need = shear_memory_mb(config) * 2**20
+        if need > available:
+            raise SettingError(
+                "shear.n",
+                config["shear"]["n"],
+                f"an N whose shear job fits in this machine's memory: it needs about {need / 1e9:.3g} GB, "
+                f"{available / 1e9:.1f} GB are available (or run it on a cluster)",
+            )
 
 
 def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
@@ -371,6 +429,7 @@ def check_sweeps(config: Mapping) -> None:
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     check_lattice(config)
+    check_fd_domain(config)
     check_seeds(config)
     check_shear(config)  # the optimum searches are checked when a target uses them (Searches)
     t_final = float(config["physics"]["t_final"])
