@@ -89,8 +89,10 @@ TRADEOFF_COLUMNS = {  # aggregate.tradeoff_table
     "E_rel_error": "E_mean / E_analytic - 1",
     "COMIC_mean": SUMMARY_COLUMNS["COMIC_mean"],
     "COMIC_std": SUMMARY_COLUMNS["COMIC_std"],
+    "COMIC_reason": COMIC_COLUMNS["COMIC_reason"],
     "n_realisations": "realisations behind the row",
-    "is_comic_optimum": "this N has the least `COMIC_mean` of its model at this time (the smallest N among ties)",
+    "is_comic_optimum": "this N has the least `COMIC_mean` of its model at this time (the smallest N among ties; "
+    "never an unscored N)",
 }
 CLAIM_COLUMNS = {  # claims.COLUMNS
     "claim": "the claim in words, naming the model and N or time it is judged for",
