@@ -166,6 +166,7 @@ BAD = [
     ),
     ("comic_times twice", _set(("comic_times",), [5, 5, 20]), ["comic_times=[5, 5, 20]", "each once"]),
     ("tradeoff times twice", _set(("tradeoff", "times"), [250, 250.0]), ["tradeoff.times=[250, 250.0]", "each once"]),
+    ("shear n past the cap", _set(("shear", "n"), 10**12), ["shear.n=1000000000000", "maximum of 100000000"]),
 ]
 
 
@@ -297,17 +298,17 @@ def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
 
 
 def test_shear_n_is_checked_against_memory_by_arithmetic():
-    """shear.n = 10**12 had no memory check (the job failed or thrashed). The estimate is
-    arithmetic, so a dry run and check-config refuse it at once, naming shear.n."""
+    """shear.n = 10**7 (within the schema's cap) had no memory check (the job failed or thrashed).
+    The estimate is arithmetic, so a dry run and check-config refuse it at once, naming shear.n."""
     import time
 
     from particle_entropy.pipeline.sweeps import shear_memory_mb
 
     cfg = copy.deepcopy(BASE)
     check_config(cfg, available=24e9)
-    cfg["shear"]["n"] = 10**12
+    cfg["shear"]["n"] = 10**7
     start = time.perf_counter()
-    with pytest.raises(SettingError, match=r"shear.n=1000000000000 is not allowed: an N whose shear job fits"):
+    with pytest.raises(SettingError, match=r"shear.n=10000000 is not allowed: an N whose shear job fits"):
         check_config(cfg, available=24e9)
     assert time.perf_counter() - start < 5.0
     # pairs grow as N^2: four times the particles, about sixteen times the pair memory
@@ -317,10 +318,20 @@ def test_shear_n_is_checked_against_memory_by_arithmetic():
     assert shear_memory_mb(no_mt) < 1000  # random walks only: no pairs
 
 
-def test_check_config_command_runs_the_dry_runs_memory_check(tmp_path):
+def test_check_config_command_runs_the_dry_runs_memory_check(tmp_path, capsys):
     """check-config accepted configs the dry run refused for memory."""
     overlay = tmp_path / "big.yaml"
-    overlay.write_text("shear:\n  n: 1000000000000\n")
-    assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2
-    overlay.write_text("figures:\n  fig1:\n    n: [1000000000]\n")
-    assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2
+    for text, named in [
+        ("shear:\n  n: 10000000\n", "shear.n=10000000 is not allowed: an N whose shear job fits"),
+        ("figures:\n  fig1:\n    n: [1000000000]\n", "figures.fig1.n=1000000000 is not allowed: an N whose job fits"),
+    ]:
+        overlay.write_text(text)
+        assert main(["check-config", str(ROOT / "config.yaml"), str(overlay)]) == 2
+        assert named in capsys.readouterr().err
+
+
+def test_the_shear_n_cap_is_the_schemas():
+    from particle_entropy.experiments.shear2d import MAX_N
+
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    assert schema["properties"]["shear"]["properties"]["n"]["maximum"] == MAX_N

@@ -19,6 +19,7 @@ from conftest import no_runtime_warnings
 
 from particle_entropy.core.runconfig import SettingError
 from particle_entropy.experiments.shear2d import (
+    MAX_N,
     ShearConfig,
     kernel_cutoff,
     run_shear,
@@ -232,6 +233,7 @@ def test_determinism_per_seed():
     [
         (dict(case="walk"), "case"),
         (dict(n=0), "n"),
+        (dict(n=MAX_N + 1), "n"),
         (dict(alpha_L=0.0), "alpha_L"),
         (dict(alpha_T=-1e-3), "alpha_T"),
         (dict(dt=0.0), "dt"),

@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
 V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
 KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
+MAX_N = 10**8  # particles (schema too): 5,000 x the paper's, ~40 GB for a random walk; more is a typo
 
 STEP_COLUMNS = {
     "step": "time-step index, 0 = initial condition",
@@ -84,8 +85,8 @@ class ShearConfig:
         """Raise SettingError naming the first setting outside its allowed range."""
         if self.case not in SHEAR_CASES:
             raise SettingError("case", self.case, f"one of {', '.join(SHEAR_CASES)}")
-        if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or self.n < 1:
-            raise SettingError("n", self.n, "an integer >= 1")
+        if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or not 1 <= self.n <= MAX_N:
+            raise SettingError("n", self.n, f"an integer in [1, {MAX_N:,}]")
         check_range("length", self.length, 0.0, math.inf, open_low=True)
         check_range("strip_lo", self.strip_lo, 0.0, self.length)
         check_range("strip_hi", self.strip_hi, self.strip_lo, self.length, open_low=True)
