@@ -36,10 +36,16 @@ def unscored(sse, dV) -> np.ndarray:
     return out
 
 
+def nan_argmin(values, axis=None):
+    """np.argmin that never picks a NaN (an unscored COMIC): NaN counts as +inf."""
+    v = np.asarray(values, dtype=np.float64)
+    return np.argmin(np.where(np.isnan(v), np.inf, v), axis=axis)
+
+
 def lowest(values) -> int:
     """Index of the lowest value, NaN never (-1 when every value is NaN)."""
     v = np.asarray(values, dtype=np.float64)
-    return int(np.argmin(np.where(np.isnan(v), np.inf, v))) if not np.isnan(v).all() else -1
+    return -1 if np.isnan(v).all() else int(nan_argmin(v))
 
 
 METRICS = ["H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "mass_total"]
@@ -419,8 +425,7 @@ def argmin_bootstrap(
         return shares, point, point, 0
 
     def argmin(stacked):  # an N whose mean is NaN (an unscored realisation) is never the argmin
-        v = value(stacked)
-        return np.argmin(np.where(np.isnan(v), np.inf, v), axis=0).astype(np.float64)  # float: scipy casts
+        return nan_argmin(value(stacked), axis=0).astype(np.float64)  # float: scipy casts its levels
 
     res = bootstrap_of_means(samples, argmin, n_resamples, seed)
     dist = np.asarray(res.bootstrap_distribution).astype(np.int64)

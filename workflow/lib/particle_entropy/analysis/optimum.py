@@ -54,6 +54,7 @@ from .aggregate import (
     bootstrap_of_means,
     convention_samples,
     lowest,
+    nan_argmin,
     realisations_table,
 )
 
@@ -310,9 +311,9 @@ class Search:
                 "print them with benchmarks/calibrate_search_costs.py)",
             )
         xs = [x for x, _ in self.cost]
-        low = 1.0 if self.over == "n" else 1.0 + 1e-12
+        valid = (lambda x: x >= 1) if self.over == "n" else (lambda x: x > 1)  # N >= 1; a growth > 1
         bad = len(set(xs)) != len(xs) or any(not (math.isfinite(c) and c > 0) for _, c in self.cost)
-        if bad or any(not (math.isfinite(x) and x >= low) for x in xs):
+        if bad or any(not (math.isfinite(x) and valid(x)) for x in xs):
             raise SettingError(f"{where}.cost", [list(p) for p in self.cost], wanted)
 
 
@@ -403,7 +404,7 @@ def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach
     not turn up. Fitting several points at once keeps one lucky mean from being taken for the minimum."""
     values = np.asarray(values, dtype=np.float64)
     values = values[:, None] if values.ndim == 1 else values
-    k = np.argmin(np.where(np.isnan(values), np.inf, values), axis=0)
+    k = nan_argmin(values, axis=0)
     out = u[k].astype(np.float64)
     for best in np.unique(k):
         if best == 0 or best == len(u) - 1:
@@ -460,7 +461,8 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
     interval) of the search's convention, from per-realisation values (columns n, dt_growth,
     seed, COMIC; as needed SSE, n_sse, dV, time_step, SSE_points, COMIC_points:
     aggregate.realisations_table at the search's time)."""
-    per_x = [g for _, g in judged(search, realisations).groupby(search.over, sort=True)]
+    values = judged(search, realisations)
+    per_x = [g for _, g in values.groupby(search.over, sort=True)]
     xs = np.array([g[search.over].iloc[0] for g in per_x])
     samples = [g["COMIC"].to_numpy(dtype=np.float64) for g in per_x]
     # mean COMIC, or Eq. 43 of the mean SSE (the paper warns the convention can move the optimum)
@@ -471,7 +473,7 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
     minimised = objective(np.array([r.mean() for r in resampled])[:, None])[:, 0]
     best = lowest(minimised)  # an unscored point (COMIC NaN: aggregate.UNSCORED) is never the best
     if best < 0:
-        why = judged(search, realisations).get("COMIC_reason", pd.Series(["COMIC NaN"]))
+        why = values.get("COMIC_reason", pd.Series(["COMIC NaN"]))
         reasons = sorted(set(why) - {""})
         raise ValueError(f"search {search.name}: no visited point scores a COMIC ({'; '.join(reasons)})")
     x_opt = search.x(float(fitted_minimum(u, minimised, counts)[0]))

@@ -301,6 +301,13 @@ SHEAR_PAIR_BYTES = 64.0
 SHEAR_PARTICLE_BYTES = 400.0
 
 
+def shear_n(config: Mapping) -> int:
+    """The shear section's particle count (ShearConfig's default when the section leaves it out)."""
+    from ..experiments.shear2d import ShearConfig
+
+    return config["shear"].get("n", ShearConfig.n)
+
+
 def shear_memory_mb(config: Mapping) -> int:
     """Estimated peak memory of the largest shear job (Fig. 10), in MB, by arithmetic: the base of
     every run (memory.BASE_BYTES), its particles' arrays and, for mass transfer, its neighbour pairs:
@@ -310,7 +317,7 @@ def shear_memory_mb(config: Mapping) -> int:
     from ..experiments.shear2d import ShearConfig, kernel_cutoff
 
     shear = config["shear"]
-    n = float(shear.get("n", ShearConfig.n))
+    n = float(shear_n(config))
     need = BASE_BYTES + SHEAR_PARTICLE_BYTES * n
     if "mt" in shear["cases"]:
         cfg = ShearConfig(case="mt", **{k: v for k, v in shear.items() if k not in ("cases", "n")})
@@ -334,7 +341,7 @@ def check_memory(config: Mapping, available: float) -> None:
         if need > available:
             raise SettingError(
                 "shear.n",
-                config["shear"]["n"],
+                shear_n(config),
                 f"an N whose shear job fits in this machine's memory: it needs about {need / 1e9:.3g} GB, "
                 f"{available / 1e9:.1f} GB are available (or run it on a cluster)",
             )
