@@ -15,13 +15,10 @@ import pytest
 
 from particle_entropy.analysis.aggregate import (
     ARGMIN_COLUMN_DOCS,
-    BOOTSTRAP_SEED,
     METRICS,
     MINIMA_COLUMN_DOCS,
     MINIMA_COLUMNS,
-    N_RESAMPLES,
     REALISATION_COLUMN_DOCS,
-    argmin_bootstrap,
     at_times,
     comic_argmin,
     comic_minima,
@@ -32,6 +29,7 @@ from particle_entropy.analysis.aggregate import (
     summarise_runs,
     tradeoff_table,
 )
+from particle_entropy.analysis.resampling import BOOTSTRAP_SEED, N_RESAMPLES, argmin_bootstrap
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
 from particle_entropy.core.labels import case_label

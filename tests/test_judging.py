@@ -145,6 +145,6 @@ def test_flat_tested_cannot_judge_a_single_realisation():
 
 
 def test_the_tests_level_is_the_bootstrap_intervals_complement():
-    from particle_entropy.analysis.aggregate import CONFIDENCE
+    from particle_entropy.analysis.resampling import CONFIDENCE
 
     assert judging.LEVEL == pytest.approx(1 - CONFIDENCE) and 0 < judging.LEVEL < 0.5

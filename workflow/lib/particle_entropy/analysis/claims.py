@@ -10,7 +10,7 @@ import pandas as pd
 from ..core.case import Case, by_model, case_of_table, rows_of
 from ..core.labels import case_label, preset_of
 from ..core.registry import SCHEME_DOCS
-from .aggregate import CONFIDENCE
+from .resampling import CONFIDENCE
 from .judging import flat_as_drawn, flat_tested, overlapping_minimum
 
 
@@ -237,7 +237,7 @@ def _ns(ns) -> str:
 
 def _interval_test(row: pd.Series, prefix: str, lo: float, hi: float) -> tuple[str, bool | None]:
     """(b) for an optimum: the claimed range is not rejected when the bootstrap interval of the
-    argmin (aggregate.argmin_bootstrap, 95 %) meets it."""
+    argmin (resampling.argmin_bootstrap, 95 %) meets it."""
     if int(row.get("n_resamples", 0)) <= 0:
         return "one realisation per N: nothing to resample", None
     a, b = int(row[f"{prefix}_ci_lo"]), int(row[f"{prefix}_ci_hi"])

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from .aggregate import BOOTSTRAP_SEED, CONFIDENCE, scipy_rng_keyword
+from .resampling import BOOTSTRAP_SEED, CONFIDENCE, scipy_rng_keyword
 
 LEVEL = round(1.0 - CONFIDENCE, 12)  # 0.05: the tests' family-wise level, the complement of the bootstrap intervals
 N_PERMUTATIONS = 9999  # random permutations per comparison (fewer when every split can be enumerated)

@@ -47,16 +47,8 @@ from ..core.registry import MEASUREMENT_POINTS
 from ..core.runconfig import first_step
 from ..core.settings import PAPER
 from ..core.timegrid import step_count
-from .aggregate import (
-    CONVENTIONS,
-    RUN_COLUMNS,
-    argmin_bootstrap,
-    bootstrap_of_means,
-    convention_samples,
-    lowest,
-    nan_argmin,
-    realisations_table,
-)
+from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
+from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
 
 MEASURES = {
     "own": "SSE at the model's own points: particles or nodes (Eq. 44)",
@@ -424,7 +416,7 @@ def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach
 
 def _fitted_interval(u, resampled, objective, counts) -> tuple[float, float]:
     """95 % percentile interval of the fitted minimum (in u) over bootstrap resamples of the
-    realisations (aggregate.bootstrap_of_means: each point on its own, single realisations fixed)."""
+    realisations (resampling.bootstrap_of_means: each point on its own, single realisations fixed)."""
 
     def vertex(stacked):
         return fitted_minimum(u, objective(stacked.reshape(len(u), -1)), counts).reshape(stacked.shape[1:])
