@@ -10,8 +10,8 @@ import pandas as pd
 from ..core.case import Case, by_model, case_of_table, rows_of
 from ..core.labels import case_label, preset_of
 from ..core.registry import SCHEME_DOCS
-from .resampling import CONFIDENCE
 from .judging import flat_as_drawn, flat_tested, overlapping_minimum
+from .resampling import CONFIDENCE
 
 
 def _near(df: pd.DataFrame, t: float) -> pd.Series:

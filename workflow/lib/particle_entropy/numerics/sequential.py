@@ -55,7 +55,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .gauss import EXP_NEAR_MAX, cutoff_radius, exp_neg, exp_neg_near
+from .fastexp import EXP_NEAR_MAX, exp_neg, exp_neg_near
+from .gauss import cutoff_radius
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)  # SplitMix64's increment: its state after k outputs is s + k G
 
@@ -72,8 +73,8 @@ def _splitmix(state):
 
 @njit(cache=True, fastmath={"contract"})
 def _kernel(u, out, cnt, near=False):
-    """out[k] = exp(-u[k]) for k < cnt, by gauss.exp_neg (arithmetic that vectorises); ``near``:
-    every u[k] <= gauss.EXP_NEAR_MAX, so the cheaper gauss.exp_neg_near gives the same bits."""
+    """out[k] = exp(-u[k]) for k < cnt, by fastexp.exp_neg (arithmetic that vectorises); ``near``:
+    every u[k] <= fastexp.EXP_NEAR_MAX, so the cheaper fastexp.exp_neg_near gives the same bits."""
     if near:
         for k in range(cnt):
             out[k] = exp_neg_near(u[k])
