@@ -40,7 +40,7 @@ rule all:
 
 
 onerror:
-    from particle_entropy.core.verify import disk_space_problems
+    from particle_entropy.pipeline.verify import disk_space_problems
 
     for problem in disk_space_problems((".", "results", ".snakemake")):
         print(problem, file=sys.stderr)

@@ -73,7 +73,7 @@ def table_check(checkout: Path, results: Path, repeats: int) -> tuple[float, flo
     """Medians of corrupt_tables over ``results``: every table read, then a warm digests file;
     the table count and their size in MB."""
     sys.path.insert(0, str(checkout / "workflow" / "lib"))
-    from particle_entropy.core.verify import corrupt_tables
+    from particle_entropy.pipeline.verify import corrupt_tables
 
     tables = list(results.rglob("*.parquet"))
     size = sum(p.stat().st_size for p in tables if p.is_file()) / 1e6

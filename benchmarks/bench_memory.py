@@ -13,9 +13,9 @@ import subprocess
 import sys
 import tempfile
 
-from particle_entropy.core.memory import estimate_bytes
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.core.timegrid import step_count
+from particle_entropy.pipeline.memory import estimate_bytes
 
 RUNS = [  # (method, kernel, n, t_final, dt0, dt_growth)
     ("fd", "implicit", 100, 1000.0, 0.01, 1.0),

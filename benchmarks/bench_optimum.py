@@ -35,7 +35,8 @@ import yaml
 from particle_entropy.analysis.optimum import read_costs
 from particle_entropy.core.case import Case, rows_of
 from particle_entropy.pipeline.configcheck import load_yaml
-from particle_entropy.pipeline.sweeps import case_run_paths, figure_ensembles, optimum_searches
+from particle_entropy.pipeline.crosschecks import optimum_searches
+from particle_entropy.pipeline.sweeps import case_run_paths, figure_ensembles
 
 VARIANTS = {  # suffix -> what it changes in the search
     "points": {"measure": "points"},

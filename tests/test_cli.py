@@ -192,7 +192,7 @@ def test_an_out_inside_a_file_is_refused_before_the_run(tmp_path):
 
 
 def test_a_run_larger_than_the_memory_available_is_refused_before_it_starts(tmp_path, monkeypatch, capsys):
-    import particle_entropy.core.memory as memory
+    import particle_entropy.pipeline.memory as memory
     from particle_entropy.cli import main
 
     monkeypatch.setattr(memory, "available_bytes", lambda: 200e6)  # a machine with 200 MB free
@@ -207,8 +207,8 @@ def test_a_run_larger_than_the_memory_available_is_refused_before_it_starts(tmp_
 
 def test_memory_estimate_is_above_a_measured_peak(tmp_path):
     """200,000 FD steps (one table row each): the estimate the CLI checks must bound the real peak."""
-    from particle_entropy.core.memory import estimate_bytes
     from particle_entropy.core.runconfig import RunConfig
+    from particle_entropy.pipeline.memory import estimate_bytes
 
     args = ["--method", "fd", "--n", "100", "--t-final", "1000", "--dt0", "0.005", "--quiet"]
     proc = subprocess.Popen([sys.executable, "-m", "particle_entropy", "simulate", *args, "--out", str(tmp_path / "x")])

@@ -12,8 +12,8 @@ import pytest
 
 from particle_entropy.analysis import aggregate, claims, optimum
 from particle_entropy.core import case, records
-from particle_entropy.experiments import shear2d
 from particle_entropy.figures import plots_shear, style
+from particle_entropy.models import shear2d
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.columnsdoc import COMMAND, PAGE, main, render, sections, split_unit
 

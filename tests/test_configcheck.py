@@ -302,7 +302,7 @@ def test_shear_n_is_checked_against_memory_by_arithmetic():
     The estimate is arithmetic, so a dry run and check-config refuse it at once, naming shear.n."""
     import time
 
-    from particle_entropy.pipeline.sweeps import shear_memory_mb
+    from particle_entropy.pipeline.memory import shear_memory_mb
 
     cfg = copy.deepcopy(BASE)
     check_config(cfg, available=24e9)
@@ -331,7 +331,7 @@ def test_check_config_command_runs_the_dry_runs_memory_check(tmp_path, capsys):
 
 
 def test_the_shear_n_cap_is_the_schemas():
-    from particle_entropy.experiments.shear2d import MAX_N
+    from particle_entropy.models.shear2d import MAX_N
 
     schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     assert schema["properties"]["shear"]["properties"]["n"]["maximum"] == MAX_N

@@ -13,9 +13,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import particle_entropy.core.verify as verify
+import particle_entropy.pipeline.verify as verify
 from particle_entropy.core.io import OutputError, check_output_path, checksum_path, write_parquet
-from particle_entropy.core.verify import corrupt_tables, set_aside, table_problem
+from particle_entropy.pipeline.verify import corrupt_tables, set_aside, table_problem
 
 DF = pd.DataFrame({"step": range(50), "SSE": [0.5 / (k + 1) for k in range(50)], "label": ["a"] * 50})
 

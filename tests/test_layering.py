@@ -16,7 +16,7 @@ from snakemake.utils import update_config
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.pipeline.configcheck import check_config
-from particle_entropy.pipeline.sweeps import check_sweeps, optimum_searches
+from particle_entropy.pipeline.crosschecks import check_sweeps, optimum_searches
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "data" / "tiny_config.yaml"

@@ -18,7 +18,7 @@ import pytest
 from conftest import no_runtime_warnings
 
 from particle_entropy.core.runconfig import SettingError
-from particle_entropy.experiments.shear2d import (
+from particle_entropy.models.shear2d import (
     MAX_N,
     ShearConfig,
     kernel_cutoff,
@@ -251,7 +251,7 @@ def test_bad_settings_name_the_setting(kw, name):
 
 
 def test_shear_memory_estimate_is_above_a_measured_peak():
-    """The mt shear job at 4x the paper's N, two steps: sweeps.shear_memory_mb must bound the
+    """The mt shear job at 4x the paper's N, two steps: memory.shear_memory_mb must bound the
     peak resident memory a fresh process reaches (its pairs grow as N^2). The peak is the child's
     own VmHWM: ru_maxrss would also count the pages a forked child shares with this (large) test
     process before it execs."""
@@ -260,11 +260,11 @@ def test_shear_memory_estimate_is_above_a_measured_peak():
 
     import yaml
 
-    from particle_entropy.pipeline.sweeps import shear_memory_mb
+    from particle_entropy.pipeline.memory import shear_memory_mb
 
     shear = {**yaml.safe_load(open("config.yaml"))["shear"], "n": 80_000, "t_final": 2, "cases": ["mt"]}
     code = (
-        "from particle_entropy.experiments.shear2d import ShearConfig, run_shear; "
+        "from particle_entropy.models.shear2d import ShearConfig, run_shear; "
         f"run_shear(ShearConfig(case='mt', **{ {k: v for k, v in shear.items() if k != 'cases'}!r})); "
         "print(next(line.split()[1] for line in open('/proc/self/status') if line.startswith('VmHWM:')))"
     )

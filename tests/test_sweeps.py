@@ -10,11 +10,11 @@ import pytest
 import yaml
 
 from particle_entropy.core.case import Case, SettingError
+from particle_entropy.pipeline.crosschecks import check_sweeps
 from particle_entropy.pipeline.sweeps import (
     Ensemble,
     case_run_paths,
     case_sections,
-    check_sweeps,
     figure_ensembles,
     realisations_for,
     run_config,

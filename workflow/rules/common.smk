@@ -21,8 +21,8 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import code_version
-from particle_entropy.core.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
-from particle_entropy.core.memory import available_bytes, estimate_mb
+from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
+from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.figures import FIGURE_MODULES, figure_options
 from particle_entropy.pipeline.sweeps import (
@@ -35,18 +35,17 @@ from particle_entropy.pipeline.sweeps import (
     SUMMARY_PATTERN,
     Ensemble,
     case_run_paths,
-    check_memory,
-    check_sweeps,
     figure_ensembles,
     lattice_cases,
     mechanism_ensembles,
-    optimum_searches,
     run_config,
     run_path,
     run_settings,
-    shear_memory_mb,
     spec_ensembles,
 )
+
+from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
+from particle_entropy.pipeline.memory import shear_memory_mb
 
 check_sweeps(config)
 # jobs run here: each must fit in this machine's memory (read once, for the sections and the searches)
@@ -251,7 +250,7 @@ def optimum_round_inputs(wildcards):
 
     if wildcards.name not in OPTIMUM:
         raise WorkflowError(f"no optimum search {wildcards.name!r} in config optimum: one of {', '.join(OPTIMUM)}")
-    OPTIMUM[wildcards.name]  # builds and checks the search (sweeps.check_search) before its first job
+    OPTIMUM[wildcards.name]  # builds and checks the search (crosschecks.check_search) before its first job
     k = int(wildcards.k)
     if k == 0:
         return {}

@@ -12,7 +12,7 @@ from dataclasses import fields
 
 from particle_entropy.core.heap import keep_freed_pages
 from particle_entropy.core.io import write_parquet
-from particle_entropy.experiments.shear2d import ShearConfig, run_shear
+from particle_entropy.models.shear2d import ShearConfig, run_shear
 
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
 

@@ -109,8 +109,8 @@ def check_config_files(files: list[str]) -> int:
     """The check-config command: merge the files, check them, print one line."""
     from snakemake.utils import update_config
 
-    from .core.memory import available_bytes
     from .pipeline.configcheck import ConfigFileError, check_config, load_yaml
+    from .pipeline.memory import available_bytes
 
     config: dict = {}
     try:
@@ -159,8 +159,8 @@ def main(argv=None) -> int:
                 check_output_path(target)
             except OutputError as e:
                 parser.error(f"{flag}: {e}")
-    from .core.memory import available_bytes, estimate_bytes
     from .core.timegrid import step_count
+    from .pipeline.memory import available_bytes, estimate_bytes
 
     need, have = estimate_bytes(cfg), available_bytes()
     if have is not None and need > have:

@@ -1,5 +1,4 @@
 """What every part shares: the registry of methods, kernels and schemes, the one definition of
 the run settings, the `Case` value, its legend text and the checked `RunConfig`, the time grids,
-the measures of mixing and error (Eqs. 2-14, 43-44), per-step records, Parquet input and output,
-table verification, memory estimates and the allocator setting of simulation processes. Imports
-nothing from the other subpackages."""
+the measures of mixing and error (Eqs. 2-14, 43-44), per-step records, Parquet input and output
+and the allocator setting of simulation processes. Imports nothing from the other subpackages."""

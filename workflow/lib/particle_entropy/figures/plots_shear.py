@@ -14,7 +14,7 @@ from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
 from ..core.registry import SHEAR_CASES
-from ..experiments.shear2d import WALL_BAND
+from ..models.shear2d import WALL_BAND
 from .style import save_figure  # noqa: F401  (re-exported for the Fig. 10 script)
 
 TITLES = {

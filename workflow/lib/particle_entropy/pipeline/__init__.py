@@ -1,4 +1,5 @@
 """What joins the library to the workflow: config sections to cases and paths (`sweeps`), the
-config's checks (`configcheck`), content hashes of the code each rule runs (`codeversion`), the
-generated schema entries and column page (`schemagen`, `columnsdoc`) and the report's table pages
-(`htmlpage`). The top of the stack with `cli`."""
+config's checks (`configcheck`: YAML and schema; `crosschecks`: the rules between fields), memory
+estimates of jobs (`memory`), table verification before a run (`verify`), content hashes of the
+code each rule runs (`codeversion`), the generated schema entries and column page (`schemagen`,
+`columnsdoc`) and the report's table pages (`htmlpage`). The top of the stack with `cli`."""

@@ -19,18 +19,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..analysis import claims, optimum
-from ..analysis.aggregate import (
-    ARGMIN_COLUMN_DOCS,
-    CONFIDENCE,
-    MINIMA_COLUMN_DOCS,
-    N_RESAMPLES,
-    REALISATION_COLUMN_DOCS,
-    SUMMARY_COLUMNS,
-)
+from ..analysis.aggregate import ARGMIN_COLUMN_DOCS, MINIMA_COLUMN_DOCS, REALISATION_COLUMN_DOCS, SUMMARY_COLUMNS
+from ..analysis.resampling import CONFIDENCE, N_RESAMPLES
 from ..core import records
 from ..core.case import CASE_COLUMNS, COLUMN_DOCS, MODEL_COLUMNS
-from ..experiments.shear2d import STATE_COLUMNS, STEP_COLUMNS
 from ..figures import plots_shear, style
+from ..models.shear2d import STATE_COLUMNS, STEP_COLUMNS
 
 PAGE = "docs/columns.md"
 COMMAND = ".venv/bin/python -m particle_entropy.pipeline.columnsdoc --write"

@@ -2,7 +2,7 @@
 
 Three layers: YAML syntax (with the line and column), the JSON schema (one error, named by its
 key path, with the allowed values from the schema's own description) and the rules between
-fields that a schema cannot say (sweeps.check_sweeps). Snakemake's own loader and validator
+fields that a schema cannot say (crosschecks.check_sweeps). Snakemake's own loader and validator
 report the first two without a line number and with the whole schema and config around the
 one useful line.
 """
@@ -194,11 +194,11 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
 
 
 def check_config(config: Mapping, schema: Mapping | None = None, available: float | None = None) -> None:
-    """Everything a dry run checks: the schema, then every rule between fields (sweeps.check_sweeps),
+    """Everything a dry run checks: the schema, then every rule between fields (crosschecks.check_sweeps),
     with ``available`` bytes (the machine's, for the check-config command) that every job fits
-    (sweeps.check_memory), and every adaptive search, which a dry run checks only when a target
+    (crosschecks.check_memory), and every adaptive search, which a dry run checks only when a target
     needs it."""
-    from .sweeps import check_memory, check_optimum, check_sweeps
+    from .crosschecks import check_memory, check_optimum, check_sweeps
 
     check_schema(config, load_schema() if schema is None else schema)
     check_sweeps(config)

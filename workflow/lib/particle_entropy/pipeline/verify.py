@@ -18,7 +18,7 @@ import shutil
 import time
 from pathlib import Path
 
-from .io import checksum_path, write_bytes_atomically
+from ..core.io import checksum_path, write_bytes_atomically
 
 CORRUPT_SUFFIX = ".corrupt"
 MAGIC = b"PAR1"

@@ -216,7 +216,7 @@ def pair_kernel(x, y, pairs, cfg: ShearConfig) -> np.ndarray:
     on a wall, D_ij = 0) get W_ij = 0, the kernel's limit for r != 0; with alpha_T = 0 so do
     pairs with dy != 0.
     """
-    from .shear_kernels import pair_weights  # numba: loaded by the jobs that step, not by plots
+    from ..numerics.shear_kernels import pair_weights  # numba: loaded by the jobs that step, not by plots
 
     return pair_weights(x, y, velocity(y), pairs, cfg.length, cfg.alpha_L, cfg.alpha_T, cfg.dt)
 
@@ -235,7 +235,7 @@ def transfer_step(x, y, m, cfg: ShearConfig, cutoff: float | None = None):
         cutoff = kernel_cutoff(cfg)
     pairs = neighbour_pairs(x, y, cfg, cutoff)
     w = pair_kernel(x, y, pairs, cfg)
-    from .shear_kernels import pair_transfer
+    from ..numerics.shear_kernels import pair_transfer
 
     m, substeps, c_max = pair_transfer(pairs, w, velocity(y), np.asarray(m, dtype=np.float64), float(cfg.beta))
     return m, int(substeps), float(c_max), int(pairs.shape[0])

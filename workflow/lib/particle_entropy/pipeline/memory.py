@@ -9,10 +9,12 @@ the memory available; the workflow declares it as the job's mem_mb.
 
 from __future__ import annotations
 
+import math
 import os
+from collections.abc import Mapping
 
-from .runconfig import RunConfig
-from .timegrid import step_count
+from ..core.runconfig import RunConfig
+from ..core.timegrid import step_count
 
 # measured (40 runs, one at a time): base 252 MB; 1.7-1.9 kB a step; per particle or node pt 19-39 B,
 # fd 64-80 B, mtpt collision 107-138 B and SPH 126-202 B (rising with N: its FGT uses more boxes)
@@ -47,3 +49,30 @@ def available_bytes() -> float | None:
         return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):
         return None
+
+
+# measured on one mt transfer step (N = 20,000 and 80,000): 16-18 B a pair in numpy arrays, about
+# 35 B a pair of resident memory with the KD tree's; rounded up, as memory.py's per-particle bytes
+SHEAR_PAIR_BYTES = 64.0
+
+
+SHEAR_PARTICLE_BYTES = 400.0
+
+
+def shear_memory_mb(config: Mapping) -> int:
+    """Estimated peak memory of the largest shear job (Fig. 10), in MB, by arithmetic: the base of
+    every run (memory.BASE_BYTES), its particles' arrays and, for mass transfer, its neighbour pairs:
+    N^2 / 2 x the kernel's share of the domain, pi s_c^2 / (L / sqrt(alpha_L) / sqrt(alpha_T)) in
+    scaled distance (2 s_c / (L / sqrt(alpha_L)) for alpha_T = 0; shear2d.kernel_cutoff)."""
+    from ..models.shear2d import ShearConfig, kernel_cutoff
+    from .sweeps import shear_n
+
+    shear = config["shear"]
+    n = float(shear_n(config))
+    need = BASE_BYTES + SHEAR_PARTICLE_BYTES * n
+    if "mt" in shear["cases"]:
+        cfg = ShearConfig(case="mt", **{k: v for k, v in shear.items() if k not in ("cases", "n")})
+        cut, width = kernel_cutoff(cfg), cfg.length / math.sqrt(cfg.alpha_L)
+        share = math.pi * cut**2 / (width / math.sqrt(cfg.alpha_T)) if cfg.alpha_T > 0 else 2.0 * cut / width
+        need += SHEAR_PAIR_BYTES * n * n / 2.0 * min(share, 1.0)
+    return int(need / 2**20) + 1

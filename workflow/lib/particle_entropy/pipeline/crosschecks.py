@@ -1,0 +1,288 @@
+"""The rules between config fields that a JSON schema cannot say, checked before any job runs:
+every number finite, every case of every section a valid run, ensemble sizes for every N, seeds
+within int64, the lattice and FD-domain experiments, the shear cases, the adaptive searches (each
+when a target first uses it: `Searches`) and, where jobs run locally, every job within memory.
+Each refusal is a SettingError naming the key path, the value and the allowed range."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from ..core.case import Case, SettingError
+from ..core.labels import case_label
+from ..core.runconfig import MAX_SEED, RunConfig
+from ..core.settings import PAPER, SETTINGS
+from .memory import estimate_mb, shear_memory_mb
+from .sweeps import (
+    Ensemble,
+    block_size,
+    case_sections,
+    lattice_cases,
+    realisations_for,
+    run_config,
+    shear_n,
+    spec_ensembles,
+)
+
+
+def check_lattice(config: Mapping) -> None:
+    """A lattice run needs an odd N and mtpt cases at eta = 1 (random walks leave the lattice)."""
+    mech = config.get("mechanism", {})
+    if "lattice" not in mech:
+        return
+    n = mech["lattice"]["n"]
+    if int(n) % 2 == 0:
+        raise SettingError("mechanism.lattice.n", n, "an odd integer >= 3, so that a particle sits at x = 0")
+    for i, spec in enumerate(mech["lattice"].get("cases", [])):
+        try:
+            case = Case.from_spec(spec, int(n), config.get("case_defaults", {}))
+            run_config(case, config)
+        except SettingError as e:
+            raise SettingError(f"mechanism.lattice.cases[{i}].{e.name}", e.value, e.allowed) from None
+    for case in lattice_cases(config):
+        if case.method != "mtpt" or case.eta != 1.0:
+            raise SettingError(
+                "mechanism.lattice",
+                case_label(case),
+                "mtpt cases at eta = 1 only (random walks would leave the lattice)",
+            )
+
+
+def check_fd_domain(config: Mapping) -> None:
+    """Every grid of `mechanism.fd_domain` runs on every length: an even whole number of intervals
+    at dx = physics.fd_length / n (fd_domain.grid_intervals), on a domain the plume fits (RunConfig)."""
+    spec = config.get("mechanism", {}).get("fd_domain")
+    if not spec:
+        return
+    from ..experiments.fd_domain import grid_intervals
+
+    physics, fd_dt = config["physics"], float(config["time"]["fd_dt"])
+    ref = float(physics.get("fd_length", PAPER["fd_length"]))
+    settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
+    for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
+        try:
+            RunConfig.of(method="fd", kernel="implicit", n=2, fd_length=float(length), **settings).check()
+        except SettingError as e:
+            raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
+    for n in spec["n"]:
+        for length in spec["lengths"]:
+            try:
+                grid_intervals(int(n), float(length), ref)
+            except SettingError as e:
+                raise SettingError("mechanism.fd_domain.n", n, e.allowed) from None
+
+
+def check_finite(value, where: str = "") -> None:
+    """Every number of the config must be finite: YAML's .nan and .inf pass the schema's
+    `number` but no setting means them. SettingError names the key path."""
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            check_finite(v, f"{where}.{k}" if where else str(k))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            check_finite(v, f"{where}[{i}]")
+    elif isinstance(value, float) and not math.isfinite(value):
+        raise SettingError(where, value, "a finite number (YAML .nan and .inf are not settings)")
+
+
+def _first_step_key(case: Case) -> str:
+    """The config key of a case's first step (runconfig.first_step)."""
+    if case.method == "fd":
+        return "time.fd_dt"
+    return "time.fixed_dt" if case.dt_growth == 1.0 else "time.dt0"
+
+
+# RunConfig settings that come from a shared config key, not from the case: a SettingError about
+# them names that key (and the case it fails for)
+SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "numerics")}
+
+
+SHARED_KEYS["dt0"] = _first_step_key
+
+
+def check_seeds(config: Mapping) -> None:
+    """Realisation r of every case uses seed base_seed + r, stored as int64 in every table (an
+    adaptive search's seeds, up to its max_realisations: check_search)."""
+    base = int(config["base_seed"])
+    counts = [e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)]
+    _check_seed_count(base, max(counts, default=1))
+
+
+def _check_seed_count(base: int, most: int) -> None:
+    if base + most - 1 > MAX_SEED:
+        raise SettingError(
+            "base_seed",
+            base,
+            f"an integer in [0, {MAX_SEED - most + 1}]: seeds run to base_seed + {most - 1} and are stored as int64",
+        )
+
+
+def check_shear(config: Mapping) -> None:
+    """Every shear case must build a valid ShearConfig (strip inside the domain, whole steps, ...)."""
+    if "shear" not in config:
+        return
+    from ..models.shear2d import ShearConfig
+
+    settings = {k: v for k, v in config["shear"].items() if k != "cases"}
+    for case in config["shear"]["cases"]:
+        try:
+            ShearConfig(case=case, **settings)
+        except SettingError as e:
+            raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
+
+
+class Searches(Mapping):
+    """The adaptive COMIC searches of config `optimum` (optimum.Search) by name, each built and
+    checked (check_search) when it is first used: a search that no requested target needs
+    cannot block a run, as when a small config is layered over config.yaml's searches."""
+
+    def __init__(self, config: Mapping, available: float | None = None):
+        self._config, self._available, self._built = config, available, {}
+        self._names = list(config.get("optimum", {}) or {})
+
+    def __getitem__(self, name: str):
+        if name not in self._names:
+            raise KeyError(name)
+        if name not in self._built:
+            self._built[name] = check_search(name, self._config, self._available)
+        return self._built[name]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+
+def optimum_searches(config: Mapping, available: float | None = None) -> Searches:
+    """The adaptive COMIC searches of config `optimum`, by name, checked when used (Searches)."""
+    return Searches(config, available)
+
+
+def optimum_largest_jobs(search) -> list[Ensemble]:
+    """A search's largest possible simulation jobs: both ends of its range (the top N; the
+    smallest growth, most steps) with the most seeds one block can hold (the first round's
+    realisations, or a doubling up to max_realisations)."""
+    seeds = 1 if search.fd else max(search.initial_realisations, search.max_realisations // 2)
+    return [Ensemble(search.case_at(x), seeds) for x in search.grid(2)]
+
+
+def check_memory(config: Mapping, available: float) -> None:
+    """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
+    of its seed block; the shear jobs: shear_memory_mb; an adaptive search's jobs: check_search)."""
+    jobs = [
+        (f"{name}.n", ens, block_size(ens, config))
+        for name, spec in case_sections(config).items()
+        for ens in spec_ensembles(spec, config)
+    ]
+    _check_jobs_fit(jobs, config, available)
+    if "shear" in config:
+        need = shear_memory_mb(config) * 2**20
+        if need > available:
+            raise SettingError(
+                "shear.n",
+                shear_n(config),
+                f"an N whose shear job fits in this machine's memory: it needs about {need / 1e9:.3g} GB, "
+                f"{available / 1e9:.1f} GB are available (or run it on a cluster)",
+            )
+
+
+def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
+    """SettingError naming the key of the first (key, ensemble, seeds) job that needs more memory."""
+    for key, ens, runs in jobs:
+        need = estimate_mb(run_config(ens.case, config), runs) * 2**20
+        if need > available:
+            raise SettingError(
+                key,
+                ens.case.n,
+                f"an N whose job fits in this machine's memory: {case_label(ens.case)} needs about "
+                f"{need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available (or run it on a cluster)",
+            )
+
+
+def _case_error(e: SettingError, where: str, case: Case) -> SettingError:
+    """A SettingError of one case's run, named by its config key: a shared setting (time.dt0, ...)
+    names that key and the case, any other the case's own key under ``where``."""
+    if e.name in SHARED_KEYS:
+        key = SHARED_KEYS[e.name](case) if callable(SHARED_KEYS[e.name]) else SHARED_KEYS[e.name]
+        return SettingError(key, e.value, f"{e.allowed} (for {where}, {case_label(case)})")
+    return SettingError(f"{where}.{e.name}", e.value, e.allowed)
+
+
+def check_search(name: str, config: Mapping, available: float | None = None):
+    """The adaptive search ``optimum.<name>`` (optimum.Search), refused unless it can run: a model
+    that exists, a range with room for a minimum, a budget of at least its first round, a time
+    within t_final (optimum.Search.check), runs valid at both ends of its range, its seeds within
+    int64 and (given ``available`` bytes) its largest jobs within memory."""
+    from ..analysis.optimum import Search
+
+    search = Search.from_config(name, config["optimum"][name], config)
+    where = f"optimum.{name}"
+    key = "growth_range" if search.over == "dt_growth" else "n_range"
+    for x in search.grid(2):  # the range's ends (FD: even)
+        case = search.case_at(x)
+        try:
+            run_config(case, config)
+        except SettingError as e:
+            if e.name in ("n", "dt_growth"):
+                raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
+            raise _case_error(e, f"{where}.case", case) from None
+    _check_seed_count(int(config["base_seed"]), search.max_realisations)
+    if available is not None:
+        _check_jobs_fit(
+            [(f"{where}.{key}", e, e.realisations) for e in optimum_largest_jobs(search)], config, available
+        )
+    return search
+
+
+def check_optimum(config: Mapping, available: float | None = None) -> None:
+    """Every adaptive search of config `optimum` (check_search): what check-config judges, since
+    it does not know which targets will be asked for."""
+    for name in config.get("optimum", {}) or {}:
+        check_search(name, config, available)
+
+
+def check_sweeps(config: Mapping) -> None:
+    """Checks the JSON schema cannot express, before any job runs: every number finite, every
+    case of every section must build a valid run (kernel for its method, dimensions that apply,
+    FD grids, explicit FD stability, an ensemble size for each N). The message names the
+    section, key and value."""
+    check_finite(config)
+    seen: dict[int, int] = {}
+    for i, entry in enumerate(config.get("realisations", [])):
+        n = int(entry["n"])
+        if n in seen:
+            raise SettingError(f"realisations[{i}].n", n, f"each N once (also at realisations[{seen[n]}])")
+        seen[n] = i
+    for key, value in config.get("claims", {}).items():
+        if isinstance(value, (list, tuple)) and len(value) == 2 and value[0] > value[1]:
+            raise SettingError(f"claims.{key}", list(value), "a range [low, high] with low <= high")
+    for name, spec in case_sections(config).items():
+        for i, c in enumerate(spec["cases"]):
+            where = f"{name}.cases[{i}]"
+            case = None
+            try:
+                for n in spec["n"]:
+                    case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
+                    run_config(case, config)
+            except SettingError as e:
+                raise _case_error(e, where, case) from None  # a shared setting names its key and the case
+        particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
+        for n in spec["n"] if particles else []:
+            try:
+                realisations_for(spec, int(n), config)
+            except SettingError as e:
+                raise SettingError(f"{name}.n", n, e.allowed) from None
+    check_lattice(config)
+    check_fd_domain(config)
+    check_seeds(config)
+    check_shear(config)  # the optimum searches are checked when a target uses them (Searches)
+    t_final = float(config["physics"]["t_final"])
+    for key, times in (
+        ("comic_times", config.get("comic_times", [])),
+        ("tradeoff.times", config.get("tradeoff", {}).get("times", [])),
+    ):
+        for t in times:
+            if not (math.isfinite(float(t)) and 0 <= float(t) <= t_final):
+                raise SettingError(key, t, f"a time in [0, physics.t_final = {t_final:g}]")
