@@ -111,19 +111,46 @@ def test_extra_files_are_hashed(pkg, tmp_path):
 
 
 # --------------------------------------------------------------------------- the real package
+def test_modules_of_one_file_name_in_two_subpackages_are_two_modules(tmp_path):
+    """Keys are dotted names, so file names need not be unique: sub/x.py and other/x.py, each
+    reached by its own relative import, up and down the tree."""
+    root = tmp_path / "deep"
+    for sub_, src in {"sub": "from ..other import x as y\n\nA = y.B\n", "other": "B = 1\n"}.items():
+        (root / sub_).mkdir(parents=True)
+        (root / sub_ / "__init__.py").write_text("")
+        (root / sub_ / "x.py").write_text(src)
+    (root / "__init__.py").write_text("")
+    (root / "top.py").write_text("from .sub.x import A\n")
+    modules.cache_clear()
+    imports.cache_clear()
+    try:
+        assert set(modules(root)) == {"sub.x", "other.x", "top"}
+        assert imports("top", root) == frozenset({"sub.x"})
+        assert imports("sub.x", root) == frozenset({"other.x"})  # not itself: the other package's x
+        assert closure(["top"], package=root) == ["other.x", "sub.x", "top"]
+        v0 = code_version("top", package=root)
+        (root / "other" / "x.py").write_text("B = 2\n")
+        modules.cache_clear()
+        imports.cache_clear()
+        assert code_version("top", package=root) != v0  # reached through sub.x
+    finally:
+        modules.cache_clear()
+        imports.cache_clear()
+
+
 def test_fd_simulation_closure_leaves_out_the_particle_code():
-    mods = closure(["simulate", "fd"], exclude={"pt", "mtpt"})
-    assert {"simulate", "fd"} <= set(mods)
-    assert "gauss" not in mods and "mass_transfer" not in mods
-    assert "pt" not in mods and "mtpt" not in mods
+    mods = closure(["models.simulate", "models.fd"], exclude={"models.pt", "models.mtpt"})
+    assert {"models.simulate", "models.fd", "core.case"} <= set(mods)
+    assert "numerics.gauss" not in mods and "numerics.mass_transfer" not in mods
+    assert "models.pt" not in mods and "models.mtpt" not in mods
 
 
 def test_mtpt_simulation_closure_holds_mass_transfer():
-    mods = closure(["simulate", "mtpt"], exclude={"pt", "fd"})
-    assert {"simulate", "mtpt", "mass_transfer"} <= set(mods)
-    assert "pt" not in mods and "fd" not in mods
-    assert code_version("simulate", "mtpt", exclude={"pt", "fd"}) != code_version(
-        "simulate", "fd", exclude={"pt", "mtpt"}
+    mods = closure(["models.simulate", "models.mtpt"], exclude={"models.pt", "models.fd"})
+    assert {"models.simulate", "models.mtpt", "numerics.mass_transfer", "numerics.fastexp"} <= set(mods)
+    assert "models.pt" not in mods and "models.fd" not in mods
+    assert code_version("models.simulate", "models.mtpt", exclude={"models.pt", "models.fd"}) != code_version(
+        "models.simulate", "models.fd", exclude={"models.pt", "models.mtpt"}
     )
 
 

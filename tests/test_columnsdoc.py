@@ -12,7 +12,7 @@ import pytest
 
 from particle_entropy.analysis import aggregate, claims, optimum
 from particle_entropy.core import case, records
-from particle_entropy.figures import plots_shear, style
+from particle_entropy.figures import fig10, style
 from particle_entropy.models import shear2d
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.columnsdoc import COMMAND, PAGE, main, render, sections, split_unit
@@ -25,7 +25,7 @@ MODULES = {  # the module names the page cites as sources of its columns
     "aggregate": aggregate,
     "optimum": optimum,
     "style": style,
-    "plots_shear": plots_shear,
+    "fig10": fig10,
     "shear2d": shear2d,
     "columnsdoc": columnsdoc,
 }

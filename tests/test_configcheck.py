@@ -278,7 +278,8 @@ def test_nested_command_line_overrides_are_typed_as_a_file_types_them():
 
 def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
     from particle_entropy.core.case import Case
-    from particle_entropy.pipeline.sweeps import MAX_REALISATIONS, Ensemble, block_size, seed_blocks
+    from particle_entropy.core.settings import MAX_REALISATIONS
+    from particle_entropy.pipeline.sweeps import Ensemble, block_size, seed_blocks
 
     for n, count in [(30, 80), (300, 7), (3000, 1), (30000, 4), (100, 33)]:
         ens = Ensemble(Case("mtpt", "collision", n), count)

@@ -397,7 +397,7 @@ def test_bad_growth_searches_are_refused_naming_the_key(spec, key):
 def test_the_figure_names_the_options_it_was_judged_with(measure, time_volume):
     import matplotlib.pyplot as plt
 
-    from particle_entropy.figures.plots_optimum import optimum_figure
+    from particle_entropy.figures.optimum import optimum_figure
 
     search = fd(width=1.5, budget_runs=40)
     plan = run_search(search, noise=0.0)
@@ -536,7 +536,7 @@ def test_the_result_says_when_the_optimum_sits_at_a_visited_end():
     N, not at the range's end: the table says so (at_end), and so does the figure's text."""
     import matplotlib.pyplot as plt
 
-    from particle_entropy.figures.plots_optimum import optimum_figure
+    from particle_entropy.figures.optimum import optimum_figure
 
     search = fd(width=1.5, budget_runs=4, start_points=3)  # walks up one step, then the budget is spent
     global N_STAR

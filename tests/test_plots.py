@@ -24,12 +24,12 @@ from particle_entropy.analysis.aggregate import METRICS  # noqa: E402
 from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, rows_of  # noqa: E402
 from particle_entropy.core.runconfig import RunConfig  # noqa: E402
 from particle_entropy.figures import (  # noqa: E402
-    FIGURE_MODULES,
-    dilution,
+    CASE_FIGURES,
     fig1,
+    fig5,
     fig9,
+    fig10,
     figure_function,
-    plots_shear,
     style,
     tradeoff,
 )
@@ -205,7 +205,7 @@ def line_styles(ax) -> dict[str, tuple]:
     }
 
 
-FIGURE_NAMES = list(FIGURE_MODULES)
+FIGURE_NAMES = list(CASE_FIGURES)
 
 
 # ------------------------------------------------------------------ every figure
@@ -296,7 +296,7 @@ def test_automatic_styles_stay_distinct_and_off_the_paper_palette():
         for eta in (0.2, 0.3, 0.4)
         for tr in (None, 3)
     ]
-    looks = style.styles(paper_cases("fig5", extra=tuple(added)), dilution.PAPER_STYLES["fig5"])
+    looks = style.styles(paper_cases("fig5", extra=tuple(added)), fig5.PAPER_STYLES)
     kinds = [(s["color"], s.get("marker"), s.get("linestyle", "-"), bool(s.get("open"))) for s in looks.values()]
     assert len(set(kinds)) == len(kinds)
     assert all(looks[m]["color"] not in (style.GREEN, style.VERMILLION) for m in added)
@@ -405,13 +405,13 @@ def test_fig10_returns_the_particles_it_draws():
         )
         for case in ("mt", "rw_drift", "rw_nodrift")
     ]
-    figure, data = plots_shear.fig10(states)
-    assert list(data.columns) == list(plots_shear.SOURCE_COLUMNS)
+    figure, data = fig10.fig10(states)
+    assert list(data.columns) == list(fig10.SOURCE_COLUMNS)
     dots = data[data["panel"].isin(list("abc"))]
     assert dots.groupby("panel")["case"].first().to_dict() == {"a": "rw_nodrift", "b": "rw_drift", "c": "mt"}
-    assert (dots.groupby("case").size() == 150).all() and (dots["mass"] > plots_shear.MASS_FLOOR).all()
+    assert (dots.groupby("case").size() == 150).all() and (dots["mass"] > fig10.MASS_FLOOR).all()
     hist = data[(data["panel"] == "f") & (data["y_name"] == "mass density")]
-    assert len(hist) == plots_shear.N_BINS and np.sum(hist["y"]) / plots_shear.N_BINS == pytest.approx(1.0)
+    assert len(hist) == fig10.N_BINS and np.sum(hist["y"]) / fig10.N_BINS == pytest.approx(1.0)
 
 
 def test_save_figure_is_byte_stable(tmp_path):
@@ -462,13 +462,11 @@ def test_fig9_draws_the_papers_bars_at_half_eq43s_width_when_asked():
 
 
 def test_figure_options_are_the_schemas_and_defaults_fill_in():
-    from particle_entropy.figures import FIGURE_OPTIONS, figure_options
+    from particle_entropy.figures import figure_options
 
     schema = yaml.safe_load((Path(__file__).parents[1] / "workflow" / "schemas" / "config.schema.yaml").read_text())
-    for fig, options in FIGURE_OPTIONS.items():
-        entries = schema["properties"]["figures"]["properties"][fig]["properties"]
-        for key, (choices, default) in options.items():
-            assert entries[key]["enum"] == list(choices) and entries[key]["default"] == default
+    bars = schema["properties"]["figures"]["properties"]["fig9"]["properties"]["bars"]
+    assert bars["enum"] == ["eq43", "paper"] and bars["default"] == "eq43"  # the paper's drawing: eq43
     assert figure_options("fig9", {"cases": [], "n": [30]}) == {"bars": "eq43"}
     assert figure_options("fig9", {"bars": "paper"}) == {"bars": "paper"}
     assert figure_options("fig1", {"bars": "paper"}) == {}  # no options: nothing passed on

@@ -819,7 +819,7 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
 
 
 def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
-    from particle_entropy.figures import FIGURE_MODULES
+    from particle_entropy.figures import CASE_FIGURES
 
     src, work = tmp_path / "src", tmp_path / "work"  # copies: the library edited, the finished run
     shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
@@ -829,7 +829,7 @@ def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
     plan = lambda: subprocess.run([*cmd, "--configfile", str(TINY)], capture_output=True, text=True, check=True)
     assert _planned_rules(plan()) == set()  # the same code in another place: nothing to do
     figures = src / "workflow/lib/particle_entropy/figures"
-    every_figure = {f"plot_{fig}" for fig in FIGURE_MODULES}
+    every_figure = {f"plot_{fig}" for fig in CASE_FIGURES}
     for module, expected in [
         ("fig7.py", lambda rules: rules == {"plot_fig7"}),
         ("dilution.py", lambda rules: rules == {"plot_fig2", "plot_fig4", "plot_fig5"}),

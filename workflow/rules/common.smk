@@ -24,13 +24,11 @@ from particle_entropy.pipeline.codeversion import code_version
 from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
-from particle_entropy.figures import FIGURE_MODULES, figure_options
+from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
+from particle_entropy.figures import BY_NAME as FIGURE, CASE_FIGURES, PAPER_FIGURES, figure_options
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,
-    FIGURE_READS,
-    MAX_REALISATIONS,
-    PAPER_FIGURES,
     RUN_PATTERN,
     SUMMARY_PATTERN,
     Ensemble,
@@ -124,7 +122,7 @@ def looks_only():
 
 
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
-FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]
+FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]  # figures.FIGURES: the one list
 SHEAR_FIGURE = ["fig10"] if "shear" in config else []
 
 
@@ -171,8 +169,8 @@ def ensembles(section):
 
 def section_inputs(section):
     """What a figure reads, in the order of its cases: single runs, final states, the COMIC
-    table or case summaries (sweeps.FIGURE_READS)."""
-    reads = FIGURE_READS.get(section, "summaries")
+    table or case summaries (figures.FIGURES)."""
+    reads = FIGURE[section].reads
     base = config["base_seed"]
     if reads == "comic":  # the COMIC table, its minima and the bootstrap argmin shares
         return [f"results/tables/{section}/{t}.parquet" for t in ("comic", "comic_minima", "comic_argmin")]
@@ -295,21 +293,31 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {
-    m: code_version("simulate", "io", m, exclude=set(METHODS) - {m}, files=[SCRIPTS / "simulate.py"]) for m in METHODS
+    m: code_version(
+        "models.simulate",
+        "core.io",
+        "core.heap",  # the script's own imports
+        f"models.{m}",
+        exclude={f"models.{o}" for o in METHODS if o != m},
+        files=[SCRIPTS / "simulate.py"],
+    )
+    for m in METHODS
 }
-SUMMARY_CODE = code_version("aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"])
-COMIC_CODE = code_version("aggregate", "io", "htmlpage", files=[SCRIPTS / "comic_tables.py"])
-TRADEOFF_CODE = code_version("aggregate", "io", files=[SCRIPTS / "tradeoff_table.py"])
-CLAIMS_CODE = code_version("claims", "io", "htmlpage", files=[SCRIPTS / "paper_claims.py"])
+SUMMARY_CODE = code_version(
+    "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
+)
+COMIC_CODE = code_version("analysis.aggregate", "core.io", "pipeline.htmlpage", files=[SCRIPTS / "comic_tables.py"])
+TRADEOFF_CODE = code_version("analysis.aggregate", "core.io", files=[SCRIPTS / "tradeoff_table.py"])
+CLAIMS_CODE = code_version("analysis.claims", "core.io", "pipeline.htmlpage", files=[SCRIPTS / "paper_claims.py"])
 
 PLOT_CODE = {  # per figure, the module that draws it: editing one figure redraws it alone
-    fig: code_version(module, "io", files=[SCRIPTS / "plot_figure.py"]) for fig, module in FIGURE_MODULES.items()
+    fig: code_version(f"figures.{fig}", "core.io", files=[SCRIPTS / "plot_figure.py"]) for fig in CASE_FIGURES
 }
-SHEAR_CODE = code_version("shear2d", "io", files=[SCRIPTS / "shear2d.py"])
-SHEAR_PLOT_CODE = code_version("plots_shear", "io", files=[SCRIPTS / "plot_fig10.py"])
-MECHANISM_PLOT_CODE = code_version("plots_mechanism", "io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
-FD_DOMAIN_CODE = code_version("fd_domain", "io", files=[SCRIPTS / "fd_domain.py"])
-LATTICE_CODE = code_version("lattice", "io", files=[SCRIPTS / "mechanism_floors.py"])
-OPTIMUM_ROUND_CODE = code_version("optimum", "io", files=[SCRIPTS / "optimum_round.py"])
-OPTIMUM_TABLE_CODE = code_version("optimum", "io", files=[SCRIPTS / "optimum_table.py"])
-OPTIMUM_PLOT_CODE = code_version("plots_optimum", "io", files=[SCRIPTS / "plot_optimum.py"])
+SHEAR_CODE = code_version("models.shear2d", "core.io", files=[SCRIPTS / "shear2d.py"])
+SHEAR_PLOT_CODE = code_version("figures.fig10", "core.io", files=[SCRIPTS / "plot_fig10.py"])
+MECHANISM_PLOT_CODE = code_version("figures.fig9_mechanism", "core.io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
+FD_DOMAIN_CODE = code_version("experiments.fd_domain", "core.io", files=[SCRIPTS / "fd_domain.py"])
+LATTICE_CODE = code_version("experiments.lattice", "core.io", files=[SCRIPTS / "mechanism_floors.py"])
+OPTIMUM_ROUND_CODE = code_version("analysis.optimum", "core.io", files=[SCRIPTS / "optimum_round.py"])
+OPTIMUM_TABLE_CODE = code_version("analysis.optimum", "core.io", files=[SCRIPTS / "optimum_table.py"])
+OPTIMUM_PLOT_CODE = code_version("figures.optimum", "core.io", files=[SCRIPTS / "plot_optimum.py"])

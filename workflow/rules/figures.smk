@@ -12,7 +12,7 @@ for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
             png=report(
                 f"figures/{_fig}.png",
                 caption=f"../report/{_fig}.rst",
-                category="Speed and accuracy" if _fig == "tradeoff" else "Figures",
+                category=FIGURE[_fig].category,
             ),
             pdf=f"figures/{_fig}.pdf",
             data=FIGURE_DATA_PATTERN.format(fig=_fig),

@@ -32,7 +32,11 @@ if "mechanism" in config:
             fd="results/tables/mechanism/fd_domain.parquet" if "fd_domain" in config["mechanism"] else [],
             floors="results/tables/mechanism/floors.parquet" if "lattice" in config["mechanism"] else [],
         output:
-            png=report("figures/fig9_mechanism.png", caption="../report/fig9_mechanism.rst", category="Mechanism"),
+            png=report(
+                "figures/fig9_mechanism.png",
+                caption="../report/fig9_mechanism.rst",
+                category=FIGURE["fig9_mechanism"].category,
+            ),
             pdf="figures/fig9_mechanism.pdf",
             data=FIGURE_DATA_PATTERN.format(fig="fig9_mechanism"),
         log:

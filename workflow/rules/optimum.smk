@@ -55,7 +55,7 @@ rule plot_optimum:
     input:
         "results/optimum/{name}.parquet",
     output:
-        png=report("figures/optimum_{name}.png", caption="../report/optimum.rst", category="Optimum search"),
+        png=report("figures/optimum_{name}.png", caption="../report/optimum.rst", category=FIGURE["optimum"].category),
         pdf="figures/optimum_{name}.pdf",
     log:
         "logs/plot/optimum_{name}.log",

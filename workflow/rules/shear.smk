@@ -1,6 +1,6 @@
 # Fig. 10 (Appendix B): 2-D shear flow, one job per case, then the figure.
 
-SHEAR_PARAMS = ["n", "length", "strip_lo", "strip_hi", "alpha_L", "alpha_T", "beta", "dt", "t_final"]
+SHEAR_PARAMS = [s.name for s in SHEAR if s.name not in ("cases", "seed")]  # settings.SHEAR: ShearConfig's fields
 
 
 if "shear" in config:  # Fig. 10 exists only with a shear section
@@ -30,7 +30,7 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
         input:
             [f"results/shear/{case}/seed~{config['shear']['seed']}/state.parquet" for case in config["shear"]["cases"]],
         output:
-            png=report("figures/fig10.png", caption="../report/fig10.rst", category="Figures"),
+            png=report("figures/fig10.png", caption="../report/fig10.rst", category=FIGURE["fig10"].category),
             pdf="figures/fig10.pdf",
             data=FIGURE_DATA_PATTERN.format(fig="fig10"),
         log:

@@ -12,11 +12,11 @@ matplotlib.use("Agg")
 import pandas as pd
 
 from particle_entropy.core.io import write_parquet
-from particle_entropy.figures import plots_shear
+from particle_entropy.figures import fig10
 
 out = snakemake.output
 states = [pd.read_parquet(p) for p in snakemake.input]
-figure, data = plots_shear.fig10(states)
-plots_shear.save_figure(figure, out.png, out.pdf)
+figure, data = fig10.fig10(states)
+fig10.save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)
 print(f"drew fig10 from {len(states)} state tables, {len(data)} plotted points", file=sys.stderr)

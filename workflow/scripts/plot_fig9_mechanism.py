@@ -12,7 +12,7 @@ import pandas as pd
 
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
-from particle_entropy.figures.plots_mechanism import fig9_mechanism
+from particle_entropy.figures.fig9_mechanism import fig9_mechanism
 from particle_entropy.figures.style import save_figure
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output

@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 
 import pandas as pd
 
-from particle_entropy.figures.plots_optimum import optimum_figure
+from particle_entropy.figures.optimum import optimum_figure
 from particle_entropy.figures.style import save_figure
 
 inp, out = snakemake.input, snakemake.output

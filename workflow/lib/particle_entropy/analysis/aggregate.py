@@ -11,6 +11,7 @@ import pandas as pd
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
 from ..core.labels import case_label
 from ..core.measures import comic
+from ..core.registry import CONVENTION_NAMES
 from .resampling import BOOTSTRAP_SEED, N_RESAMPLES, argmin_bootstrap, lowest
 
 # why a COMIC (Eq. 43) does not score a model: it is NaN in every scoring table, never -inf, never a minimum
@@ -349,10 +350,16 @@ def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataF
 
 # --------------------------------------------------------------------------- bootstrap of the argmin
 # convention -> (its column prefix in the minima table, what is minimised over N)
-CONVENTIONS = {
-    "mean_COMIC": ("n_opt", "mean over realisations of per-realisation COMIC"),
-    "COMIC_of_mean_SSE": ("n_opt_of_mean_SSE", "COMIC of the mean SSE over realisations"),
-}
+CONVENTIONS = dict(
+    zip(
+        CONVENTION_NAMES,  # mean_COMIC, COMIC_of_mean_SSE
+        (
+            ("n_opt", "mean over realisations of per-realisation COMIC"),
+            ("n_opt_of_mean_SSE", "COMIC of the mean SSE over realisations"),
+        ),
+        strict=True,
+    )
+)
 ARGMIN_COLUMN_DOCS = {
     "label": "legend label of the model (without N)",
     **{c: f"model column (case.COLUMN_DOCS): {c}" for c in MODEL_COLUMNS},

@@ -43,18 +43,24 @@ import pandas as pd
 
 from ..core.case import APPLIES, Case, SettingError
 from ..core.labels import case_label
-from ..core.registry import MEASUREMENT_POINTS
+from ..core.registry import MEASURE_NAMES, MEASUREMENT_POINTS
 from ..core.runconfig import first_step
-from ..core.settings import PAPER
+from ..core.settings import PAPER, SEARCH, defaults
 from ..core.timegrid import step_count
 from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
 from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
 
-MEASURES = {
-    "own": "SSE at the model's own points: particles or nodes (Eq. 44)",
-    "points": f"SSE at the {MEASUREMENT_POINTS} measurement points common to all models (section 6, point 1)",
-}
-TIME_DEFAULTS = {"dt0": PAPER["dt0"], "fd_dt": PAPER["fd_dt"], "fixed_dt": PAPER["fixed_dt"]}
+SEARCH_DEFAULTS = defaults(SEARCH)  # settings.SEARCH: one search's keys, defaults and ranges
+MEASURES = dict(
+    zip(
+        MEASURE_NAMES,  # own, points
+        (
+            "SSE at the model's own points: particles or nodes (Eq. 44)",
+            f"SSE at the {MEASUREMENT_POINTS} measurement points common to all models (section 6, point 1)",
+        ),
+        strict=True,
+    )
+)
 OVER = {
     "n": "N (particles; FD intervals), searched in log N",
     "dt_growth": "the time-step growth factor at a fixed N (pt, mtpt), searched in log(dt_growth - 1)",
@@ -125,17 +131,17 @@ class Search:
     lo: float  # the range of the searched value (OVER)
     hi: float
     over: str = "n"
-    width: float = 10.0  # stop when bracket_hi / bracket_lo <= width (dt growth: of dt_growth - 1)
+    width: float = SEARCH_DEFAULTS["width"]  # stop when bracket_hi / bracket_lo <= width (growth: of dt_growth - 1)
     budget_runs: float = math.inf  # runs (realisations x N); a config sets this, budget_core_s or both
     budget_core_s: float = math.inf  # stop before the cost model's core-seconds would exceed this
     cost: tuple = ()  # calibrated ((searched value, seconds per run), ...): the cost model (calibrated_cost)
-    initial_points: int = 7  # the coarse grid over the range (7 over 30 ... 30,000: half decades)
-    start_points: int = 3  # round 0 visits the lowest of them; later rounds walk up only as needed
-    initial_realisations: int = 4
-    max_realisations: int = 64
+    initial_points: int = SEARCH_DEFAULTS["initial_points"]  # the coarse grid over the range
+    start_points: int = SEARCH_DEFAULTS["start_points"]  # round 0 visits the lowest of them
+    initial_realisations: int = SEARCH_DEFAULTS["realisations"]
+    max_realisations: int = SEARCH_DEFAULTS["max_realisations"]
     min_step: float = 1.1  # no two visited values closer than this ratio (dt growth: of dt_growth - 1)
-    convention: str = "mean_COMIC"  # or COMIC_of_mean_SSE (aggregate.CONVENTIONS): what is minimised
-    measure: str = "own"  # or "points": SSE at the measurement points common to all models (MEASURES)
+    convention: str = SEARCH_DEFAULTS["convention"]  # what is minimised over N (aggregate.CONVENTIONS)
+    measure: str = SEARCH_DEFAULTS["measure"]  # where SSE is taken (MEASURES)
     steps: Mapping | None = None  # time.dt0, fd_dt, fixed_dt: set, the time step joins the sampling volume
 
     @property
@@ -214,7 +220,7 @@ class Search:
             lo, hi = (float(v) for v in spec["growth_range"])
         else:
             lo, hi = (int(v) for v in spec["n_range"])
-        steps = {**TIME_DEFAULTS, **config.get("time", {})} if spec.get("time_volume", False) else None
+        steps = dict(config.get("time", {})) if spec.get("time_volume", SEARCH_DEFAULTS["time_volume"]) else None
         search = cls(
             name=name,
             model=model,
@@ -440,7 +446,7 @@ def judged(search: Search, realisations: pd.DataFrame) -> pd.DataFrame:
         s, method = search.steps, search.model.method
         times = r["time_step"].to_numpy(np.float64)
         growth = r["dt_growth"].to_numpy(np.float64)
-        first = [first_step(method, g, s["dt0"], s["fd_dt"], s["fixed_dt"]) for g in growth]
+        first = [first_step(method, g, s) for g in growth]
         mean_dt = times / np.array([step_count(t, d, g) for t, d, g in zip(times, first, growth)])
         r = r.assign(COMIC=r["COMIC"] - np.log(mean_dt), dV=r["dV"] * mean_dt)
     return r

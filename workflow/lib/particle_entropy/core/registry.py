@@ -84,6 +84,9 @@ PRESETS = {"authors": {"scheme": "authors", "truncation": 3.0, "time_grid": "aut
 TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or whole steps while t < t_final
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
+# what an adaptive search minimises over N (aggregate.CONVENTIONS) and where it takes SSE (optimum.MEASURES)
+CONVENTION_NAMES = ("mean_COMIC", "COMIC_of_mean_SSE")
+MEASURE_NAMES = ("own", "points")
 
 # The measurement points common to every model (Section 6, "Four important points regarding the
 # COMIC", point 1: "15 randomly chosen 'measurement points' common to all simulations"): this many

@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import math
 import zlib
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
 from .registry import DEFAULT_KERNEL
-from .settings import BY_NAME, PAPER, Setting
+from .settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .timegrid import MAX_STEPS, max_first_step, step_count
-
-MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
 
 
 def check_setting(setting: Setting, value):
@@ -27,11 +26,18 @@ def check_setting(setting: Setting, value):
     return check_range(setting.name, value, setting.low, setting.high, open_low=setting.open_low)
 
 
-def first_step(method: str, dt_growth: float, dt0: float, fd_dt: float, fixed_dt: float) -> float:
-    """The first time step: FD its fixed fd_dt; particles dt0, or fixed_dt when the step is fixed."""
+def first_step_key(method: str, dt_growth: float) -> str:
+    """The `time` setting of a run's first step: FD its fixed fd_dt; particles dt0, or fixed_dt
+    when the step is fixed (dt_growth 1)."""
     if method == "fd":
-        return fd_dt
-    return fixed_dt if dt_growth == 1.0 else dt0
+        return "fd_dt"
+    return "fixed_dt" if dt_growth == 1.0 else "dt0"
+
+
+def first_step(method: str, dt_growth: float, time: Mapping | None = None) -> float:
+    """The first time step of a run from a config's `time` section (the paper's where it has none)."""
+    key = first_step_key(method, dt_growth)
+    return float((time or {}).get(key, PAPER[key]))
 
 
 @dataclass(frozen=True)
@@ -97,7 +103,7 @@ class RunConfig:
     def resolved(self) -> RunConfig:
         """Fill the first step (first_step) and check every setting."""
         if self.dt0 is None:
-            dt0 = first_step(self.method, self.dt_growth, PAPER["dt0"], PAPER["fd_dt"], PAPER["fixed_dt"])
+            dt0 = first_step(self.method, self.dt_growth)
             cfg = replace(self, dt0=dt0)
         else:
             cfg = self

@@ -1,11 +1,18 @@
-"""The one typed definition of every run setting: config key, CLI option, default, range, meaning.
+"""The one typed definition of every config setting: key, default, unit, range, meaning.
 
-From ``SETTINGS`` come the paper's defaults (``PAPER``), ``RunConfig``'s defaults and range
-checks, the CLI's options (cli.py) and the schema's entries for these keys, which
+Each config section is declared here once, as a tuple of ``Setting``: the run settings
+(``SETTINGS``: physics, time, numerics, case_defaults), the keys of every section that lists cases
+(``CASE_SECTION``: figures, tradeoff, mechanism sweeps), the figures' drawing options
+(``FIGURE_OPTIONS``), the trade-off sweep (``TRADEOFF``), the mechanism experiments
+(``MECHANISM``), the shear flow (``SHEAR``) and an adaptive search (``SEARCH``), with the caps
+they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``SHEAR_MAX_N``). From them come the paper's
+defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
+checks, the CLI's options (cli.py), the schema's blocks, which
 ``python -m particle_entropy.pipeline.schemagen --write`` writes into
-workflow/schemas/config.schema.yaml (tests/test_settings.py fails when the file is stale).
-Settings that are case dimensions (eta, truncation, dt_growth, scheme) live under
-``case_defaults`` in a config and are checked by ``Case``.
+workflow/schemas/config.schema.yaml (tests/test_settings.py fails when the file is stale), and
+the column page's descriptions of settings written beside results. Cross-field rules (a strip
+inside its domain, a search's budget of at least one round) are checked where the fields meet;
+their range is then given in words (``range_text``).
 """
 
 from __future__ import annotations
@@ -13,14 +20,32 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE, SCHEMES, TIME_GRIDS, TRANSFER_METHODS
+from .registry import (
+    CONVENTION_NAMES,
+    FGT_TOLERANCE,
+    FGT_TOLERANCE_RANGE,
+    MEASURE_NAMES,
+    SCHEMES,
+    SHEAR_CASES,
+    TIME_GRIDS,
+    TRANSFER_METHODS,
+)
+
+MAX_REALISATIONS = 10_000  # realisations of one case or N: more is a typo, not an ensemble
+MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
+SHEAR_MAX_N = 10**8  # shear particles: 5,000 x the paper's, ~40 GB for a random walk; more is a typo
+NO_DEFAULT = object()  # a setting the config must give (or may leave out, with no default)
 
 
 @dataclass(frozen=True)
 class Setting:
-    """One setting: ``name`` is its RunConfig field (CLI option ``--name`` with dashes), ``key``
-    its config key. Numbers lie in [low, high] (``open_low``: low excluded); ``choices`` lists
-    the allowed words; ``none`` allows the word none (None), as truncation does."""
+    """One setting: ``name`` is its field (a RunConfig's: CLI option ``--name`` with dashes),
+    ``key`` its config key (``<name>`` standing for any key of a mapping, ``[]`` for any item of
+    a list). ``kind`` is number, integer, boolean or string (with ``choices``, the allowed
+    words), or shape: a structured value whose JSON-schema ``shape`` is given. Numbers lie in
+    [low, high] (``open_low``: low excluded); ``none`` allows the word none (None), as truncation
+    does; ``range_text`` states a range that depends on other fields; ``required``: the config
+    must give it."""
 
     name: str
     key: str
@@ -32,10 +57,19 @@ class Setting:
     open_low: bool = False
     choices: tuple[str, ...] | None = None
     none: bool = False
+    kind: str = "number"
+    shape: dict | None = None
+    range_text: str | None = None
+    required: bool = False
 
     @property
     def section(self) -> str:
-        return self.key.split(".")[0]
+        """The key of the mapping the setting sits in (``physics``, ``mechanism.lattice``)."""
+        return self.key.rsplit(".", 1)[0]
+
+    @property
+    def has_default(self) -> bool:
+        return self.default is not NO_DEFAULT
 
     @property
     def option(self) -> str:
@@ -43,12 +77,18 @@ class Setting:
 
     def allowed(self) -> str:
         """The allowed values in words, as error messages and help texts give them."""
+        if self.range_text is not None:
+            return self.range_text
         if self.choices is not None:
             return "one of " + ", ".join(self.choices)
+        if self.kind == "boolean":
+            return "true or false"
+        integer = self.kind == "integer"
+        noun, num = ("an integer", lambda v: f"{int(v):,}") if integer else ("a number", lambda v: f"{v:g}")
         if self.high != math.inf:
-            words = f"a number in {'(' if self.open_low else '['}{self.low:g}, {self.high:g}]"
+            words = f"{noun} in {'(' if self.open_low else '['}{num(self.low)}, {num(self.high)}]"
         else:
-            words = f"a number {'>' if self.open_low else '>='} {self.low:g}"
+            words = f"{noun} {'>' if self.open_low else '>='} {num(self.low)}"
         return ("none or " if self.none else "") + words
 
 
@@ -151,4 +191,386 @@ SETTINGS = (
 BY_NAME = {s.name: s for s in SETTINGS}
 CASE_SETTINGS = tuple(s.name for s in SETTINGS if s.section == "case_defaults")
 # The paper's settings (../shared/docs/experiments.md beside the repository); config.yaml equals these.
-PAPER = {s.name: s.default for s in SETTINGS} | {"shear_beta": 0.5}  # Appendix B coefficient (Eq. 16)
+PAPER = {s.name: s.default for s in SETTINGS}
+
+
+def defaults(settings) -> dict:
+    """Field name -> default of the settings that have one."""
+    return {s.name: s.default for s in settings if s.has_default}
+
+
+def _ref(name: str) -> dict:
+    return {"$ref": f"#/$defs/{name}"}
+
+
+# ------------------------------------------------------------------------------ sections of cases
+# The keys of every section that lists cases: each figure under `figures`, `tradeoff` and each
+# sweep of `mechanism` (the cases, the N and the realisations of each N).
+REALISATIONS_DOC = f'an integer in [1, {MAX_REALISATIONS:,}], or "ensemble" for the `realisations` table'
+CASE_SECTION = (
+    Setting(
+        "cases",
+        "<section>.cases",
+        NO_DEFAULT,
+        "the models drawn: method, kernel and the dimensions that differ from case_defaults",
+        kind="shape",
+        shape=_ref("cases"),
+        range_text="a list of cases",
+        required=True,
+    ),
+    Setting(
+        "n",
+        "<section>.n",
+        NO_DEFAULT,
+        "particle numbers (FD: intervals)",
+        kind="shape",
+        shape=_ref("ns"),
+        required=True,
+    ),
+    Setting(
+        "realisations",
+        "<section>.realisations",
+        1,
+        "realisations of each N",
+        kind="shape",
+        shape=_ref("realisations"),
+        range_text=REALISATIONS_DOC,
+    ),
+    Setting(
+        "max_realisations",
+        "<section>.max_realisations",
+        NO_DEFAULT,
+        "cap on the ensemble realisations of each N",
+        kind="integer",
+        low=1,
+        high=MAX_REALISATIONS,
+    ),
+)
+REALISATIONS_ENTRY = (  # one row of the top-level `realisations` table
+    Setting("n", "realisations[].n", NO_DEFAULT, "particle number N", kind="integer", low=1, required=True),
+    Setting(
+        "count",
+        "realisations[].count",
+        NO_DEFAULT,
+        "realisations of this N",
+        kind="integer",
+        low=1,
+        high=MAX_REALISATIONS,
+        required=True,
+    ),
+)
+FIGURE_OPTIONS = (  # drawing options a config may set beside a figure's cases
+    Setting(
+        "bars",
+        "figures.fig9.bars",
+        "eq43",
+        "bars about the COMIC of the mean SSE: eq43 = Eq. 43 applied to SSE_mean -+ SSE_std; paper = "
+        "ln(SSE_mean -+ SSE_std) - ln(SSE_mean), as the authors' script draws them (lower end unbounded where "
+        "std >= mean)",
+        choices=("eq43", "paper"),
+    ),
+)
+TRADEOFF = (
+    Setting(
+        "times",
+        "tradeoff.times",
+        NO_DEFAULT,
+        "times at which cost and error are tabulated (nearest step)",
+        "T",
+        kind="shape",
+        shape={"type": "array", "minItems": 1, "uniqueItems": True, "items": {"type": "number", "minimum": 0}},
+        range_text="times in [0, physics.t_final], each once",
+        required=True,
+    ),
+)
+MECHANISM = (
+    Setting(
+        "sweeps",
+        "mechanism.sweeps",
+        NO_DEFAULT,
+        "case sweeps, each cases x n like a figure; a case in two sweeps or in Fig. 9 shares its runs",
+        kind="shape",
+        shape={"type": "array", "minItems": 1, "items": _ref("case_section")},
+        range_text="a list of case sections",
+        required=True,
+    ),
+    Setting(
+        "n",
+        "mechanism.lattice.n",
+        NO_DEFAULT,
+        "particles on the lattice (a particle at x = 0)",
+        kind="integer",
+        low=3,
+        range_text="an odd integer >= 3",
+        required=True,
+    ),
+    Setting(
+        "cases",
+        "mechanism.lattice.cases",
+        NO_DEFAULT,
+        "extra cases drawn as floors only, besides every mechanism model",
+        kind="shape",
+        shape=_ref("cases"),
+        range_text="a list of mtpt cases at eta = 1",
+    ),
+    Setting(
+        "n",
+        "mechanism.fd_domain.n",
+        NO_DEFAULT,
+        "FD grids, as intervals on the paper's domain: dx = physics.fd_length / n",
+        kind="shape",
+        shape=_ref("ns"),
+        range_text="even whole numbers of intervals on every length",
+        required=True,
+    ),
+    Setting(
+        "lengths",
+        "mechanism.fd_domain.lengths",
+        NO_DEFAULT,
+        "domain lengths, the first the paper's",
+        "L",
+        kind="shape",
+        shape={"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0}},
+        range_text="lengths > 0 that hold the plume",
+        required=True,
+    ),
+)
+# what each object of these sections holds (the schema's description of the object itself)
+SECTION_DOCS = {
+    "tradeoff": "Speed-accuracy sweep: cases x n like a figure, plus the times to tabulate.",
+    "mechanism": "Controlled experiments behind figures/fig9_mechanism.png (its own target): case sweeps at "
+    "shared seeds, and the Fig. 8 domain experiment.",
+    "mechanism.lattice": "Noise-free SSE floors: every mechanism model (and these extra cases) run on evenly "
+    "spaced particles (eta = 1 only).",
+    "mechanism.fd_domain": "Fig. 8's late error: implicit FD at these grids (n = fd_length_paper / dx) on domains "
+    "of these lengths, same dx.",
+    "shear": "Fig. 10 (Appendix B): 2-D shear flow v_x = y - y^2, D = diag(alpha_L v_x, alpha_T v_x).",
+    "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
+    "core-seconds or both).",
+}
+
+# ------------------------------------------------------------------------------ the shear flow
+SHEAR = (  # Appendix B; ShearConfig's fields (models/shear2d.py) besides `case`
+    Setting(
+        "cases",
+        "shear.cases",
+        NO_DEFAULT,
+        "cases to run: rw_nodrift, rw_drift (random walks without / with the grad.D drift), mt (mass transfer only)",
+        kind="shape",
+        shape={
+            "type": "array",
+            "minItems": 1,
+            "uniqueItems": True,
+            "items": {"type": "string", "enum": list(SHEAR_CASES)},
+        },
+        range_text="a list of " + ", ".join(SHEAR_CASES) + ", each once",
+        required=True,
+    ),
+    Setting("seed", "shear.seed", 0, "random seed", kind="integer", low=0, high=MAX_SEED, required=True),
+    Setting(
+        "n",
+        "shear.n",
+        20_000,
+        "particles, uniform over the domain (the memory check may refuse fewer)",
+        kind="integer",
+        low=1,
+        high=SHEAR_MAX_N,
+        required=True,
+    ),
+    Setting("length", "shear.length", 400.0, "periodic domain length in x", "L", 0.0, open_low=True, required=True),
+    Setting(
+        "strip_lo",
+        "shear.strip_lo",
+        90.0,
+        "left edge of the initial strip",
+        "L",
+        0.0,
+        range_text="a number in [0, length]",
+        required=True,
+    ),
+    Setting(
+        "strip_hi",
+        "shear.strip_hi",
+        110.0,
+        "right edge of the initial strip",
+        "L",
+        0.0,
+        open_low=True,
+        range_text="a number in (strip_lo, length]",
+        required=True,
+    ),
+    Setting("alpha_L", "shear.alpha_L", 1e-2, "longitudinal dispersivity", "L", 0.0, open_low=True, required=True),
+    Setting("alpha_T", "shear.alpha_T", 1e-3, "transverse dispersivity", "L", 0.0, required=True),
+    Setting("beta", "shear.beta", 0.5, "mass-transfer coefficient of Eq. 16 for the mt case", low=0.0, high=1.0),
+    Setting("dt", "shear.dt", 1.0, "time step", "T", 0.0, open_low=True, required=True),
+    Setting(
+        "t_final",
+        "shear.t_final",
+        500.0,
+        "final time",
+        "T",
+        0.0,
+        open_low=True,
+        range_text="a number > 0, a whole number of steps dt",
+        required=True,
+    ),
+)
+
+# ------------------------------------------------------------------------------ an adaptive search
+SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
+    Setting(
+        "case",
+        "optimum.<name>.case",
+        NO_DEFAULT,
+        "the searched model (unset dimensions from case_defaults)",
+        kind="shape",
+        shape=_ref("case"),
+        range_text="a case",
+        required=True,
+    ),
+    Setting(
+        "time",
+        "optimum.<name>.time",
+        NO_DEFAULT,
+        "time at which COMIC is judged (nearest recorded step)",
+        "T",
+        0.0,
+        open_low=True,
+        range_text="a number in (0, physics.t_final]",
+        required=True,
+    ),
+    Setting(
+        "n_range",
+        "optimum.<name>.n_range",
+        NO_DEFAULT,
+        "[low, high]: the N searched (particles; FD intervals)",
+        kind="shape",
+        shape={"type": "array", "items": {"type": "integer", "minimum": 1}, "minItems": 2, "maxItems": 2},
+        range_text="integers with 1 <= low < high (FD: low >= 2)",
+    ),
+    Setting(
+        "growth_range",
+        "optimum.<name>.growth_range",
+        NO_DEFAULT,
+        "[low, high]: search the time-step growth factor instead of N (pt, mtpt), at the N given by `n`, "
+        "in log(dt_growth - 1)",
+        kind="shape",
+        shape={"type": "array", "items": {"type": "number", "exclusiveMinimum": 1}, "minItems": 2, "maxItems": 2},
+        range_text="numbers with 1 < low < high",
+    ),
+    Setting("n", "optimum.<name>.n", NO_DEFAULT, "the N at which a growth_range search runs", kind="integer", low=1),
+    Setting(
+        "budget_runs",
+        "optimum.<name>.budget_runs",
+        NO_DEFAULT,
+        "most runs (realisations x N) the search may start",
+        kind="integer",
+        low=1,
+        range_text="an integer >= the first round's start_points x realisations",
+    ),
+    Setting(
+        "budget_core_s",
+        "optimum.<name>.budget_core_s",
+        NO_DEFAULT,
+        "most core-seconds the search may spend, counted by its cost model (`cost`), never measured, so the "
+        "search takes the same path on every machine; round 0 always runs",
+        "s",
+        0.0,
+        open_low=True,
+        range_text="a number > 0; needs `cost`",
+    ),
+    Setting(
+        "cost",
+        "optimum.<name>.cost",
+        NO_DEFAULT,
+        "the cost model: [[searched value (N or dt_growth), seconds per run], ...], interpolated in log-log; "
+        "calibrated once on a quiet machine by benchmarks/calibrate_search_costs.py",
+        kind="shape",
+        shape={
+            "type": "array",
+            "minItems": 1,
+            "maxItems": 1000,
+            "items": {
+                "type": "array",
+                "items": {"type": "number", "exclusiveMinimum": 0},
+                "minItems": 2,
+                "maxItems": 2,
+            },
+        },
+        range_text="pairs of numbers > 0 at distinct values",
+    ),
+    Setting(
+        "width",
+        "optimum.<name>.width",
+        10.0,
+        "stop when the bracket of the optimum is no wider than this ratio high / low N (growth: of dt_growth - 1)",
+        low=1.0,
+        open_low=True,
+        range_text="a number in (1.1, the range's own ratio]",
+    ),
+    Setting(
+        "initial_points",
+        "optimum.<name>.initial_points",
+        7,
+        "points of the coarse grid over the whole range (even in log N; 7 over 30-30,000 = half decades)",
+        kind="integer",
+        low=3,
+        range_text="an integer in [3, 1 + 2 ln(high / low) / ln(width)]: two coarse steps at least width wide",
+    ),
+    Setting(
+        "start_points",
+        "optimum.<name>.start_points",
+        3,
+        "round 0 runs the lowest this many coarse points; later rounds walk up the coarse grid only while the "
+        "minimum may lie higher",
+        kind="integer",
+        low=3,
+        range_text="an integer in [3, initial_points]",
+    ),
+    Setting(
+        "measure",
+        "optimum.<name>.measure",
+        "own",
+        "where SSE is taken: own = at the model's own points (particles, nodes; Eq. 44), points = at the "
+        "measurement points common to every model (the paper's section 6, point 1; columns SSE_points, "
+        "COMIC_points)",
+        choices=MEASURE_NAMES,
+    ),
+    Setting(
+        "time_volume",
+        "optimum.<name>.time_volume",
+        False,
+        "count the time step in the sampling volume (the paper's section 6, point 3): COMIC - ln(mean dt), "
+        "mean dt = time / steps taken to reach it",
+        kind="boolean",
+    ),
+    Setting(
+        "realisations",
+        "optimum.<name>.realisations",
+        4,
+        "realisations of each newly visited N (FD: always 1)",
+        kind="integer",
+        low=1,
+    ),
+    Setting(
+        "max_realisations",
+        "optimum.<name>.max_realisations",
+        64,
+        "most realisations of one N (replication doubles them up to this)",
+        kind="integer",
+        low=1,
+        high=MAX_REALISATIONS,
+        range_text=f"an integer in [realisations, {MAX_REALISATIONS:,}]",
+    ),
+    Setting(
+        "convention",
+        "optimum.<name>.convention",
+        "mean_COMIC",
+        "what is minimised over N: mean_COMIC = the mean over realisations of per-realisation COMIC; "
+        "COMIC_of_mean_SSE = COMIC (Eq. 43) of the mean SSE",
+        choices=CONVENTION_NAMES,
+    ),
+)
+
+DECLARED = (*SETTINGS, *CASE_SECTION, *REALISATIONS_ENTRY, *FIGURE_OPTIONS, *TRADEOFF, *MECHANISM, *SHEAR, *SEARCH)
+BY_KEY = {s.key: s for s in DECLARED}  # every declared setting by its config key

@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 from ..analysis.judging import paper_bars
 from ..core.case import Case, rows_of
 from ..core.labels import case_label, variant_text
-from . import FIGURE_OPTIONS
+from ..core.settings import BY_KEY
 from .style import (
     BLUE,
     COLLISION,
@@ -50,7 +50,7 @@ def _scheme_text(model: Case) -> str:
 
 # the bars about the COMIC of the mean SSE (config figures.fig9.bars): eq43, Eq. 43 applied to
 # SSE_mean -+ SSE_std; paper, ln(SSE_mean -+ SSE_std) - ln(SSE_mean) as the authors' script draws them
-BARS = FIGURE_OPTIONS["fig9"]["bars"][0]
+BARS = BY_KEY["figures.fig9.bars"].choices
 
 
 def _mean_sse_bars(g: pd.DataFrame, bars: str) -> tuple[np.ndarray, np.ndarray]:

@@ -1,7 +1,7 @@
 """The figures' shared toolkit: palette, styles, ``Series``, drawing, axes and byte-stable saving.
 
 A figure function ``fig(tables, cases, D=..., t_final=...)`` (one module per figure family,
-``FIGURE_MODULES`` in ``figures/__init__.py``) builds its ``Series`` first and draws them, so the
+``FIGURES`` in ``figures/__init__.py``) builds its ``Series`` first and draws them, so the
 tidy table ``source_table`` returns (columns in ``SOURCE_COLUMNS``) is what is on the page;
 ``save_figure`` writes byte-stable PNG and PDF.
 

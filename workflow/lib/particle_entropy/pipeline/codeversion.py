@@ -1,6 +1,6 @@
 """Content hashes of the library code a task runs, so a workflow reruns exactly what an edit changes.
 
-``code_version("fig7")`` hashes figures/fig7.py and every package module it imports, directly or
+``code_version("figures.fig7")`` hashes figures/fig7.py and every package module it imports, directly or
 not (found by reading the import statements, so a new import is followed without a list to
 keep up to date). A rule that passes this hash as a parameter reruns when, and only when, the
 content of that code changes: restoring a file's old content, or touching it, reruns nothing.
@@ -21,15 +21,13 @@ PACKAGE = Path(__file__).resolve().parents[1]  # particle_entropy/, above this s
 
 @functools.cache
 def modules(package: Path = PACKAGE) -> dict[str, Path]:
-    """Every module of the package and its subpackages by its name (``gauss``, not
-    ``numerics.gauss``): the names are unique across subpackages, so a name is a module."""
+    """Every module of the package and its subpackages by its dotted name below the package
+    (``numerics.gauss``, ``cli``): two subpackages may hold modules of the same file name."""
     found: dict[str, Path] = {}
     for path in sorted(package.rglob("*.py")):
         if path.name == "__init__.py" or "__pycache__" in path.parts:
             continue
-        if path.stem in found:
-            raise ValueError(f"two modules named {path.stem!r}: {found[path.stem]} and {path}")
-        found[path.stem] = path
+        found[".".join(path.relative_to(package).with_suffix("").parts)] = path
     return found
 
 
@@ -40,19 +38,23 @@ _RELATIVE = re.compile(r"^[ \t]*from[ \t]+(\.+)([\w.]*)[ \t]+import[ \t]+(\([^)]
 
 @functools.cache
 def imports(module: str, package: Path = PACKAGE) -> frozenset[str]:
-    """Package modules that ``module`` imports by relative imports (``from . import x``,
-    ``from .x import y``, ``from ..sub.x import y``, ``from ..sub import x``), lazy ones
+    """Package modules (dotted names) that ``module`` imports by relative imports (``from . import
+    x``, ``from .x import y``, ``from ..sub.x import y``, ``from ..sub import x``), lazy ones
     included. Read by a pattern, not a parse: the workflow hashes its code at every start."""
     known = modules(package)
+    here = module.split(".")[:-1]  # the subpackage the module sits in
     found = set()
-    for _, path, names in _RELATIVE.findall(known[module].read_text()):
-        last = path.split(".")[-1] if path else None
-        if last in known:
-            found.add(last)
+    for dots, path, names in _RELATIVE.findall(known[module].read_text()):
+        base = here[: len(here) - (len(dots) - 1)] if len(dots) - 1 <= len(here) else None
+        if base is None:  # above the package: not one of its modules
+            continue
+        target = ".".join([*base, *filter(None, path.split("."))])
+        if target in known:
+            found.add(target)
         else:  # from a (sub)package: the names may be modules
             words = re.findall(r"\w+", names.split("#")[0] if not names.startswith("(") else names)
-            found.update(w for w in words if w in known)
-    return frozenset(found)
+            found.update(f"{target}.{w}" if target else w for w in words)
+    return frozenset(found & set(known))
 
 
 def closure(entries, exclude=(), package: Path = PACKAGE) -> list[str]:

@@ -23,7 +23,7 @@ from ..analysis.aggregate import ARGMIN_COLUMN_DOCS, MINIMA_COLUMN_DOCS, REALISA
 from ..analysis.resampling import CONFIDENCE, N_RESAMPLES
 from ..core import records
 from ..core.case import CASE_COLUMNS, COLUMN_DOCS, MODEL_COLUMNS
-from ..figures import plots_shear, style
+from ..figures import fig10, style
 from ..models.shear2d import STATE_COLUMNS, STEP_COLUMNS
 
 PAGE = "docs/columns.md"
@@ -403,8 +403,8 @@ def sections() -> list[Section]:
             ("results/figures/fig10.parquet",),
             "One row per plotted point of Fig. 10 (the 2-D shear flow, Appendix B): a particle of panels a-c or a "
             "histogram bin or reference-line end of panels d-f. Written by rule `plot_fig10` "
-            "(`plots_shear.source_data`).",
-            (("plots_shear.SOURCE_COLUMNS", plots_shear.SOURCE_COLUMNS),),
+            "(`fig10.source_data`).",
+            (("fig10.SOURCE_COLUMNS", fig10.SOURCE_COLUMNS),),
         ),
         Section(
             "Shear-flow steps",

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 
 from ..core.case import Case, SettingError
 from ..core.labels import case_label
-from ..core.runconfig import MAX_SEED, RunConfig
+from ..core.runconfig import MAX_SEED, RunConfig, first_step_key
 from ..core.settings import PAPER, SETTINGS
 from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
@@ -86,19 +86,10 @@ def check_finite(value, where: str = "") -> None:
         raise SettingError(where, value, "a finite number (YAML .nan and .inf are not settings)")
 
 
-def _first_step_key(case: Case) -> str:
-    """The config key of a case's first step (runconfig.first_step)."""
-    if case.method == "fd":
-        return "time.fd_dt"
-    return "time.fixed_dt" if case.dt_growth == 1.0 else "time.dt0"
-
-
 # RunConfig settings that come from a shared config key, not from the case: a SettingError about
-# them names that key (and the case it fails for)
+# them names that key (and the case it fails for); the first step's key depends on the case
 SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "numerics")}
-
-
-SHARED_KEYS["dt0"] = _first_step_key
+SHARED_KEYS["dt0"] = lambda case: "time." + first_step_key(case.method, case.dt_growth)
 
 
 def check_seeds(config: Mapping) -> None:

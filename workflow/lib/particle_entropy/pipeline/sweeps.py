@@ -20,10 +20,6 @@ from ..core.settings import PAPER, SETTINGS
 RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
 FIGURE_DATA_PATTERN = "results/figures/{fig}.parquet"
-PAPER_FIGURES = tuple(f"fig{k}" for k in range(1, 10))  # the case-drawn figures; fig10 is the shear flow
-# What each case section's figure reads: single runs of base_seed, final states, its own COMIC
-# table, the trade-off table; every other figure reads case summaries (ensemble statistics).
-FIGURE_READS = {"fig1": "runs", "fig2": "runs", "fig7": "snapshots", "fig9": "comic", "tradeoff": "tradeoff"}
 # config.physics / config.time keys -> RunConfig settings shared by every case
 PHYSICS = tuple(s.name for s in SETTINGS if s.section == "physics")  # D, t_final, omega, ...
 NUMERICS = tuple(s.name for s in SETTINGS if s.section == "numerics")  # transfer_method, _tolerance
@@ -113,9 +109,6 @@ def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
     return spec_ensembles(config["figures"][fig], config)
 
 
-MAX_REALISATIONS = 10_000  # realisations of one case (schema and hand-written targets): more is a typo
-
-
 def block_size(ens: Ensemble, config: Mapping) -> int:
     """Seeds in the largest job of an ensemble (``seed_blocks``), without building the blocks."""
     blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
@@ -142,9 +135,7 @@ def run_settings(case: Case, config: Mapping) -> dict:
     physics, time, numerics = config["physics"], config["time"], config.get("numerics", {})
     out = {k: float(physics.get(k, PAPER[k])) for k in PHYSICS}
     out.update({k: numerics.get(k, PAPER[k]) for k in NUMERICS})
-    out["dt0"] = float(
-        first_step(case.method, case.dt_growth, time["dt0"], time["fd_dt"], time.get("fixed_dt", PAPER["fixed_dt"]))
-    )
+    out["dt0"] = first_step(case.method, case.dt_growth, time)
     return out
 
 
