@@ -1,10 +1,12 @@
 """The page docs/columns.md, rendered from the column dicts of the code that writes each table.
 
 One section per derived table: its path, what a row holds and the rule that writes it, then a row
-per column from the dicts listed in ``sections()`` (``records.COLUMNS``, ``aggregate.SUMMARY_COLUMNS``,
-...). A description's unit is its trailing ``[...]``; a run of the case (or model) columns is one
-row that links to their own section. The few tables whose module keeps no column dict take their
-meanings from the dicts of this module. ``python -m particle_entropy.pipeline.columnsdoc --write
+per column from the dicts listed in ``sections()`` (``columns.RECORD_COLUMN_DOCS``,
+``aggregate.SUMMARY_COLUMNS``, ...). A description's unit is its trailing ``[...]``; a run of the
+case (or model) columns is one row that links to their own section. The meanings of the columns
+simulation jobs write live where no such job imports them (core/columns.py), so editing one
+reruns no simulation. The few tables whose module keeps no column dict take their meanings from
+the dicts of this module. ``python -m particle_entropy.pipeline.columnsdoc --write
 docs/columns.md`` writes the page; ``--check`` exits 1 while the page differs from the dicts.
 """
 
@@ -28,7 +30,8 @@ from ..analysis.aggregate import (
     SUMMARY_COLUMNS,
 )
 from ..core import records
-from ..core.case import CASE_COLUMNS, COLUMN_DOCS, MODEL_COLUMNS
+from ..core.case import CASE_COLUMNS, MODEL_COLUMNS
+from ..core.columns import CASE_COLUMN_DOCS, RECORD_COLUMN_DOCS
 from ..experiments.shear2d import STATE_COLUMNS, STEP_COLUMNS
 from ..figures import plots_shear, style
 
@@ -53,13 +56,13 @@ SNAPSHOT_COLUMNS = {  # the final state of simulate.run(..., want_state=True)
 }
 # columns aggregate.summarise_runs copies from the lowest seed's run table
 SUMMARY_COPIED = {
-    **{c: records.COLUMNS[c] for c in ("H_C_analytic", "E_analytic", "dV")},
-    "n_sse": f"{records.COLUMNS['n_sse']}; copied from the lowest seed",
-    "settled": records.COLUMNS["settled"],
+    **{c: RECORD_COLUMN_DOCS[c] for c in ("H_C_analytic", "E_analytic", "dV")},
+    "n_sse": f"{RECORD_COLUMN_DOCS['n_sse']}; copied from the lowest seed",
+    "settled": RECORD_COLUMN_DOCS["settled"],
 }
 COMIC_COLUMNS = {  # aggregate.comic_table: case summaries at the step nearest each requested time
     "label": REALISATION_COLUMN_DOCS["label"],
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time [T]",
     "time_step": "time of the recorded step nearest to it [T]",
     "COMIC_mean": SUMMARY_COLUMNS["COMIC_mean"],
@@ -77,7 +80,7 @@ COMIC_COLUMNS = {  # aggregate.comic_table: case summaries at the step nearest e
 }
 TRADEOFF_COLUMNS = {  # aggregate.tradeoff_table
     "label": REALISATION_COLUMN_DOCS["label"],
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time (the row is the recorded step nearest to it) [T]",
     "wall_s": "wall-clock seconds of one realisation from t = 0 to that step, ensemble mean (the summary's "
     "`wall_cum_mean`; differs run to run) [s]",
@@ -111,7 +114,7 @@ SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Record
     "dt": "the run's fixed time step (setting) [T]",
     "beta": "the run's mass-transfer coefficient of Eq. 16 (setting; used by `mt` only)",
     "work": "running sum of `substeps` (0 for random walks); unlike the 1-D run tables it does not count particles",
-    "peak_rss_mb": records.COLUMNS["peak_rss_mb"],
+    "peak_rss_mb": RECORD_COLUMN_DOCS["peak_rss_mb"],
     "case": STATE_COLUMNS["case"],
     "seed": STATE_COLUMNS["seed"],
     "n": "particles, uniform over the domain",
@@ -123,7 +126,7 @@ SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Record
     "t_final": "end time [T]",
 }
 LATTICE_COLUMNS = {  # lattice.lattice_run
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time [T]",
     "time_step": "time of the recorded step nearest to it [T]",
     "SSE": "SSE of the lattice run, Eq. 44 [1/L²]",
@@ -297,7 +300,7 @@ def keyed(names: Sequence[str], docs: Mapping[str, str]) -> dict[str, str]:
 
 def sections() -> list[Section]:
     """The page's tables in order, built from the column dicts as they are now."""
-    case = ("case.COLUMN_DOCS", {c: COLUMN_DOCS[c] for c in CASE_COLUMNS})
+    case = ("columns.CASE_COLUMN_DOCS", keyed(CASE_COLUMNS, CASE_COLUMN_DOCS))
     d = ("columnsdoc.RUN_SETTINGS", {"D": RUN_SETTINGS["D"]})
     same_columns = "(same columns for `fig9` and `mechanism`;"
     return [
@@ -306,7 +309,7 @@ def sections() -> list[Section]:
             (),
             "Most tables carry the case of a row as typed columns (`Case.columns()`). A *model* is a case at every "
             "N: tables keyed by model (minima, argmin shares) have all of these except `n`.",
-            (("case.COLUMN_DOCS", COLUMN_DOCS),),
+            (case,),
             grouped=False,
         ),
         Section(
@@ -316,7 +319,11 @@ def sections() -> list[Section]:
             "one case, told apart by `seed`, and step 0 is the initial condition. Written by rule `simulate` "
             "(`workflow/scripts/simulate.py`, `simulate.run_seeds`); what a measure is computed on depends on the "
             "method.",
-            (("records.COLUMNS", records.COLUMNS), case, ("columnsdoc.RUN_SETTINGS", RUN_SETTINGS)),
+            (
+                ("columns.RECORD_COLUMN_DOCS", keyed(records.COLUMNS, RECORD_COLUMN_DOCS)),
+                case,
+                ("columnsdoc.RUN_SETTINGS", RUN_SETTINGS),
+            ),
         ),
         Section(
             "Final states",
