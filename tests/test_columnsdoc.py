@@ -12,7 +12,6 @@ import pytest
 
 from particle_entropy.analysis import aggregate, claims, optimum
 from particle_entropy.core import case, columns, records
-from particle_entropy.experiments import shear2d
 from particle_entropy.figures import plots_shear, style
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.columnsdoc import COMMAND, PAGE, main, render, sections, split_unit
@@ -25,7 +24,6 @@ MODULES = {  # the module names the page cites as sources of its columns
     "optimum": optimum,
     "style": style,
     "plots_shear": plots_shear,
-    "shear2d": shear2d,
     "columnsdoc": columnsdoc,
 }
 KEYED = {  # held to the column names of the code: case.CASE_COLUMNS, records.COLUMNS, claims.COLUMNS, ...

@@ -4,10 +4,11 @@ One section per derived table: its path, what a row holds and the rule that writ
 per column from the dicts listed in ``sections()`` (``columns.RECORD_COLUMN_DOCS``,
 ``aggregate.SUMMARY_COLUMNS``, ...). A description's unit is its trailing ``[...]``; a run of the
 case (or model) columns is one row that links to their own section. The meanings of the columns
-simulation jobs write live where no such job imports them (core/columns.py), so editing one
-reruns no simulation. The few tables whose module keeps no column dict take their meanings from
-the dicts of this module. ``python -m particle_entropy.pipeline.columnsdoc --write
-docs/columns.md`` writes the page; ``--check`` exits 1 while the page differs from the dicts.
+simulation jobs write live where no such job imports them (core/columns.py, and here for the
+shear flow's), so editing one reruns no simulation. The few tables whose module keeps no column
+dict take their meanings from the dicts of this module too. ``python -m
+particle_entropy.pipeline.columnsdoc --write docs/columns.md`` writes the page; ``--check``
+exits 1 while the page differs from the dicts.
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ from ..analysis.aggregate import (
 from ..core import records
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS
 from ..core.columns import CASE_COLUMN_DOCS, RECORD_COLUMN_DOCS
-from ..experiments.shear2d import STATE_COLUMNS, STEP_COLUMNS
+from ..core.registry import SHEAR_CASES
+from ..experiments.shear2d import WALL_BAND
 from ..figures import plots_shear, style
 
 PAGE = "docs/columns.md"
@@ -110,13 +112,33 @@ CLAIM_COLUMNS = {  # claims.COLUMNS
     "Holm-adjusted one-sided Welch t-tests of each N against the best (`judging.py`; empty where not judged)",
     "passed_test": "verdict of (b), null where it does not apply or cannot be computed",
 }
-SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
+SHEAR_STEP_COLUMNS = {  # shear2d.run_shear's per-step table (its Recorder's rows)
+    "step": "time-step index, 0 = initial condition",
+    "time": "time at the end of the step (step × dt) [T]",
+    "mass_total": "total particle mass (1 at t = 0)",
+    "mass_min": "smallest particle mass",
+    "wall_fraction": f"share of particles (random walks) or of mass (`mt`) within {WALL_BAND} of a wall; "
+    f"{2 * WALL_BAND} if spread evenly in y",
+    "mean_y": "mean lateral position: of all particles (random walks), mass-weighted (`mt`) [L]",
+    "substeps": "mass-transfer substeps taken to keep masses non-negative (0 for random walks and step 0)",
+    "max_offdiag_beta": "beta × the largest row sum of P_ij over j ≠ i before splitting (0: no transfer)",
+    "n_pairs": "particle pairs within the kernel cut-off (`mt`; 0 for random walks)",
+    "wall_s": "wall-clock seconds spent in the step [s]",
+}
+SHEAR_STATE_COLUMNS = {  # shear2d.run_shear's final particle table
+    "x": "final position along the flow, in [0, length) [L]",
+    "y": "final lateral position, in [0, 1] [L]",
+    "mass": "final particle mass",
+    "case": "shear case: " + ", ".join(f"`{c}`" for c in SHEAR_CASES),
+    "seed": "random seed",
+}
+SHEAR_SETTINGS = {  # shear step columns beyond SHEAR_STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
     "dt": "the run's fixed time step (setting) [T]",
     "beta": "the run's mass-transfer coefficient of Eq. 16 (setting; used by `mt` only)",
     "work": "running sum of `substeps` (0 for random walks); unlike the 1-D run tables it does not count particles",
     "peak_rss_mb": RECORD_COLUMN_DOCS["peak_rss_mb"],
-    "case": STATE_COLUMNS["case"],
-    "seed": STATE_COLUMNS["seed"],
+    "case": SHEAR_STATE_COLUMNS["case"],
+    "seed": SHEAR_STATE_COLUMNS["seed"],
     "n": "particles, uniform over the domain",
     "length": "length of the periodic domain in x [L]",
     "strip_lo": "left end of the initial strip [L]",
@@ -424,13 +446,13 @@ def sections() -> list[Section]:
             ("results/shear/<shear_case>/seed~<S>/steps.parquet",),
             "One row per time step of one Appendix-B shear-flow run (case `rw_nodrift`, `rw_drift` or `mt`, seed "
             "S), the run's settings repeated on every row. Written by rule `simulate_shear` (`shear2d.run_shear`).",
-            (("shear2d.STEP_COLUMNS", STEP_COLUMNS), ("columnsdoc.SHEAR_SETTINGS", SHEAR_SETTINGS)),
+            (("columnsdoc.SHEAR_STEP_COLUMNS", SHEAR_STEP_COLUMNS), ("columnsdoc.SHEAR_SETTINGS", SHEAR_SETTINGS)),
         ),
         Section(
             "Shear-flow final states",
             ("results/shear/<shear_case>/seed~<S>/state.parquet",),
             "One row per particle at t_final of one shear-flow run. Written by rule `simulate_shear`.",
-            (("shear2d.STATE_COLUMNS", STATE_COLUMNS),),
+            (("columnsdoc.SHEAR_STATE_COLUMNS", SHEAR_STATE_COLUMNS),),
         ),
         Section(
             "Lattice floors",
