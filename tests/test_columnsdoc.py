@@ -11,25 +11,27 @@ from pathlib import Path
 import pytest
 
 from particle_entropy.analysis import aggregate, claims, optimum
-from particle_entropy.core import case, records
+from particle_entropy.core import case, columns, records
 from particle_entropy.figures import fig10, style
-from particle_entropy.models import shear2d
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.columnsdoc import COMMAND, PAGE, main, render, sections, split_unit
 
 ROOT = Path(__file__).resolve().parents[1]
 REGENERATE = f"run `{COMMAND} {PAGE}` from the repository root to regenerate it"
 MODULES = {  # the module names the page cites as sources of its columns
-    "records": records,
-    "case": case,
+    "columns": columns,
     "aggregate": aggregate,
     "optimum": optimum,
     "style": style,
     "fig10": fig10,
-    "shear2d": shear2d,
     "columnsdoc": columnsdoc,
 }
-KEYED = {"columnsdoc.CLAIM_COLUMNS", "columnsdoc.PLAN_COLUMN_DOCS"}  # held to claims.COLUMNS, optimum.PLAN_COLUMNS
+KEYED = {  # held to the column names of the code: case.CASE_COLUMNS, records.COLUMNS, claims.COLUMNS, ...
+    "columns.CASE_COLUMN_DOCS",
+    "columns.RECORD_COLUMN_DOCS",
+    "columnsdoc.CLAIM_COLUMNS",
+    "columnsdoc.PLAN_COLUMN_DOCS",
+}
 SOURCES = sorted({name for s in sections() for name, _ in s.parts})
 UNITS = {"–", "T", "L", "nats", "1/L", "1/L²", "L²/T", "s", "MB", "kernel widths"}
 UNITS |= {"per `x_name`", "per `y_name`", "L in a-c, 1/L in d-f"}  # the figure source data's
@@ -80,7 +82,7 @@ def test_a_column_added_to_a_dict_changes_the_page(source, monkeypatch):
     assert text != (ROOT / PAGE).read_text(encoding="utf-8")
 
 
-@pytest.mark.parametrize(("module", "attr"), [(claims, "COLUMNS"), (optimum, "PLAN_COLUMNS")])
+@pytest.mark.parametrize(("module", "attr"), [(records, "COLUMNS"), (claims, "COLUMNS"), (optimum, "PLAN_COLUMNS")])
 def test_a_column_without_a_meaning_is_refused(module, attr, monkeypatch):
     monkeypatch.setattr(module, attr, [*getattr(module, attr), "brand_new_column"])
     with pytest.raises(ValueError, match="columns without a meaning: \\['brand_new_column'\\]"):

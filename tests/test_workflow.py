@@ -457,6 +457,7 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
         ("figures/style.py", lambda r: r.startswith("plot_")),
         # legend text: the tables with a label column and the figures, never a simulation
         ("core/labels.py", lambda r: not r.startswith("simulate") and r not in ("fd_domain", "mechanism_floors")),
+        ("core/columns.py", lambda r: not r.startswith("simulate")),  # column meanings: figures, never a simulation
         ("numerics/mass_transfer.py", None),
     ]:
         original = (lib / module).read_text()

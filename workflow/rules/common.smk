@@ -20,7 +20,7 @@ check_schema(config, load_schema(SCHEMA))  # one short message naming the key pa
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
-from particle_entropy.pipeline.codeversion import code_version
+from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
 from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
@@ -292,17 +292,7 @@ def sim_settings(wildcards):
 # The code each task runs (its script, the library modules it uses and what they import), hashed:
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
-SIM_CODE = {
-    m: code_version(
-        "models.simulate",
-        "core.io",
-        "core.heap",  # the script's own imports
-        f"models.{m}",
-        exclude={f"models.{o}" for o in METHODS if o != m},
-        files=[SCRIPTS / "simulate.py"],
-    )
-    for m in METHODS
-}
+SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
 SUMMARY_CODE = code_version(
     "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
 )
@@ -313,7 +303,7 @@ CLAIMS_CODE = code_version("analysis.claims", "core.io", "pipeline.htmlpage", fi
 PLOT_CODE = {  # per figure, the module that draws it: editing one figure redraws it alone
     fig: code_version(f"figures.{fig}", "core.io", files=[SCRIPTS / "plot_figure.py"]) for fig in CASE_FIGURES
 }
-SHEAR_CODE = code_version("models.shear2d", "core.io", files=[SCRIPTS / "shear2d.py"])
+SHEAR_CODE = code_version(*SHEAR_ENTRIES, files=[SCRIPTS / "shear2d.py"])
 SHEAR_PLOT_CODE = code_version("figures.fig10", "core.io", files=[SCRIPTS / "plot_fig10.py"])
 MECHANISM_PLOT_CODE = code_version("figures.fig9_mechanism", "core.io", files=[SCRIPTS / "plot_fig9_mechanism.py"])
 FD_DOMAIN_CODE = code_version("experiments.fd_domain", "core.io", files=[SCRIPTS / "fd_domain.py"])

@@ -21,7 +21,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-from .registry import KERNELS, METHODS, PRESETS, SCHEME_DOCS, SCHEME_RECORDS, SCHEMES, TIME_GRIDS
+from .registry import KERNELS, METHODS, PRESETS, SCHEME_RECORDS, SCHEMES, TIME_GRIDS
 from .settings import BY_NAME, PAPER
 
 N_MIN = 2  # one particle (or one FD interval) is a delta against itself: SSE 0, COMIC -inf
@@ -40,22 +40,6 @@ PATH_SEGMENTS = {
 CASE_DIR = "/".join(seg.format("{" + w + "}") for w, seg in PATH_SEGMENTS.values())
 MODEL_COLUMNS = ("method", "kernel", "eta", "truncation", "dt_growth", "scheme", "time_grid")
 CASE_COLUMNS = ("method", "kernel", "n", "eta", "truncation", "dt_growth", "scheme", "time_grid")
-COLUMN_DOCS = {
-    "method": "`pt` (random-walk particle tracking), `mtpt` (mass-transfer particle tracking) or `fd` (implicit or "
-    "explicit finite differences); in figure source data also `analytic` for a reference curve",
-    "kernel": "`pt`: `bins`, `fixed` or `adaptive` (how the density is reconstructed); `mtpt`: `collision` (Eq. 17) "
-    "or `sph` (Eqs. 20, 21, 26); `fd`: `implicit` or `explicit` (time scheme)",
-    "n": "number of particles; for FD the number of grid intervals (the grid has N + 1 nodes)",
-    "eta": "fraction of D carried by mass transfer, the rest by random walks (MTPT); 1 for PT and FD",
-    "truncation": "MTPT transfer kernel cut at this many kernel widths; `inf` for the whole Gaussian (PT and FD "
-    "always `inf`) [kernel widths]",
-    "dt_growth": "time-step growth factor dt_(k+1) / dt_k; 1 is a fixed step (FD always 1)",
-    "scheme": "how MTPT transfers mass: "
-    + "; ".join(f"`{k}` ({v})" for k, v in SCHEME_DOCS.items())
-    + "; PT and FD always `symmetric`",
-    "time_grid": "particle time grid: `exact` (the last step shortened to end at t_final) or `authors` (whole "
-    "growing steps while t < t_final, as the authors' code); FD always `exact`",
-}
 # Which dimensions apply to which method; the others hold NEUTRAL values.
 APPLIES = {
     "eta": ("mtpt",),

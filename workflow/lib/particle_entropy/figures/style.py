@@ -26,7 +26,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-from ..core.case import CASE_COLUMNS, COLUMN_DOCS, Case, case_of_table
+from ..core.case import CASE_COLUMNS, Case, case_of_table
+from ..core.columns import CASE_COLUMN_DOCS
 from ..core.labels import case_label
 
 # Okabe-Ito colour-blind-safe palette (and the paper's grey for Fig. 4's collision kernel)
@@ -55,7 +56,7 @@ SOURCE_COLUMNS = {
     "panel": "panel letter as printed (empty for a one-panel figure)",
     "series": "series name, unique within a panel: its legend label, except in fig7 (the legend adds a line of "
     "statistics) and fig9 (the model's label, which is the panel title, then the quantity)",
-    **{c: f"case of the point: {COLUMN_DOCS[c]}" for c in CASE_COLUMNS},
+    **{c: f"case of the point: {CASE_COLUMN_DOCS[c]}" for c in CASE_COLUMNS},
     "x_name": "quantity on the x axis, which gives `x` its unit: `time` [T], `x` (position) [L], `dx` [L], "
     "`wall_s` [s], `N` (particles; FD intervals; no unit)",
     "x": "its value [per `x_name`]",

@@ -15,8 +15,9 @@ of advection by v_x (with periodic wrap in x):
 
 Walkers reflect at the walls (y -> -y below 0, 2 - y above 1).
 
-Units: lengths [L], times [T], masses dimensionless (total 1). Columns of the result tables
-are described in ``STEP_COLUMNS`` and ``STATE_COLUMNS``.
+Units: lengths [L], times [T], masses dimensionless (total 1). What the columns of the result
+tables mean is in pipeline/columnsdoc.py (``SHEAR_STEP_COLUMNS``, ``SHEAR_STATE_COLUMNS``), which
+the shear job does not import, so editing a description does not rerun it.
 """
 
 from __future__ import annotations
@@ -41,27 +42,6 @@ WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
 V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
 KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
 MAX_N = 10**8  # particles (schema too): 5,000 x the paper's, ~40 GB for a random walk; more is a typo
-
-STEP_COLUMNS = {
-    "step": "time-step index, 0 = initial condition",
-    "time": "time at the end of the step (step × dt) [T]",
-    "mass_total": "total particle mass (1 at t = 0)",
-    "mass_min": "smallest particle mass",
-    "wall_fraction": f"share of particles (random walks) or of mass (`mt`) within {WALL_BAND} of a wall; "
-    f"{2 * WALL_BAND} if spread evenly in y",
-    "mean_y": "mean lateral position: of all particles (random walks), mass-weighted (`mt`) [L]",
-    "substeps": "mass-transfer substeps taken to keep masses non-negative (0 for random walks and step 0)",
-    "max_offdiag_beta": "beta × the largest row sum of P_ij over j ≠ i before splitting (0: no transfer)",
-    "n_pairs": "particle pairs within the kernel cut-off (`mt`; 0 for random walks)",
-    "wall_s": "wall-clock seconds spent in the step [s]",
-}
-STATE_COLUMNS = {
-    "x": "final position along the flow, in [0, length) [L]",
-    "y": "final lateral position, in [0, 1] [L]",
-    "mass": "final particle mass",
-    "case": "shear case: " + ", ".join(f"`{c}`" for c in SHEAR_CASES),
-    "seed": "random seed",
-}
 
 
 @dataclass(frozen=True)

@@ -80,6 +80,20 @@ def code_version(*entries: str, exclude=(), files=(), package: Path = PACKAGE) -
     return h.hexdigest()[:16]
 
 
+# What the simulation jobs run besides their method's module (workflow/rules/common.smk hashes
+# these, and tests/test_columns.py holds them clear of presentation): the driver, table output and
+# the allocator setting that the job script imports.
+SIMULATION_ENTRIES = ("models.simulate", "core.io", "core.heap")
+SHEAR_ENTRIES = ("models.shear2d", "core.io", "core.heap")
+
+
+def simulation_code(method: str, methods, script) -> str:
+    """The code hash of a ``method`` simulation job: SIMULATION_ENTRIES, the method's module and
+    the job's script, the other ``methods``' modules left out."""
+    others = {f"models.{m}" for m in methods if m != method}
+    return code_version(*SIMULATION_ENTRIES, f"models.{method}", exclude=others, files=[script])
+
+
 def export_library_path(lib: str | Path) -> str:
     """Put ``lib`` first on PYTHONPATH for every job this process starts (once): jobs then import
     this checkout's library in any software environment (a venv, a conda env built by --sdm

@@ -1,11 +1,14 @@
 """The page docs/columns.md, rendered from the column dicts of the code that writes each table.
 
 One section per derived table: its path, what a row holds and the rule that writes it, then a row
-per column from the dicts listed in ``sections()`` (``records.COLUMNS``, ``aggregate.SUMMARY_COLUMNS``,
-...). A description's unit is its trailing ``[...]``; a run of the case (or model) columns is one
-row that links to their own section. The few tables whose module keeps no column dict take their
-meanings from the dicts of this module. ``python -m particle_entropy.pipeline.columnsdoc --write
-docs/columns.md`` writes the page; ``--check`` exits 1 while the page differs from the dicts.
+per column from the dicts listed in ``sections()`` (``columns.RECORD_COLUMN_DOCS``,
+``aggregate.SUMMARY_COLUMNS``, ...). A description's unit is its trailing ``[...]``; a run of the
+case (or model) columns is one row that links to their own section. The meanings of the columns
+simulation jobs write live where no such job imports them (core/columns.py, and here for the
+shear flow's), so editing one reruns no simulation. The few tables whose module keeps no column
+dict take their meanings from the dicts of this module too. ``python -m
+particle_entropy.pipeline.columnsdoc --write docs/columns.md`` writes the page; ``--check``
+exits 1 while the page differs from the dicts.
 """
 
 from __future__ import annotations
@@ -22,9 +25,11 @@ from ..analysis import claims, optimum
 from ..analysis.aggregate import ARGMIN_COLUMN_DOCS, MINIMA_COLUMN_DOCS, REALISATION_COLUMN_DOCS, SUMMARY_COLUMNS
 from ..analysis.resampling import CONFIDENCE, N_RESAMPLES
 from ..core import records
-from ..core.case import CASE_COLUMNS, COLUMN_DOCS, MODEL_COLUMNS
+from ..core.case import CASE_COLUMNS, MODEL_COLUMNS
+from ..core.columns import CASE_COLUMN_DOCS, RECORD_COLUMN_DOCS
+from ..core.registry import SHEAR_CASES
 from ..figures import fig10, style
-from ..models.shear2d import STATE_COLUMNS, STEP_COLUMNS
+from ..models.shear2d import WALL_BAND
 
 PAGE = "docs/columns.md"
 COMMAND = ".venv/bin/python -m particle_entropy.pipeline.columnsdoc --write"
@@ -47,13 +52,13 @@ SNAPSHOT_COLUMNS = {  # the final state of simulate.run(..., want_state=True)
 }
 # columns aggregate.summarise_runs copies from the lowest seed's run table
 SUMMARY_COPIED = {
-    **{c: records.COLUMNS[c] for c in ("H_C_analytic", "E_analytic", "dV")},
-    "n_sse": f"{records.COLUMNS['n_sse']}; copied from the lowest seed",
-    "settled": records.COLUMNS["settled"],
+    **{c: RECORD_COLUMN_DOCS[c] for c in ("H_C_analytic", "E_analytic", "dV")},
+    "n_sse": f"{RECORD_COLUMN_DOCS['n_sse']}; copied from the lowest seed",
+    "settled": RECORD_COLUMN_DOCS["settled"],
 }
 COMIC_COLUMNS = {  # aggregate.comic_table: case summaries at the step nearest each requested time
     "label": REALISATION_COLUMN_DOCS["label"],
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time [T]",
     "time_step": "time of the recorded step nearest to it [T]",
     "COMIC_mean": SUMMARY_COLUMNS["COMIC_mean"],
@@ -71,7 +76,7 @@ COMIC_COLUMNS = {  # aggregate.comic_table: case summaries at the step nearest e
 }
 TRADEOFF_COLUMNS = {  # aggregate.tradeoff_table
     "label": REALISATION_COLUMN_DOCS["label"],
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time (the row is the recorded step nearest to it) [T]",
     "wall_s": "wall-clock seconds of one realisation from t = 0 to that step, ensemble mean (the summary's "
     "`wall_cum_mean`; differs run to run) [s]",
@@ -101,13 +106,33 @@ CLAIM_COLUMNS = {  # claims.COLUMNS
     "Holm-adjusted one-sided Welch t-tests of each N against the best (`judging.py`; empty where not judged)",
     "passed_test": "verdict of (b), null where it does not apply or cannot be computed",
 }
-SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
+SHEAR_STEP_COLUMNS = {  # shear2d.run_shear's per-step table (its Recorder's rows)
+    "step": "time-step index, 0 = initial condition",
+    "time": "time at the end of the step (step × dt) [T]",
+    "mass_total": "total particle mass (1 at t = 0)",
+    "mass_min": "smallest particle mass",
+    "wall_fraction": f"share of particles (random walks) or of mass (`mt`) within {WALL_BAND} of a wall; "
+    f"{2 * WALL_BAND} if spread evenly in y",
+    "mean_y": "mean lateral position: of all particles (random walks), mass-weighted (`mt`) [L]",
+    "substeps": "mass-transfer substeps taken to keep masses non-negative (0 for random walks and step 0)",
+    "max_offdiag_beta": "beta × the largest row sum of P_ij over j ≠ i before splitting (0: no transfer)",
+    "n_pairs": "particle pairs within the kernel cut-off (`mt`; 0 for random walks)",
+    "wall_s": "wall-clock seconds spent in the step [s]",
+}
+SHEAR_STATE_COLUMNS = {  # shear2d.run_shear's final particle table
+    "x": "final position along the flow, in [0, length) [L]",
+    "y": "final lateral position, in [0, 1] [L]",
+    "mass": "final particle mass",
+    "case": "shear case: " + ", ".join(f"`{c}`" for c in SHEAR_CASES),
+    "seed": "random seed",
+}
+SHEAR_SETTINGS = {  # shear step columns beyond SHEAR_STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
     "dt": "the run's fixed time step (setting) [T]",
     "beta": "the run's mass-transfer coefficient of Eq. 16 (setting; used by `mt` only)",
     "work": "running sum of `substeps` (0 for random walks); unlike the 1-D run tables it does not count particles",
-    "peak_rss_mb": records.COLUMNS["peak_rss_mb"],
-    "case": STATE_COLUMNS["case"],
-    "seed": STATE_COLUMNS["seed"],
+    "peak_rss_mb": RECORD_COLUMN_DOCS["peak_rss_mb"],
+    "case": SHEAR_STATE_COLUMNS["case"],
+    "seed": SHEAR_STATE_COLUMNS["seed"],
     "n": "particles, uniform over the domain",
     "length": "length of the periodic domain in x [L]",
     "strip_lo": "left end of the initial strip [L]",
@@ -117,7 +142,7 @@ SHEAR_SETTINGS = {  # shear step columns beyond shear2d.STEP_COLUMNS: the Record
     "t_final": "end time [T]",
 }
 LATTICE_COLUMNS = {  # lattice.lattice_run
-    **{c: COLUMN_DOCS[c] for c in CASE_COLUMNS},
+    **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},
     "time": "requested time [T]",
     "time_step": "time of the recorded step nearest to it [T]",
     "SSE": "SSE of the lattice run, Eq. 44 [1/L²]",
@@ -291,7 +316,7 @@ def keyed(names: Sequence[str], docs: Mapping[str, str]) -> dict[str, str]:
 
 def sections() -> list[Section]:
     """The page's tables in order, built from the column dicts as they are now."""
-    case = ("case.COLUMN_DOCS", {c: COLUMN_DOCS[c] for c in CASE_COLUMNS})
+    case = ("columns.CASE_COLUMN_DOCS", keyed(CASE_COLUMNS, CASE_COLUMN_DOCS))
     d = ("columnsdoc.RUN_SETTINGS", {"D": RUN_SETTINGS["D"]})
     same_columns = "(same columns for `fig9` and `mechanism`;"
     return [
@@ -300,7 +325,7 @@ def sections() -> list[Section]:
             (),
             "Most tables carry the case of a row as typed columns (`Case.columns()`). A *model* is a case at every "
             "N: tables keyed by model (minima, argmin shares) have all of these except `n`.",
-            (("case.COLUMN_DOCS", COLUMN_DOCS),),
+            (case,),
             grouped=False,
         ),
         Section(
@@ -310,7 +335,11 @@ def sections() -> list[Section]:
             "one case, told apart by `seed`, and step 0 is the initial condition. Written by rule `simulate` "
             "(`workflow/scripts/simulate.py`, `simulate.run_seeds`); what a measure is computed on depends on the "
             "method.",
-            (("records.COLUMNS", records.COLUMNS), case, ("columnsdoc.RUN_SETTINGS", RUN_SETTINGS)),
+            (
+                ("columns.RECORD_COLUMN_DOCS", keyed(records.COLUMNS, RECORD_COLUMN_DOCS)),
+                case,
+                ("columnsdoc.RUN_SETTINGS", RUN_SETTINGS),
+            ),
         ),
         Section(
             "Final states",
@@ -411,13 +440,13 @@ def sections() -> list[Section]:
             ("results/shear/<shear_case>/seed~<S>/steps.parquet",),
             "One row per time step of one Appendix-B shear-flow run (case `rw_nodrift`, `rw_drift` or `mt`, seed "
             "S), the run's settings repeated on every row. Written by rule `simulate_shear` (`shear2d.run_shear`).",
-            (("shear2d.STEP_COLUMNS", STEP_COLUMNS), ("columnsdoc.SHEAR_SETTINGS", SHEAR_SETTINGS)),
+            (("columnsdoc.SHEAR_STEP_COLUMNS", SHEAR_STEP_COLUMNS), ("columnsdoc.SHEAR_SETTINGS", SHEAR_SETTINGS)),
         ),
         Section(
             "Shear-flow final states",
             ("results/shear/<shear_case>/seed~<S>/state.parquet",),
             "One row per particle at t_final of one shear-flow run. Written by rule `simulate_shear`.",
-            (("shear2d.STATE_COLUMNS", STATE_COLUMNS),),
+            (("columnsdoc.SHEAR_STATE_COLUMNS", SHEAR_STATE_COLUMNS),),
         ),
         Section(
             "Lattice floors",
