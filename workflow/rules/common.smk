@@ -102,23 +102,17 @@ def rebuildable(tables):
 # tables before it plans), and any run while a lock is held, which Snakemake then refuses (another
 # run is writing these tables; a stale lock needs --unlock, which also only looks). Snakemake
 # takes its lock after this file is read, so two runs started in the same instant may both check.
-DRY_RUN = bool(getattr(workflow.output_settings, "dryrun", False))
-NO_JOB_FLAGS = {  # Snakemake options after which it runs no job
-    *("--unlock", "--summary", "-S", "--detailed-summary", "-D", "--list-rules", "--list", "-l"),
-    *("--list-target-rules", "--lt", "--dag", "--rulegraph", "--filegraph", "--d3dag", "--lint"),
-    *("--list-changes", "--lc", "--list-input-changes", "--li", "--list-params-changes", "--lp"),
-    *("--list-code-changes", "--list-untracked", "--lu", "--cleanup-metadata", "--cm"),
-    *("--cleanup-shadow", "--report", "--archive", "--containerize", "--export-cwl"),
-    *("--generate-unit-tests", "--delete-all-output", "--delete-temp-output", "--conda-create-envs-only"),
-    *("--conda-cleanup-envs", "--conda-list-envs"),
-}
+# Snakemake picks its action (a run, --unlock, --summary, --dag ...) only after reading this file:
+# pipeline/invocation.py reads the command line again with Snakemake's own parser.
+from particle_entropy.pipeline.invocation import runs_no_job, snakemake_options
+
+DRY_RUN = bool(getattr(workflow.output_settings, "dryrun", False))  # from a profile too
 
 
 def looks_only():
     """Whether this invocation must change no table (see above)."""
-    flags = {a.split("=", 1)[0] for a in sys.argv[1:]}
     locks = Path(".snakemake/locks")
-    return DRY_RUN or bool(flags & NO_JOB_FLAGS) or (locks.is_dir() and any(locks.iterdir()))
+    return DRY_RUN or runs_no_job(snakemake_options(sys.argv)) or (locks.is_dir() and any(locks.iterdir()))
 
 
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
