@@ -110,3 +110,69 @@ def test_runconfig_defaults_are_the_settings():
     cfg = RunConfig.of(method="mtpt", n=300).resolved()
     for s in S.SETTINGS:
         assert getattr(cfg, s.name, getattr(cfg.case, s.name, None)) == s.default or s.name in ("fd_dt", "fixed_dt"), s
+
+
+# --------------------------------------------------------------------------- every declared section
+def _entry_at(key: str) -> dict:
+    """The schema entry of a declared setting's key, wherever its section sits in the schema."""
+    parts = key.replace("[]", ".[]").split(".")
+    if parts[0] == "<section>":
+        node = SCHEMA["$defs"]["case_section"]
+        parts = parts[1:]
+    else:
+        node = SCHEMA
+    for part in parts:
+        if part == "[]":
+            node = node["items"]
+        elif part == "<name>":
+            (node,) = node["patternProperties"].values()
+        else:
+            node = node["properties"][part]
+    return node
+
+
+@pytest.mark.parametrize("setting", [s for s in S.DECLARED if s.section != "case_defaults"], ids=lambda s: s.key)
+def test_every_declared_setting_reads_back_from_the_schema(setting):
+    """Default, words, bounds and meaning of every declared key are the schema's (schemagen)."""
+    entry = _entry_at(setting.key)
+    assert setting.doc[1:] in entry["description"] and setting.allowed() in entry["description"]
+    if setting.has_default and "$ref" in entry:  # the referenced definition carries it
+        assert SCHEMA["$defs"][entry["$ref"].rsplit("/", 1)[1]]["default"] == setting.default
+    elif setting.has_default:
+        assert entry["default"] == ("none" if setting.none and setting.default is None else setting.default)
+    else:
+        assert "default" not in entry
+    if setting.choices is not None:
+        assert tuple(entry["enum"]) == setting.choices
+    if setting.kind in ("number", "integer") and setting.choices is None and not setting.none:
+        assert entry["type"] == setting.kind
+        low = entry.get("exclusiveMinimum" if setting.open_low else "minimum")
+        assert low == setting.low and entry.get("maximum", math.inf) == setting.high
+
+
+def test_a_declared_section_is_required_where_it_says():
+    shear = SCHEMA["properties"]["shear"]
+    assert shear["required"] == [s.name for s in S.SHEAR if s.required]
+    assert "beta" not in shear["required"]  # it has a default that config.yaml may leave to it
+    search = SCHEMA["properties"]["optimum"]["patternProperties"]
+    (search,) = search.values()
+    assert search["required"] == ["case", "time"]
+
+
+def test_the_caps_are_declared_once():
+    """Every cap on realisations in the schema is settings.MAX_REALISATIONS (10,000: more is a typo)."""
+    assert S.MAX_REALISATIONS == 10_000
+    caps = [
+        _entry_at("realisations[].count")["maximum"],
+        SCHEMA["$defs"]["realisations"]["oneOf"][0]["maximum"],
+        _entry_at("<section>.max_realisations")["maximum"],
+        _entry_at("optimum.<name>.max_realisations")["maximum"],
+    ]
+    assert caps == [S.MAX_REALISATIONS] * 4
+
+
+def test_every_paper_figure_has_its_schema_entry_and_only_those():
+    from particle_entropy.figures import PAPER_FIGURES
+
+    assert list(SCHEMA["properties"]["figures"]["properties"]) == list(PAPER_FIGURES)
+    assert PAPER_FIGURES == tuple(f"fig{k}" for k in range(1, 10))  # the paper's case-drawn figures

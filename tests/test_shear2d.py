@@ -18,8 +18,8 @@ import pytest
 from conftest import no_runtime_warnings
 
 from particle_entropy.core.runconfig import SettingError
+from particle_entropy.core.settings import SHEAR_MAX_N as MAX_N
 from particle_entropy.models.shear2d import (
-    MAX_N,
     ShearConfig,
     kernel_cutoff,
     run_shear,

@@ -8,7 +8,7 @@ redraws figures and rebuilds those tables but reruns no simulation.
 from __future__ import annotations
 
 from .case import Case
-from .registry import PRESETS
+from .registry import AUTHORS_SPH_CONSTANT, PRESETS
 
 KERNEL_NAMES = {
     "bins": "binned",
@@ -25,7 +25,7 @@ SCHEME_LABELS = {  # legend text of a non-default scheme (registry.SCHEME_RECORD
     "sequential_sorted": "sequential loop in position order",
     "sequential_symnorm": "sequential loop, symmetric weights",
     "sequential_noclip": "sequential loop, no clipping",
-    "authors": "sequential loop, SPH constant 0.822",
+    "authors": f"sequential loop, SPH constant {AUTHORS_SPH_CONSTANT:g}",
 }
 PRESET_LABELS = {"authors": "the authors' algorithm"}  # a case whose dimensions are all its preset's
 

@@ -19,6 +19,10 @@ ALL_KERNELS = tuple(k for m in METHODS for k in KERNELS[m])
 DEFAULT_KERNEL = {m: KERNELS[m][0] for m in METHODS}  # bins, collision, implicit
 
 
+SPH_CONSTANT = 0.82  # the constant of the adaptive SPH bandwidth, Eq. 26
+AUTHORS_SPH_CONSTANT = 0.822  # the same constant in the authors' script
+
+
 @dataclass(frozen=True)
 class Scheme:
     """How MTPT transfers mass: the flags the step reads (models/mtpt.py) and what they mean.
@@ -39,7 +43,7 @@ class Scheme:
     symnorm: bool = False
     clip: bool = True
     compensated: bool = False
-    sph_constant: float = 0.82
+    sph_constant: float = SPH_CONSTANT
 
 
 # The first two are the paper's equations and the authors' code; each later one changes one
@@ -69,9 +73,10 @@ SCHEME_RECORDS = {
         Scheme("sequential_noclip", "the authors' loop without clipping negative masses", sequential=True, clip=False),
         Scheme(
             "authors",
-            "the authors' loop with their script's SPH constant 0.822 (Eq. 26 has 0.82)",
+            f"the authors' loop with their script's SPH constant {AUTHORS_SPH_CONSTANT:g} "
+            f"(Eq. 26 has {SPH_CONSTANT:g})",
             sequential=True,
-            sph_constant=0.822,
+            sph_constant=AUTHORS_SPH_CONSTANT,
         ),
     )
 }

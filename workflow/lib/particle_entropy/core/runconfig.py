@@ -23,6 +23,11 @@ def check_setting(setting: Setting, value):
         return value
     if setting.none and value is None:
         return value
+    if setting.kind == "integer":
+        whole = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+        if not whole or not setting.low <= value <= setting.high:
+            raise SettingError(setting.name, value, setting.allowed())
+        return value
     return check_range(setting.name, value, setting.low, setting.high, open_low=setting.open_low)
 
 
@@ -99,6 +104,11 @@ class RunConfig:
     dt_growth = property(lambda self: self.case.dt_growth)
     scheme = property(lambda self: self.case.scheme)
     time_grid = property(lambda self: self.case.time_grid)
+
+    @property
+    def dV(self) -> float:
+        """A particle's sampling volume dV = Omega / N (the Delta V of Eqs. 5-9; the bin width of Eq. 11)."""
+        return self.omega / self.n
 
     def resolved(self) -> RunConfig:
         """Fill the first step (first_step) and check every setting."""

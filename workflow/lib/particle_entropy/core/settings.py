@@ -79,6 +79,8 @@ class Setting:
         """The allowed values in words, as error messages and help texts give them."""
         if self.range_text is not None:
             return self.range_text
+        if self.kind == "shape":
+            raise ValueError(f"setting {self.key}: a structured value needs its range_text")
         if self.choices is not None:
             return "one of " + ", ".join(self.choices)
         if self.kind == "boolean":
@@ -225,6 +227,7 @@ CASE_SECTION = (
         "particle numbers (FD: intervals)",
         kind="shape",
         shape=_ref("ns"),
+        range_text="a list of integers >= 2",
         required=True,
     ),
     Setting(
@@ -337,6 +340,9 @@ MECHANISM = (
 )
 # what each object of these sections holds (the schema's description of the object itself)
 SECTION_DOCS = {
+    "figures": "The cases of each figure (figures.FIGURES: fig1 ... fig9; fig10 is the shear section).",
+    "<section>": "Cases x n: the models drawn, the N and the realisations of each N.",
+    "realisations[]": "One N and its number of realisations.",
     "tradeoff": "Speed-accuracy sweep: cases x n like a figure, plus the times to tabulate.",
     "mechanism": "Controlled experiments behind figures/fig9_mechanism.png (its own target): case sweeps at "
     "shared seeds, and the Fig. 8 domain experiment.",
@@ -345,6 +351,8 @@ SECTION_DOCS = {
     "mechanism.fd_domain": "Fig. 8's late error: implicit FD at these grids (n = fd_length_paper / dx) on domains "
     "of these lengths, same dx.",
     "shear": "Fig. 10 (Appendix B): 2-D shear flow v_x = y - y^2, D = diag(alpha_L v_x, alpha_T v_x).",
+    "optimum": "Adaptive searches for the N minimising mean COMIC (its own target: snakemake -j2 optimum; "
+    "results/optimum/<name>.parquet, figures/optimum_<name>.png), one per key (letters, digits, _).",
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }
@@ -366,7 +374,17 @@ SHEAR = (  # Appendix B; ShearConfig's fields (models/shear2d.py) besides `case`
         range_text="a list of " + ", ".join(SHEAR_CASES) + ", each once",
         required=True,
     ),
-    Setting("seed", "shear.seed", 0, "random seed", kind="integer", low=0, high=MAX_SEED, required=True),
+    Setting(
+        "seed",
+        "shear.seed",
+        0,
+        "random seed",
+        kind="integer",
+        low=0,
+        high=MAX_SEED,
+        range_text="an integer in [0, 2^63 - 1] (stored as int64)",
+        required=True,
+    ),
     Setting(
         "n",
         "shear.n",

@@ -73,7 +73,7 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
     """H_D of the masses (Eq. 2), E (Eq. 9), H_PMF, SSE and COMIC against the Gaussian, and both at
     the measurement points (m / dV linearly interpolated between the sorted particles, 0 outside
     the cloud, measures.sse_points)."""
-    dV = cfg.omega / cfg.n
+    dV = cfg.dV
     total = float(m.sum())
     h_d = M.entropy_discrete(m / total)
     g = M.analytic_sampled(x, cfg.D, t, dV)

@@ -16,7 +16,7 @@ from ..numerics.kernels import h_de
 def reconstruction_width(cfg: RunConfig, t: float) -> float:
     """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23)."""
     if cfg.kernel == "bins":
-        return cfg.omega / cfg.n
+        return cfg.dV
     if cfg.kernel == "fixed":
         return math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
     return h_de(cfg.n, cfg.D, t)
@@ -63,7 +63,7 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     """Entropies, dilution index and fitness of the reconstruction at time t; SSE_points and
     COMIC_points interpolate the same reconstruction (bin centres or the kernel's grid) to the
     measurement points (measures.sse_points)."""
-    dV = cfg.omega / cfg.n
+    dV = cfg.dV
     pts, f, spacing, h = reconstruct(cfg, x_sorted, t)
     points = M.measurement_points()
     if h == 0.0:

@@ -32,7 +32,8 @@ import numpy as np
 
 from ..core.records import Recorder
 from ..core.registry import SHEAR_CASES
-from ..core.runconfig import MAX_SEED, SettingError, check_range
+from ..core.runconfig import SettingError, check_range, check_setting
+from ..core.settings import SHEAR, defaults
 from ..core.timegrid import MAX_STEPS
 
 if TYPE_CHECKING:
@@ -41,50 +42,47 @@ if TYPE_CHECKING:
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
 V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
 KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
-MAX_N = 10**8  # particles (schema too): 5,000 x the paper's, ~40 GB for a random walk; more is a typo
+
+
+SHEAR_DEFAULTS = defaults(SHEAR)  # settings.SHEAR: each field's default, range and meaning
 
 
 @dataclass(frozen=True)
 class ShearConfig:
+    """One shear run: a case of SHEAR_CASES and the settings of config `shear` (settings.SHEAR)."""
+
     case: str = "mt"
-    n: int = 20_000  # particles, uniform over the whole domain
-    length: float = 400.0  # periodic domain length in x [L]
-    strip_lo: float = 90.0  # initial strip 90 < x < 110 [L]
-    strip_hi: float = 110.0
-    alpha_L: float = 1e-2  # longitudinal dispersivity [L]
-    alpha_T: float = 1e-3  # transverse dispersivity [L]
-    dt: float = 1.0  # [T]
-    t_final: float = 500.0  # [T]
-    beta: float = 0.5  # mass-transfer coefficient of Eq. 16
-    seed: int = 0
+    n: int = SHEAR_DEFAULTS["n"]  # particles, uniform over the whole domain
+    length: float = SHEAR_DEFAULTS["length"]  # periodic domain length in x [L]
+    strip_lo: float = SHEAR_DEFAULTS["strip_lo"]  # initial strip strip_lo < x < strip_hi [L]
+    strip_hi: float = SHEAR_DEFAULTS["strip_hi"]
+    alpha_L: float = SHEAR_DEFAULTS["alpha_L"]  # longitudinal dispersivity [L]
+    alpha_T: float = SHEAR_DEFAULTS["alpha_T"]  # transverse dispersivity [L]
+    dt: float = SHEAR_DEFAULTS["dt"]  # [T]
+    t_final: float = SHEAR_DEFAULTS["t_final"]  # [T]
+    beta: float = SHEAR_DEFAULTS["beta"]  # mass-transfer coefficient of Eq. 16
+    seed: int = SHEAR_DEFAULTS["seed"]
 
     def __post_init__(self):
         self.check()
 
     def check(self) -> None:
-        """Raise SettingError naming the first setting outside its allowed range."""
+        """Raise SettingError naming the first setting outside its allowed range (settings.SHEAR),
+        then the rules between them: the strip inside the domain, whole steps, the kernel in the box."""
         if self.case not in SHEAR_CASES:
             raise SettingError("case", self.case, f"one of {', '.join(SHEAR_CASES)}")
-        if isinstance(self.n, bool) or not isinstance(self.n, (int, np.integer)) or not 1 <= self.n <= MAX_N:
-            raise SettingError("n", self.n, f"an integer in [1, {MAX_N:,}]")
-        check_range("length", self.length, 0.0, math.inf, open_low=True)
+        for s in SHEAR:
+            if s.name != "cases":
+                check_setting(s, getattr(self, s.name))
         check_range("strip_lo", self.strip_lo, 0.0, self.length)
         check_range("strip_hi", self.strip_hi, self.strip_lo, self.length, open_low=True)
-        check_range("alpha_L", self.alpha_L, 0.0, math.inf, open_low=True)
-        check_range("alpha_T", self.alpha_T, 0.0, math.inf)
-        check_range("dt", self.dt, 0.0, math.inf, open_low=True)
-        check_range("t_final", self.t_final, 0.0, math.inf)
         steps = self.t_final / self.dt
         if abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
             raise SettingError("t_final", self.t_final, f"a whole number of steps dt={self.dt!r}")
-        check_range("beta", self.beta, 0.0, 1.0)
         if steps > MAX_STEPS:
             raise SettingError(
                 "dt", self.dt, f"at most {MAX_STEPS:,} steps to t_final: dt >= {self.t_final / MAX_STEPS:.3g}"
             )
-        seed_ok = isinstance(self.seed, (int, np.integer)) and not isinstance(self.seed, bool)
-        if not seed_ok or not 0 <= self.seed <= MAX_SEED:
-            raise SettingError("seed", self.seed, f"an integer in [0, 2^63 - 1 = {MAX_SEED}] (stored as int64)")
         if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
             # the minimum-image distance in x is only exact while the kernel fits in half the box
             raise SettingError(

@@ -93,7 +93,7 @@ def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) ->
         t = ts[k]
         x, m, label, h, beta, sub = mtpt.step(cfg, x, m, label, dt, t, rng, order_rng)
         _row(rec, cfg, k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
-    dV = cfg.omega / cfg.n
+    dV = cfg.dV
     return {"x": x, "mass": m, "c": m / dV}
 
 

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from ..core.registry import SPH_CONSTANT
+
 
 def collision_sigma(eta: float, D: float, dt: float) -> float:
     """Standard deviation of the collision kernel, variance 4 eta D dt (Eq. 17)."""
@@ -17,11 +19,8 @@ def h_de(n: int, D: float, t: float) -> float:
     return 1.06 * n ** (-0.2) * math.sqrt(2.0 * D * t)
 
 
-SPH_CONSTANT = 0.82  # Eq. 26; the authors' script has 0.822 (registry.SCHEME_RECORDS["authors"])
-
-
 def h_sph(n: int, omega: float, D: float, t: float, constant: float = SPH_CONSTANT) -> float:
-    """Adaptive SPH bandwidth h_SPH = 0.82 (2 D t)^(2/5) (N / Omega)^(-1/5) (Eq. 26)."""
+    """Adaptive SPH bandwidth h_SPH = 0.82 (2 D t)^(2/5) (N / Omega)^(-1/5) (Eq. 26; registry.SPH_CONSTANT)."""
     return constant * (2.0 * D * t) ** 0.4 * (n / omega) ** (-0.2)
 
 

@@ -28,6 +28,7 @@ from ..core import records
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS
 from ..core.columns import CASE_COLUMN_DOCS, RECORD_COLUMN_DOCS
 from ..core.registry import SHEAR_CASES
+from ..core.settings import SHEAR
 from ..figures import fig10, style
 from ..models.shear2d import WALL_BAND
 
@@ -127,19 +128,12 @@ SHEAR_STATE_COLUMNS = {  # shear2d.run_shear's final particle table
     "seed": "random seed",
 }
 SHEAR_SETTINGS = {  # shear step columns beyond SHEAR_STEP_COLUMNS: the Recorder's and ShearConfig.case_columns
-    "dt": "the run's fixed time step (setting) [T]",
-    "beta": "the run's mass-transfer coefficient of Eq. 16 (setting; used by `mt` only)",
     "work": "running sum of `substeps` (0 for random walks); unlike the 1-D run tables it does not count particles",
     "peak_rss_mb": RECORD_COLUMN_DOCS["peak_rss_mb"],
     "case": SHEAR_STATE_COLUMNS["case"],
     "seed": SHEAR_STATE_COLUMNS["seed"],
-    "n": "particles, uniform over the domain",
-    "length": "length of the periodic domain in x [L]",
-    "strip_lo": "left end of the initial strip [L]",
-    "strip_hi": "right end of the initial strip [L]",
-    "alpha_L": "longitudinal dispersivity [L]",
-    "alpha_T": "transverse dispersivity [L]",
-    "t_final": "end time [T]",
+    # the run's settings, as config `shear` declares them (settings.SHEAR)
+    **{s.name: s.doc + ("" if s.unit == "-" else f" [{s.unit}]") for s in SHEAR if s.name not in ("cases", "seed")},
 }
 LATTICE_COLUMNS = {  # lattice.lattice_run
     **{c: CASE_COLUMN_DOCS[c] for c in CASE_COLUMNS},

@@ -1,12 +1,15 @@
-"""Write the run settings' entries of the config schema from their one definition (settings.py).
+"""Write the config schema's entries from their one declaration (core/settings.py).
 
 The schema (workflow/schemas/config.schema.yaml) is hand-written except between the lines
-``# BEGIN generated: <block>`` and ``# END generated: <block>``: there this module writes the
-entries of physics, time, numerics and case_defaults (type, range or enum, default, description),
-the $defs of the case dimensions and the shear cases' enum, from ``settings.SETTINGS`` and the registry. Snakemake
-reads the schema from a file, so the generated lines are committed;
-``python -m particle_entropy.pipeline.schemagen --check`` (and tests/test_settings.py) fails
-when they are stale, ``--write`` rewrites them.
+``# BEGIN generated: <block>`` and ``# END generated: <block>``: there this module writes, from
+the declarations of core/settings.py, the registry and the list of figures (figures.FIGURES),
+the entries of physics, time, numerics and case_defaults, the $defs of the case dimensions and
+of a section of cases, and the whole objects of figures, tradeoff, mechanism, shear, an adaptive
+search and a `realisations` entry (type, range or enum, default, description, required keys).
+What stays hand-written is the frame: the top-level keys and the few rules between keys a schema
+can say (a search's budget and range). Snakemake reads the schema from a file, so the generated
+lines are committed; ``python -m particle_entropy.pipeline.schemagen --check`` (and
+tests/test_settings.py) fails when they are stale, ``--write`` rewrites them.
 """
 
 from __future__ import annotations
@@ -16,11 +19,27 @@ import json
 import math
 import re
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from ..core.case import NONE
-from ..core.registry import ALL_KERNELS, METHODS, PRESETS, SHEAR_CASES
-from ..core.settings import SETTINGS, Setting
+from ..core.registry import ALL_KERNELS, METHODS, PRESETS
+from ..core.settings import (
+    BY_KEY,
+    CASE_SECTION,
+    FIGURE_OPTIONS,
+    MAX_REALISATIONS,
+    MECHANISM,
+    REALISATIONS_DOC,
+    REALISATIONS_ENTRY,
+    SEARCH,
+    SECTION_DOCS,
+    SETTINGS,
+    SHEAR,
+    TRADEOFF,
+    Setting,
+)
+from ..figures import PAPER_FIGURES
 from .configcheck import SCHEMA_PATH
 
 COMMAND = "python -m particle_entropy.pipeline.schemagen --write"
@@ -55,26 +74,75 @@ def description(s: Setting) -> str:
     return f"{s.doc[0].upper()}{s.doc[1:]}{unit}; {s.allowed()}."
 
 
+class Block(dict):
+    """A mapping the schema writes in block style, one key a line (other mappings: flow style)."""
+
+
 def entry(s: Setting, default: bool = True) -> dict:
     """The JSON-schema entry of one setting."""
     out: dict = {}
-    if s.choices is not None:
+    if s.kind == "shape":
+        out = dict(s.shape)
+    elif s.kind == "boolean":
+        out = {"type": "boolean"}
+    elif s.choices is not None:
         out = {"type": "string", "enum": list(s.choices)}
     else:
-        number = {"type": "number"}
+        number = {"type": "integer" if s.kind == "integer" else "number"}
         if s.low is not None:
             number["exclusiveMinimum" if s.open_low else "minimum"] = _number(s.low)
         if s.high != math.inf:
             number["maximum"] = _number(s.high)
         out = {"oneOf": [{"type": "string", "enum": [NONE]}, number]} if s.none else number
-    if default:
+    if default and s.has_default and "$ref" not in out:  # a referenced definition carries its own default
         out["default"] = NONE if s.none and s.default is None else s.default
     out["description"] = description(s)
     return out
 
 
-def blocks() -> dict[str, list[tuple[str, dict]]]:
-    """(key, entry) lines of every generated block."""
+def object_body(section: str, settings) -> Block:
+    """The schema of the object at config key ``section``: its meaning (settings.SECTION_DOCS),
+    an entry per setting directly in it, the objects nested in it (``section.sub``, in the order
+    of their first setting) and the keys it requires."""
+    props, required = Block(), []
+    for s in settings:
+        if s.section == section:
+            props[s.name] = entry(s)
+            if s.required:
+                required.append(s.name)
+        elif s.section.startswith(section + "."):
+            sub = s.section[len(section) + 1 :].split(".")[0]
+            if sub not in props:
+                props[sub] = object_body(f"{section}.{sub}", settings)
+    out = Block(type="object", description=SECTION_DOCS[section], additionalProperties=False, properties=props)
+    if required:
+        out["required"] = required
+    return out
+
+
+def case_section(section: str, extra=()) -> tuple[Setting, ...]:
+    """The settings of a section of cases at config key ``section`` (settings.CASE_SECTION), and ``extra``."""
+    return tuple(replace(s, key=f"{section}.{s.name}") for s in CASE_SECTION) + tuple(extra)
+
+
+def figures_body() -> Block:
+    """The `figures` object: one entry per paper figure (figures.PAPER_FIGURES), a section of cases
+    with the figure's drawing options where it has some (settings.FIGURE_OPTIONS)."""
+    props = Block()
+    for fig in PAPER_FIGURES:
+        options = [s for s in FIGURE_OPTIONS if s.section == f"figures.{fig}"]
+        if options:
+            body = object_body(
+                "<section>", case_section("<section>", [replace(s, key=f"<section>.{s.name}") for s in options])
+            )
+            props[fig] = body
+        else:
+            props[fig] = {"$ref": "#/$defs/case_section"}
+    return Block(type="object", description=SECTION_DOCS["figures"], additionalProperties=False, properties=props)
+
+
+def blocks() -> dict[str, Block]:
+    """Every generated block: its keys and their values, as the schema writes them."""
     out: dict[str, list[tuple[str, dict]]] = {"physics": [], "time": [], "numerics": [], "case_defaults": []}
     defs = [
         ("method", {"type": "string", "enum": list(METHODS), "description": "pt, mtpt or fd (registry.METHODS)."}),
@@ -105,8 +173,54 @@ def blocks() -> dict[str, list[tuple[str, dict]]]:
             out["case_defaults"].append((key, {"$ref": f"#/$defs/{key}", "default": d}))
         else:
             out[s.section].append((key, entry(s)))
+    dims = [s.key.split(".", 1)[1] for s in SETTINGS if s.section == "case_defaults"]
+    case = {k: {"$ref": f"#/$defs/{k}"} for k in ("method", "kernel", "preset", *dims)}
+    defs.append(
+        (
+            "case",
+            Block(
+                type="object",
+                description=f"One model: method and kernel, and the dimensions {', '.join(dims)} that apply to it "
+                "(unset ones come from case_defaults).",
+                additionalProperties=False,
+                properties=Block(case),
+                required=["method", "kernel"],
+            ),
+        )
+    )
+    defs.append(("case_section", object_body("<section>", CASE_SECTION)))
+    defs.append(
+        (
+            "realisations",
+            {
+                "description": f"Realisations per N, {REALISATIONS_DOC}.",
+                "default": BY_KEY["<section>.realisations"].default,
+                "oneOf": [
+                    {"type": "integer", "minimum": 1, "maximum": MAX_REALISATIONS},
+                    {"type": "string", "enum": ["ensemble"]},
+                ],
+            },
+        )
+    )
     out["defs"] = defs
-    out["shear_cases"] = [("items", {"type": "string", "enum": list(SHEAR_CASES)})]
+    generated = {name: Block(pairs) for name, pairs in out.items()}
+    generated["figures"] = figures_body()
+    generated["tradeoff"] = object_body("tradeoff", case_section("tradeoff", TRADEOFF))
+    generated["mechanism"] = object_body("mechanism", MECHANISM)
+    generated["shear"] = object_body("shear", SHEAR)
+    generated["search"] = object_body("optimum.<name>", SEARCH)
+    generated["realisations_entry"] = Block(items=object_body("realisations[]", REALISATIONS_ENTRY))
+    return generated
+
+
+def _lines(block: Block, indent: str) -> list[str]:
+    """``block`` as schema lines at ``indent``: nested Blocks in block style, other values in flow style."""
+    out = []
+    for key, value in block.items():
+        if isinstance(value, Block):
+            out += [f"{indent}{key}:\n", *_lines(value, indent + "  ")]
+        else:
+            out.append(f"{indent}{key}: {_yaml(value)}\n")
     return out
 
 
@@ -120,10 +234,8 @@ def render(text: str) -> str:
         if name not in generated:
             raise ValueError(f"schema block {name!r} is not one this module writes: {', '.join(generated)}")
         seen.add(name)
-        lines = [
-            f"{indent}# BEGIN generated: {name} (from core/settings.py and registry.py by `{COMMAND}`; do not edit)\n"
-        ]
-        lines += [f"{indent}{key}: {_yaml(value)}\n" for key, value in generated[name]]
+        lines = [f"{indent}# BEGIN generated: {name} (from core/settings.py by `{COMMAND}`; do not edit)\n"]
+        lines += _lines(generated[name], indent)
         return "".join(lines) + f"{indent}# END generated: {name}\n"
 
     out = _BLOCK.sub(fill, re.sub(r"# BEGIN generated: (\w+) \(.*\)\n", r"# BEGIN generated: \1\n", text))

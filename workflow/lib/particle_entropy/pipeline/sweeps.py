@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.runconfig import RunConfig, first_step
-from ..core.settings import PAPER, SETTINGS
+from ..core.settings import BY_KEY, PAPER, SETTINGS
 
 RUN_PATTERN = "results/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 SUMMARY_PATTERN = "results/tables/cases/" + CASE_DIR + "/r~{nreal}.parquet"
@@ -77,7 +77,7 @@ def lattice_cases(config: Mapping) -> list[Case]:
 
 def realisations_for(spec: Mapping, n: int, config: Mapping) -> int:
     """Realisations of one N in a section: an integer, or the `realisations` table (capped)."""
-    r = spec.get("realisations", 1)
+    r = spec.get("realisations", BY_KEY["<section>.realisations"].default)
     if r == "ensemble":
         table = {int(e["n"]): int(e["count"]) for e in config["realisations"]}
         if n not in table:
