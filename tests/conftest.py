@@ -1,7 +1,9 @@
-"""Shared references and helpers for the particle_entropy test suite.
+"""Shared references, paths and fixtures for the particle_entropy test suite.
 
 Every reference here is built from the paper's formulas with plain dense numpy, independently
-of the library code it is compared with.
+of the library code it is compared with. Paths are module constants, imported as
+``from conftest import ROOT, TINY`` (pytest puts tests/ on sys.path), so that module-level code
+such as parametrize lists can use them; what a test may change is a fixture, fresh for each test.
 """
 
 from __future__ import annotations
@@ -9,9 +11,14 @@ from __future__ import annotations
 import math
 import warnings
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]  # the checkout: Snakefile, config.yaml, workflow/
+TINY = ROOT / "tests" / "data" / "tiny_config.yaml"  # the small config of the workflow tests
 
 
 # --------------------------------------------------------------------------- dense references
@@ -81,3 +88,9 @@ def no_runtime_warnings():
 @pytest.fixture
 def rng():
     return np.random.default_rng(20200101)
+
+
+@pytest.fixture
+def tiny_config() -> dict:
+    """The tiny config, parsed afresh for each test: a test may edit it."""
+    return yaml.safe_load(TINY.read_text())

@@ -12,14 +12,12 @@ from pathlib import Path
 
 import pytest
 import yaml
+from conftest import ROOT, TINY
 from snakemake.utils import update_config
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.pipeline.configcheck import check_config
 from particle_entropy.pipeline.sweeps import check_sweeps, optimum_searches
-
-ROOT = Path(__file__).resolve().parents[1]
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
 
 
 def _merged() -> dict:
@@ -51,14 +49,14 @@ def test_the_merge_keeps_config_yamls_searches_past_the_tiny_t_final():
     assert "fd_t250" in config["optimum"] and config["optimum"]["fd_t250"]["time"] > config["physics"]["t_final"]
 
 
-def test_unused_searches_do_not_block_the_case_sections():
+def test_unused_searches_do_not_block_the_case_sections(tiny_config):
     config = _merged()
     check_sweeps(config)  # the figures, the mechanism, the trade-off: all fine
     searches = optimum_searches(config)
     assert "fd_t250" in list(searches)  # named, not yet judged
     with pytest.raises(SettingError, match=r"optimum\.fd_t250\.time=250"):
         searches["fd_t250"]
-    tiny_search = next(n for n in yaml.safe_load(TINY.read_text())["optimum"])
+    tiny_search = next(n for n in tiny_config["optimum"])
     assert searches[tiny_search].name == tiny_search  # the tiny config's own search is fine
 
 
@@ -68,10 +66,10 @@ def test_check_config_still_judges_every_search():
         check_config(_merged())
 
 
-def test_a_bad_search_is_refused_when_it_is_used():
+def test_a_bad_search_is_refused_when_it_is_used(tiny_config):
     config = copy.deepcopy(_merged())
     del config["optimum"]  # only the tiny config's searches, then break one of them
-    config["optimum"] = copy.deepcopy(yaml.safe_load(TINY.read_text())["optimum"])
+    config["optimum"] = tiny_config["optimum"]
     name = next(iter(config["optimum"]))
     config["optimum"][name]["time"] = 1e6
     with pytest.raises(SettingError, match=rf"optimum\.{name}\.time"):

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import math
 import zlib
-from pathlib import Path
 
 import matplotlib
 import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from conftest import ROOT
 
 from particle_entropy.core.labels import case_label
 
@@ -35,7 +35,7 @@ from particle_entropy.figures import (  # noqa: E402
 )
 from particle_entropy.models.simulate import run  # noqa: E402
 
-CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config.yaml").read_text())
+CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 NS = (30, 100)
 T = np.array([0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0])
 KW = {"D": 1e-3, "t_final": 20.0}
@@ -464,7 +464,7 @@ def test_fig9_draws_the_papers_bars_at_half_eq43s_width_when_asked():
 def test_figure_options_are_the_schemas_and_defaults_fill_in():
     from particle_entropy.figures import FIGURE_OPTIONS, figure_options
 
-    schema = yaml.safe_load((Path(__file__).parents[1] / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     for fig, options in FIGURE_OPTIONS.items():
         entries = schema["properties"]["figures"]["properties"][fig]["properties"]
         for key, (choices, default) in options.items():

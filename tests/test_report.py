@@ -26,11 +26,10 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from conftest import ROOT, TINY
 
 pytestmark = pytest.mark.browser
 
-ROOT = Path(__file__).resolve().parents[1]
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
 FIGURES = [f"fig{k}" for k in range(1, 11)] + ["tradeoff"]
 CATEGORY = {**{f: "Figures" for f in FIGURES}, "tradeoff": "Speed and accuracy"}
 # Headless, no GPU, no sandbox (root in a container), nothing fetched: every host name is unresolvable.

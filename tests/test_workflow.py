@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from conftest import ROOT, TINY
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
@@ -29,9 +30,7 @@ from particle_entropy.pipeline.sweeps import (
     spec_ensembles,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
 
 
 def load(path):
@@ -173,12 +172,12 @@ def test_tiny_run_builds_every_figure(tiny_run):
             assert f.exists() and f.stat().st_size > 5000, f
 
 
-def test_tiny_run_tables_have_documented_columns(tiny_run):
+def test_tiny_run_tables_have_documented_columns(tiny_run, tiny_config):
     comic = pd.read_parquet(tiny_run / "results/tables/comic.parquet")
     assert {"label", *CASE_COLUMNS, "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std", "n_realisations"} <= set(
         comic.columns
     )
-    cfg = load(TINY)
+    cfg = tiny_config
     expected = {e.case.model for f in ("fig8", "fig9") for e in figure_ensembles(cfg, f)}
     assert set(models_in(comic)) == expected
     minima = pd.read_parquet(tiny_run / "results/tables/comic_minima.parquet")
@@ -224,8 +223,8 @@ def test_summary_averages_its_realisations(tiny_run):
     assert summary["COMIC_mean"].iloc[last] == pytest.approx(expected[last], rel=1e-12)
 
 
-def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
-    cfg = load(TINY)
+def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["figures"]["fig9"]["n"] = cfg["figures"]["fig9"]["n"] + [400]
     cfg["realisations"].append({"n": 400, "count": 2})
     new = tmp_path / "more.yaml"
@@ -239,8 +238,8 @@ def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
     assert figs == {"figures/fig9.png", "figures/fig9.pdf"}
 
 
-def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
-    cfg = load(TINY)
+def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["realisations"] = [dict(e, count=e["count"] + 2) if e["n"] == 200 else e for e in cfg["realisations"]]
     new = tmp_path / "seeds.yaml"
     new.write_text(yaml.safe_dump(cfg, sort_keys=True))
@@ -263,8 +262,8 @@ def _expected_runs(cfg, fig):
 
 
 @pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
-def test_each_figure_target_plans_only_its_runs(fig, tmp_path):
-    cfg = load(TINY)
+def test_each_figure_target_plans_only_its_runs(fig, tmp_path, tiny_config):
+    cfg = tiny_config
     proc = snakemake(tmp_path, "-n", f"figures/{fig}.png", configfile=TINY)
     assert set(planned_outputs(proc)) == _expected_runs(cfg, fig)
     snaps = planned_outputs(proc, prefix="results/snapshots/")
@@ -343,16 +342,16 @@ def _cases_in(table):
 
 
 @pytest.mark.parametrize("fig", PLOTTED)
-def test_each_figure_writes_the_data_of_exactly_its_cases(tiny_run, fig):
-    cfg = load(TINY)
+def test_each_figure_writes_the_data_of_exactly_its_cases(tiny_run, fig, tiny_config):
+    cfg = tiny_config
     ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
     data = pd.read_parquet(tiny_run / f"results/figures/{fig}.parquet")
     assert {"series", *CASE_COLUMNS, "x", "y"} <= set(data.columns)
     assert _cases_in(data) == {e.case for e in ensembles}
 
 
-def test_an_added_case_is_drawn_from_its_summary(tiny_run):
-    cfg = load(TINY)
+def test_an_added_case_is_drawn_from_its_summary(tiny_run, tiny_config):
+    cfg = tiny_config
     spec = {"method": "mtpt", "kernel": "collision", "eta": 0.25, "truncation": 3}
     assert spec in cfg["figures"]["fig5"]["cases"]  # the tiny config's added case
     added = Case.from_spec(spec, 100, cfg["case_defaults"])
@@ -363,8 +362,8 @@ def test_an_added_case_is_drawn_from_its_summary(tiny_run):
     np.testing.assert_array_equal(rows["y"].to_numpy(), plotted)  # the figure shows the summary's values
 
 
-def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
-    cfg = load(TINY)
+def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run, tiny_config):
+    cfg = tiny_config
     base = Case.from_spec({"method": "mtpt", "kernel": "collision", "eta": 1}, None, cfg["case_defaults"])
     truncated = replace(base, truncation=3.0)
     sequential = replace(truncated, scheme="sequential")
@@ -387,8 +386,8 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
         assert claims["claim"].str.startswith(case_label(m) + ": COMIC minimum").sum() == 2, case_label(m)
 
 
-def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run):
-    cfg = load(TINY)
+def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run, tiny_config):
+    cfg = tiny_config
     proc = snakemake(tiny_run, "-n", "figures/fig9_mechanism.png", configfile=TINY)
     planned = [e for e in re.findall(r"wildcards: (.*)", proc.stdout) if "scheme=" in e]
     # the equations and the sequential loop are Fig. 9's cases: already run, never planned again
@@ -475,8 +474,8 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
         assert plan()[0] == set(), module
 
 
-def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path):
-    cfg = load(TINY)
+def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path, tiny_config):
+    cfg = tiny_config
     del cfg["shear"], cfg["tradeoff"]
     path = tmp_path / "lean.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
@@ -487,8 +486,8 @@ def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path):
 # --- corrupt tables are found before use and rebuilt ------------------------------------------
 
 
-def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
-    cfg = load(TINY)
+def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]  # a table Fig. 9 reads
     good = run.read_bytes()
     before = pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS))
@@ -503,8 +502,8 @@ def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
-def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run):
-    cfg = load(TINY)
+def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[-1], cfg)[-1]
     good = run.read_bytes()
     run.write_bytes(good[:100])
@@ -537,8 +536,8 @@ def test_set_aside_derived_tables_are_rebuilt_by_the_next_run(tiny_run):
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
-def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run):
-    cfg = load(TINY)
+def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]
     good = run.read_bytes()
     run.write_bytes(good[:100])
@@ -564,8 +563,8 @@ def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_r
     record.write_text(f"{hashlib.sha256(other.read_bytes()).hexdigest()}  {other.name}\n")
 
 
-def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run):
-    cfg = load(TINY)
+def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run, tiny_config):
+    cfg = tiny_config
     ensembles = figure_ensembles(cfg, "fig9")
     here, there = (tiny_run / case_run_paths(e, cfg)[0] for e in (ensembles[0], ensembles[1]))
     assert pd.read_parquet(here)["n"].iloc[0] != pd.read_parquet(there)["n"].iloc[0] or here.parent != there.parent
@@ -616,8 +615,8 @@ def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
     assert (tmp_path / "figures" / "fig8.png").stat().st_size > 100 * 1024
 
 
-def test_a_config_without_figures_judges_no_claim(tmp_path):
-    cfg = load(TINY)
+def test_a_config_without_figures_judges_no_claim(tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["figures"] = {}
     for key in ("shear", "tradeoff", "mechanism"):
         del cfg[key]
@@ -790,10 +789,10 @@ def test_every_derived_table_column_is_documented(tiny_run):
             assert not absent, f"{copy}: documented but absent: {sorted(absent)}"
 
 
-def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
+def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run, tiny_config):
     from particle_entropy.analysis.optimum import REASONS, RESULT_COLUMNS, Search
 
-    cfg = load(TINY)
+    cfg = tiny_config
     snakemake(tiny_run, "optimum", configfile=TINY)
     for name, spec in cfg["optimum"].items():
         search = Search.from_config(name, spec, cfg)
@@ -895,7 +894,7 @@ def test_parsing_the_workflow_imports_neither_scipy_nor_pandas(tmp_path):
     assert not seen["by"], seen["by"]
 
 
-def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run):
+def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run, tiny_config):
     import json
 
     digests = tiny_run / ".snakemake" / "particle_entropy" / "table_digests.json"
@@ -907,7 +906,7 @@ def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_r
     kept = digests.stat().st_mtime_ns
     snakemake(tiny_run, configfile=TINY)
     assert digests.stat().st_mtime_ns == kept  # nothing changed, nothing rewritten
-    cfg = load(TINY)
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
     run.write_bytes(run.read_bytes()[:100])  # in place: the same inode
     proc = snakemake(tiny_run, configfile=TINY)
