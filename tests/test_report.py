@@ -19,14 +19,13 @@ import os
 import queue
 import shutil
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
 
 import pandas as pd
 import pytest
-from conftest import ROOT, TINY
+from conftest import TINY, run_snakemake
 
 pytestmark = pytest.mark.browser
 
@@ -58,13 +57,6 @@ def chromium_binary() -> str:
             pytrace=False,
         )
     return binary
-
-
-def snakemake(workdir: Path, *args: str) -> None:
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2", *args]
-    proc = subprocess.run([*cmd, "--configfile", str(TINY)], capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise AssertionError(f"{' '.join(args) or 'snakemake'} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
 
 
 class Browser:
@@ -253,8 +245,8 @@ def report(tmp_path_factory):
     binary = chromium_binary()
     work = tmp_path_factory.mktemp("report")
     started = time.monotonic()
-    snakemake(work)
-    snakemake(work, "--report", str(work / "report.html"))
+    run_snakemake(work, configfile=TINY)
+    run_snakemake(work, "--report", work / "report.html", configfile=TINY)
     seen = {"built_s": time.monotonic() - started, "workdir": work}
     seen.update(browse(binary, work / "report.html", work))
     seen["seconds"] = time.monotonic() - started

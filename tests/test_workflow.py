@@ -6,7 +6,6 @@ import hashlib
 import re
 import shutil
 import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -14,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from conftest import ROOT, TINY
+from conftest import ROOT, TINY, run_snakemake, snakemake_command
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
@@ -35,16 +34,6 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 def load(path):
     return yaml.safe_load(Path(path).read_text())
-
-
-def snakemake(workdir, *args, configfile=None, check=True):
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2", *args]
-    if configfile:  # last: --configfile takes every following word as a file
-        cmd += ["--configfile", str(configfile)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if check and proc.returncode != 0:
-        raise AssertionError(f"snakemake failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    return proc
 
 
 def planned_outputs(proc, prefix="results/runs/"):
@@ -92,7 +81,7 @@ def test_bad_config_stops_before_any_job(tmp_path):
     cfg["figures"]["fig9"]["cases"][0]["eta"] = 2
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     out = proc.stdout + proc.stderr
     assert "eta" in out and "maximum" in out and "2" in out
@@ -104,7 +93,7 @@ def test_kernel_method_mismatch_is_refused(tmp_path):
     cfg["figures"]["fig1"]["cases"][0] = {"method": "pt", "kernel": "sph"}
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     assert "figures.fig1.cases[0].kernel='sph'" in proc.stdout + proc.stderr
 
@@ -114,7 +103,7 @@ def test_nan_in_the_yaml_is_refused_before_any_job(tmp_path):
     assert "D: .nan" in text
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     assert "physics.D=nan is not allowed: a finite number" in proc.stdout + proc.stderr
     assert not (tmp_path / "results").exists()
@@ -124,19 +113,19 @@ def test_nan_in_the_yaml_is_refused_before_any_job(tmp_path):
 
 
 def test_full_dry_run_plans_every_figure(tmp_path):
-    proc = snakemake(tmp_path, "-n", configfile=ROOT / "config.yaml")
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=ROOT / "config.yaml")
     out = proc.stdout + proc.stderr
     for k in range(1, 11):
         assert f"figures/fig{k}.png" in out
     assert "figures/tradeoff.png" in out and "results/paper_claims.md" in out
-    fig9 = planned_outputs(snakemake(tmp_path, "-n", "figures/fig9.png", configfile=ROOT / "config.yaml"))
+    fig9 = planned_outputs(run_snakemake(tmp_path, "figures/fig9.png", dry_run=True, configfile=ROOT / "config.yaml"))
     # 3 models x 2 schemes x (80 + 80 + 60 + 50 + 20 + 6 + 4 seeds in blocks of 20, N <= 30,000)
     assert len(fig9) == 6 * (4 + 4 + 3 + 3 + 1 + 1 + 1)
     assert "figures/fig9_mechanism.png" not in out  # its own target, not part of the paper's run
 
 
 def test_one_figure_runs_only_its_jobs(tmp_path):
-    proc = snakemake(tmp_path, "-n", "figures/fig8.png", configfile=ROOT / "config.yaml")
+    proc = run_snakemake(tmp_path, "figures/fig8.png", dry_run=True, configfile=ROOT / "config.yaml")
     runs = planned_outputs(proc)
     assert len(runs) == 7
     assert all(r.startswith("results/runs/fd/implicit/") for r in runs)
@@ -144,12 +133,12 @@ def test_one_figure_runs_only_its_jobs(tmp_path):
 
 
 def test_slurm_profile_parses(tmp_path):
-    proc = snakemake(
+    proc = run_snakemake(
         tmp_path,
-        "-n",
         "--profile",
         str(ROOT / "workflow/profiles/slurm"),
         "figures/fig8.png",
+        dry_run=True,
         configfile=ROOT / "config.yaml",
     )
     assert len(planned_outputs(proc)) == 7
@@ -161,7 +150,7 @@ def test_slurm_profile_parses(tmp_path):
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory):
     work = tmp_path_factory.mktemp("tiny")
-    snakemake(work, configfile=TINY)
+    run_snakemake(work, configfile=TINY)
     return work
 
 
@@ -229,7 +218,7 @@ def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path, tiny_config):
     cfg["realisations"].append({"n": 400, "count": 2})
     new = tmp_path / "more.yaml"
     new.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tiny_run, "-n", configfile=new)
+    proc = run_snakemake(tiny_run, dry_run=True, configfile=new)
     runs = planned_outputs(proc)
     assert runs and all("/n~400/" in r for r in runs)
     models = len(cfg["figures"]["fig9"]["cases"])
@@ -243,7 +232,7 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path, tiny_config):
     cfg["realisations"] = [dict(e, count=e["count"] + 2) if e["n"] == 200 else e for e in cfg["realisations"]]
     new = tmp_path / "seeds.yaml"
     new.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    runs = planned_outputs(snakemake(tiny_run, "-n", configfile=new))
+    runs = planned_outputs(run_snakemake(tiny_run, dry_run=True, configfile=new))
     assert runs and all("/n~200/" in r for r in runs)
     assert all(not r.endswith("seeds~0-0.parquet") and not r.endswith("seeds~1-1.parquet") for r in runs)
 
@@ -264,7 +253,7 @@ def _expected_runs(cfg, fig):
 @pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
 def test_each_figure_target_plans_only_its_runs(fig, tmp_path, tiny_config):
     cfg = tiny_config
-    proc = snakemake(tmp_path, "-n", f"figures/{fig}.png", configfile=TINY)
+    proc = run_snakemake(tmp_path, f"figures/{fig}.png", dry_run=True, configfile=TINY)
     assert set(planned_outputs(proc)) == _expected_runs(cfg, fig)
     snaps = planned_outputs(proc, prefix="results/snapshots/")
     assert (len(snaps) > 0) == (fig == "fig7")  # particle snapshots only where a figure plots them
@@ -272,7 +261,7 @@ def test_each_figure_target_plans_only_its_runs(fig, tmp_path, tiny_config):
 
 
 def test_fig10_target_runs_only_the_shear_cases(tmp_path):
-    proc = snakemake(tmp_path, "-n", "figures/fig10.png", configfile=TINY)
+    proc = run_snakemake(tmp_path, "figures/fig10.png", dry_run=True, configfile=TINY)
     assert planned_outputs(proc) == []
     shear = planned_outputs(proc, prefix="results/shear/")
     assert sorted(shear) == sorted(
@@ -289,19 +278,7 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     import time
 
     target = "results/tables/comic.parquet"
-    cmd = [
-        sys.executable,
-        "-m",
-        "snakemake",
-        "-s",
-        str(ROOT / "Snakefile"),
-        "-d",
-        str(tmp_path),
-        "-j2",
-        target,
-        "--configfile",
-        str(TINY),
-    ]
+    cmd = snakemake_command(tmp_path, target, configfile=TINY)
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.time() + 120
     while time.time() < deadline and len(list((tmp_path / "results").rglob("*.parquet"))) < 6:
@@ -309,10 +286,10 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)  # no clean-up: jobs die mid-write or mid-run
     proc.wait()
     assert not (tmp_path / target).exists(), "the run finished before it could be killed"
-    again = snakemake(tmp_path, target, configfile=TINY, check=False)  # the killed run's lock is still there
+    again = run_snakemake(tmp_path, target, configfile=TINY, check=False)  # the killed run's lock is still there
     assert again.returncode != 0 and "--unlock" in again.stdout + again.stderr
-    snakemake(tmp_path, "--unlock", configfile=TINY)  # README: after a kill -9, unlock, then the same command
-    snakemake(tmp_path, target, configfile=TINY)
+    run_snakemake(tmp_path, "--unlock", configfile=TINY)  # README: after a kill -9, unlock, then the same command
+    run_snakemake(tmp_path, target, configfile=TINY)
     assert (tmp_path / target).read_bytes() == (tiny_run / target).read_bytes()
     for new in (tmp_path / "results/runs").rglob("*.parquet"):
         old = tiny_run / new.relative_to(tmp_path)
@@ -322,7 +299,7 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
 
 
 def test_report_holds_every_figure_with_its_caption(tiny_run):
-    snakemake(tiny_run, "--report", "report.html", configfile=TINY)
+    run_snakemake(tiny_run, "--report", "report.html", configfile=TINY)
     html = (tiny_run / "report.html").read_text(errors="replace")
     assert len(html) > 100_000
     for k in range(1, 11):
@@ -388,12 +365,12 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run, ti
 
 def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run, tiny_config):
     cfg = tiny_config
-    proc = snakemake(tiny_run, "-n", "figures/fig9_mechanism.png", configfile=TINY)
+    proc = run_snakemake(tiny_run, "figures/fig9_mechanism.png", dry_run=True, configfile=TINY)
     planned = [e for e in re.findall(r"wildcards: (.*)", proc.stdout) if "scheme=" in e]
     # the equations and the sequential loop are Fig. 9's cases: already run, never planned again
     assert planned and not any("trunc=none" in e and "scheme=symmetric" in e for e in planned)
     assert not any("scheme=sequential," in e or e.endswith("scheme=sequential") for e in planned)
-    snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+    run_snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
     assert (tiny_run / "figures/fig9_mechanism.png").stat().st_size > 5000
     data = pd.read_parquet(tiny_run / "results/figures/fig9_mechanism.parquet")
     assert set(data["panel"]) == set("abcd")
@@ -427,27 +404,19 @@ def _planned_rules(proc):
     return set(re.findall(r"^\s*(?:local)?rule (\w+):", proc.stdout + proc.stderr, flags=re.M)) - {"all"}
 
 
-def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
-    src = tmp_path / "src"  # a copy of the workflow whose library we edit
-    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
+@pytest.fixture
+def tiny_run_copy(tiny_run, tmp_path):
+    """A copy of the finished tiny run (its report left out), for dry runs of an edited workflow_copy."""
     work = tmp_path / "work"
     shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
+    return work
+
+
+def test_code_edits_rerun_only_the_rules_that_use_that_code(workflow_copy, tiny_run_copy):
+    src, work = workflow_copy, tiny_run_copy  # the library of src is edited
 
     def plan():
-        cmd = [
-            sys.executable,
-            "-m",
-            "snakemake",
-            "-s",
-            str(src / "Snakefile"),
-            "-d",
-            str(work),
-            "-n",
-            "--configfile",
-            str(TINY),
-        ]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        proc = run_snakemake(work, snakefile=src / "Snakefile", dry_run=True, configfile=TINY)
         return _planned_rules(proc), proc
 
     assert plan()[0] == set()  # the same code in another place: nothing to do
@@ -479,7 +448,7 @@ def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path, tiny_co
     del cfg["shear"], cfg["tradeoff"]
     path = tmp_path / "lean.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=path)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=path)
     assert "figures/fig9.png" in proc.stdout and "fig10" not in proc.stdout and "tradeoff" not in proc.stdout
 
 
@@ -493,12 +462,12 @@ def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run, tiny_config):
     before = pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS))
     summaries = sorted((tiny_run / "results/tables/cases").rglob("*.parquet"))
     run.write_bytes(good[:100])  # truncate -s 100
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS)), before)  # rebuilt
     assert (run.parent / (run.name + ".corrupt")).exists()
     assert all(s.exists() for s in summaries)  # no good table was lost on the way
-    again = snakemake(tiny_run, "-n", configfile=TINY)
+    again = run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
@@ -508,11 +477,11 @@ def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run, tiny_config):
     good = run.read_bytes()
     run.write_bytes(good[:100])
     files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
-    snakemake(tiny_run, "-n", configfile=TINY)
+    run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert run.read_bytes() == good[:100]  # not moved, not repaired
     assert not (run.parent / (run.name + ".corrupt")).exists()
     assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
-    proc = snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
+    proc = run_snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0
 
@@ -528,11 +497,11 @@ def test_set_aside_derived_tables_are_rebuilt_by_the_next_run(tiny_run):
     before = {p: p.read_bytes() for p in derived}
     for p in derived:
         p.write_bytes(before[p][:100])
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     for p in derived:
         assert f"corrupt table {p.relative_to(tiny_run)}" in proc.stderr
         assert p.read_bytes() == before[p], p  # rebuilt, byte for byte
-    again = snakemake(tiny_run, "-n", configfile=TINY)
+    again = run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
@@ -550,13 +519,13 @@ def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_r
     outputs = [p.relative_to(tiny_run).as_posix() for p in (tiny_run / "results").rglob("*.parquet")]
     (locks / "0.output.lock").write_text("\n".join(outputs) + "\n")
     files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
-    snakemake(tiny_run, configfile=TINY, check=False)
+    run_snakemake(tiny_run, configfile=TINY, check=False)
     assert run.read_bytes() == good[:100]  # not set aside: no file under results/ added, moved or changed
     assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
-    unlock = snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
+    unlock = run_snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
     assert unlock.returncode == 0, unlock.stderr[-2000:]
     assert not (locks.exists() and any(locks.iterdir())) and run.read_bytes() == good[:100]  # only looked
-    proc = snakemake(tiny_run, configfile=TINY)  # the lock gone: checked, set aside, rebuilt
+    proc = run_snakemake(tiny_run, configfile=TINY)  # the lock gone: checked, set aside, rebuilt
     assert f"corrupt table {run.relative_to(tiny_run)}" in proc.stderr and pd.read_parquet(run).shape[0] > 0
     assert f"corrupt table {other.relative_to(tiny_run)}" not in proc.stderr  # read whole: sound
     record.rmdir()  # the module's run as it was, for the tests after this one
@@ -572,7 +541,7 @@ def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run,
     for suffix in ("", ".sha256"):  # a valid table and its matching checksum: whole, but the wrong case
         Path(str(here) + suffix).write_bytes(Path(str(there) + suffix).read_bytes())
     (here.parent / (here.name + ".sha256")).write_text((there.parent / (there.name + ".sha256")).read_text())
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table {here.relative_to(tiny_run)}" in proc.stderr and "another case's table" in proc.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(here).drop(columns=list(TIMING_COLUMNS)), before)
 
@@ -584,13 +553,13 @@ def test_a_second_run_in_the_same_directory_is_refused_and_the_first_completes(t
     import time
 
     target = "results/figures/fig8.parquet"  # FD only: a short run, long enough to be running still
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2", target]
-    first = subprocess.Popen([*cmd, "--configfile", str(TINY)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    cmd = snakemake_command(tmp_path, target, configfile=TINY)
+    first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     locks = tmp_path / ".snakemake" / "locks"
     deadline = time.time() + 120
     while time.time() < deadline and not (locks.exists() and any(locks.iterdir())):
         time.sleep(0.1)
-    second = snakemake(tmp_path, target, configfile=TINY, check=False)
+    second = run_snakemake(tmp_path, target, configfile=TINY, check=False)
     out, _ = first.communicate(timeout=600)
     assert second.returncode != 0 and "cannot be locked" in second.stdout + second.stderr
     assert first.returncode == 0, out[-3000:]
@@ -605,13 +574,12 @@ def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
         resource.setrlimit(resource.RLIMIT_FSIZE, (100 * 1024, 100 * 1024))
 
     env = {**os.environ, "PARTICLE_ENTROPY_MIN_FREE_MB": "1e12"}  # and every disk looks nearly full
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2"]
-    cmd += ["figures/fig8.png", "--configfile", str(TINY)]
-    full = subprocess.run(cmd, capture_output=True, text=True, env=env, preexec_fn=small_files)
+    target = "figures/fig8.png"
+    full = run_snakemake(tmp_path, target, configfile=TINY, env=env, preexec_fn=small_files, check=False)
     assert full.returncode != 0 and "Error in rule plot_fig8" in full.stdout + full.stderr
     assert "No space left on device? The file system holding" in full.stderr
     assert "rerun the same command" in full.stderr
-    subprocess.run(cmd, capture_output=True, text=True, env=env, check=True)  # room again: it completes
+    run_snakemake(tmp_path, target, configfile=TINY, env=env)  # room again: it completes
     assert (tmp_path / "figures" / "fig8.png").stat().st_size > 100 * 1024
 
 
@@ -622,7 +590,7 @@ def test_a_config_without_figures_judges_no_claim(tmp_path, tiny_config):
         del cfg[key]
     path = tmp_path / "none.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    snakemake(tmp_path, configfile=path)
+    run_snakemake(tmp_path, configfile=path)
     assert "No claim judged" in (tmp_path / "results/paper_claims.md").read_text()
     assert list(pd.read_parquet(tmp_path / "results/tables/paper_claims.parquet").columns) == [
         "claim",
@@ -641,7 +609,7 @@ def test_a_short_message_for_a_misspelt_key(tmp_path):
     text = (ROOT / "config.yaml").read_text().replace("physics:", "physic:", 1)
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "did you mean physics?" in out
     assert len(out.splitlines()) < 12  # not the whole schema and config around the one useful line
@@ -649,7 +617,7 @@ def test_a_short_message_for_a_misspelt_key(tmp_path):
 
 def test_a_yaml_error_in_config_yaml_names_its_line(tmp_path):
     (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\nshear: {n: 10\n")
-    proc = snakemake(tmp_path, "-n", check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, check=False)
     assert proc.returncode != 0 and "config.yaml: not valid YAML at line" in proc.stdout + proc.stderr
 
 
@@ -660,7 +628,7 @@ TEMPLATE = '__use_yte__: true\n?if __import__("pathlib").Path("{mark}").touch() 
 def test_a_template_in_config_yaml_is_refused_before_it_runs(tmp_path):
     mark = tmp_path / "ran"
     (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\n" + TEMPLATE.format(mark=mark))
-    proc = snakemake(tmp_path, "-n", check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "config.yaml: line" in out and "__use_yte__ makes Snakemake run" in out
     assert not mark.exists()  # checked before Snakemake loads it: the code never ran
@@ -669,7 +637,7 @@ def test_a_template_in_config_yaml_is_refused_before_it_runs(tmp_path):
 def test_a_template_configfile_is_refused_though_snakemake_ran_it(tmp_path):
     mark, template = tmp_path / "ran", tmp_path / "template.yaml"
     template.write_text(TEMPLATE.format(mark=mark))
-    proc = snakemake(tmp_path, "-n", configfile=template, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=template, check=False)
     assert proc.returncode != 0 and "template.yaml: line 1: __use_yte__" in proc.stdout + proc.stderr
     # Snakemake loads a --configfile before the Snakefile: the README says it is trusted as code
     assert mark.exists()
@@ -677,9 +645,9 @@ def test_a_template_configfile_is_refused_though_snakemake_ran_it(tmp_path):
 
 
 def test_nested_command_line_overrides_of_numbers_and_lists_work(tmp_path):
-    ok = snakemake(tmp_path, "-n", "--config", "physics={D: 0.002}", "comic_times=[5, 20]", configfile=TINY)
+    ok = run_snakemake(tmp_path, "--config", "physics={D: 0.002}", "comic_times=[5, 20]", dry_run=True, configfile=TINY)
     assert "physics.D" not in ok.stdout + ok.stderr
-    bad = snakemake(tmp_path, "-n", "--config", "physics={D: -1}", configfile=TINY, check=False)
+    bad = run_snakemake(tmp_path, "--config", "physics={D: -1}", dry_run=True, configfile=TINY, check=False)
     assert bad.returncode != 0 and "physics.D=-1 is not allowed" in bad.stdout + bad.stderr
 
 
@@ -699,7 +667,7 @@ CASE_PATH = "mtpt/collision/n~100/eta~1/trunc~none/growth~1.05/scheme~symmetric/
     ids=["seeds reversed", "seeds huge", "r 0", "eta 1e", "n 1", "unknown search"],
 )
 def test_a_hand_written_target_that_names_no_valid_run_is_refused_by_its_pattern(tmp_path, target, expected):
-    proc = snakemake(tmp_path, "-n", target, configfile=ROOT / "config.yaml", check=False)
+    proc = run_snakemake(tmp_path, target, dry_run=True, configfile=ROOT / "config.yaml", check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "WorkflowError" in out and expected in out, out[-1500:]
     assert not (tmp_path / "results").exists()
@@ -758,9 +726,9 @@ def test_every_derived_table_column_is_documented(tiny_run):
     import pyarrow.parquet as pq
 
     if not (tiny_run / "results/figures/fig9_mechanism.parquet").exists():  # the mechanism tables too
-        snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+        run_snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
     if not (tiny_run / "results/optimum").exists():  # and the optimum searches' plans and results
-        snakemake(tiny_run, "optimum", configfile=TINY)
+        run_snakemake(tiny_run, "optimum", configfile=TINY)
     sections = _column_doc_sections()
     tables = sorted((tiny_run / "results").rglob("*.parquet"))
     found = {}  # section heading -> {table: its columns}
@@ -793,7 +761,7 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run, tiny_co
     from particle_entropy.analysis.optimum import REASONS, RESULT_COLUMNS, Search
 
     cfg = tiny_config
-    snakemake(tiny_run, "optimum", configfile=TINY)
+    run_snakemake(tiny_run, "optimum", configfile=TINY)
     for name, spec in cfg["optimum"].items():
         search = Search.from_config(name, spec, cfg)
         for ext in ("png", "pdf"):
@@ -813,19 +781,15 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run, tiny_co
         assert int(table["realisations"].sum()) == int(row["runs_spent"])
         for r in plan.itertuples():  # every block is an ordinary simulation table
             assert (tiny_run / run_path(search.case_at(getattr(r, search.over)), r.first, r.last)).exists(), r
-    proc = snakemake(tiny_run, "-n", "optimum", configfile=TINY)
+    proc = run_snakemake(tiny_run, "optimum", dry_run=True, configfile=TINY)
     assert "Nothing to be done" in proc.stdout + proc.stderr
 
 
-def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
+def test_a_figure_edit_redraws_only_that_figure(workflow_copy, tiny_run_copy):
     from particle_entropy.figures import FIGURE_MODULES
 
-    src, work = tmp_path / "src", tmp_path / "work"  # copies: the library edited, the finished run
-    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
-    shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(src / "Snakefile"), "-d", str(work), "-n"]
-    plan = lambda: subprocess.run([*cmd, "--configfile", str(TINY)], capture_output=True, text=True, check=True)
+    src, work = workflow_copy, tiny_run_copy  # copies: the library edited, the finished run
+    plan = lambda: run_snakemake(work, snakefile=src / "Snakefile", dry_run=True, configfile=TINY)
     assert _planned_rules(plan()) == set()  # the same code in another place: nothing to do
     figures = src / "workflow/lib/particle_entropy/figures"
     every_figure = {f"plot_{fig}" for fig in FIGURE_MODULES}
@@ -883,9 +847,8 @@ def test_parsing_the_workflow_imports_neither_scipy_nor_pandas(tmp_path):
     import json
 
     out = tmp_path / "imports.json"
-    args = ["-s", str(ROOT / "Snakefile"), "-d", str(tmp_path / "work"), "-n", "--configfile", str(TINY)]
-    proc = subprocess.run([sys.executable, "-c", RECORD_IMPORTS, f"{ROOT}/", str(out), *args], capture_output=True)
-    assert proc.returncode == 0, proc.stderr.decode()[-3000:]
+    launcher = ("-c", RECORD_IMPORTS, f"{ROOT}/", str(out))
+    run_snakemake(tmp_path / "work", dry_run=True, configfile=TINY, launcher=launcher)  # AssertionError if it fails
     seen = json.loads(out.read_text())
     assert not seen["scipy"]
     assert not [f for f in seen["by"] if not f.startswith("workflow/lib/")]  # Snakefile, rules, scripts: none
@@ -899,16 +862,16 @@ def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_r
 
     digests = tiny_run / ".snakemake" / "particle_entropy" / "table_digests.json"
     for _ in range(2):  # nothing to do; the parse checks every table (the second reads none settled before)
-        proc = snakemake(tiny_run, configfile=TINY)
+        proc = run_snakemake(tiny_run, configfile=TINY)
         assert "Nothing to be done" in proc.stdout + proc.stderr
     tables = {p.relative_to(tiny_run / "results").as_posix() for p in (tiny_run / "results").rglob("*.parquet")}
     assert set(json.loads(digests.read_text())["tables"]) == tables
     kept = digests.stat().st_mtime_ns
-    snakemake(tiny_run, configfile=TINY)
+    run_snakemake(tiny_run, configfile=TINY)
     assert digests.stat().st_mtime_ns == kept  # nothing changed, nothing rewritten
     cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
     run.write_bytes(run.read_bytes()[:100])  # in place: the same inode
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0 and (run.parent / (run.name + ".corrupt")).exists()
