@@ -21,7 +21,6 @@ from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models
 from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.pipeline.sweeps import (
-    FIGURE_READS,
     Ensemble,
     case_run_paths,
     figure_ensembles,
@@ -240,23 +239,80 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path, tiny_config):
 # --- a figure target pulls only its own simulations ------------------------------------------
 
 
-def _expected_runs(cfg, fig):
-    ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
-    reads = FIGURE_READS.get(fig, "summaries")
-    if reads == "snapshots":
-        return set()
-    if reads == "runs":
-        return {run_path(e.case, cfg["base_seed"]) for e in ensembles}
-    return {p for e in ensembles for p in case_run_paths(e, cfg)}
+# What each figure target of tests/data/tiny_config.yaml plans in an empty directory, written
+# out by hand from that file, not from the library (layout: README "Output layout"; seeds:
+# docs/architecture.md "Seeds"): results/{runs|snapshots}/<case>/seeds~A-B.parquet.
+# - <case> is method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S/grid~R. What a case leaves unset
+#   comes from case_defaults (eta 1, truncation none, dt_growth 1.3), else the paper's (scheme
+#   symmetric, time grid exact); `preset: authors` is truncation 3, scheme authors, grid authors.
+#   FD takes eta 1, truncation none, growth 1 whatever the defaults.
+BINS = "pt/bins/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+FIXED = "pt/fixed/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+ADAPTIVE = "pt/adaptive/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1 = "mtpt/collision/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_05 = "mtpt/collision/n~{n}/eta~0.5/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_01 = "mtpt/collision/n~{n}/eta~0.1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_025_CUT = "mtpt/collision/n~{n}/eta~0.25/trunc~3/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1_CUT = "mtpt/collision/n~{n}/eta~1/trunc~3/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1_CUT_SEQUENTIAL = "mtpt/collision/n~{n}/eta~1/trunc~3/growth~1.3/scheme~sequential/grid~exact"
+SPH_1 = "mtpt/sph/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+SPH_01 = "mtpt/sph/n~{n}/eta~0.1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+SPH_AUTHORS = "mtpt/sph/n~{n}/eta~1/trunc~3/growth~1.3/scheme~authors/grid~authors"
+FD = "fd/implicit/n~{n}/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact"
+# - Seeds A-B of each N. Realisation r has seed base_seed + r = r. `realisations: 1` is seed 0,
+#   and FD runs once; `ensemble` is the `realisations` count of N (30: 3, 60: 3, 100: 2, 200: 2),
+#   capped at max_realisations. For N <= seed_blocks.max_n = 60, seeds run seed_blocks.size = 2
+#   to a job, in blocks starting at 0, 2, ...; above it, one seed a job.
+SEED_0 = {30: ["0-0"], 100: ["0-0"]}  # n [30, 100], one realisation
+CAPPED_AT_2 = {30: ["0-1"], 100: ["0-0", "1-1"]}  # n [30, 100]: 3 -> 2 seeds, one block; 2 seeds, two jobs
+FIG6_SEEDS = {30: ["0-1"], 60: ["0-1"], 100: ["0-0", "1-1"], 200: ["0-0", "1-1"]}  # each capped at 2
+FIG8_SEEDS = {30: ["0-0"], 60: ["0-0"], 100: ["0-0"], 200: ["0-0"]}  # FD: once
+FIG9_SEEDS = {30: ["0-1", "2-2"], 60: ["0-1", "2-2"], 100: ["0-0", "1-1"], 200: ["0-0", "1-1"]}  # 3, 3, 2, 2: no cap
+TRADEOFF_SEEDS = {30: ["0-1"], 60: ["0-1"]}  # capped at 2 (3 -> 2 both)
+TRADEOFF_FD_SEEDS = {30: ["0-0"], 60: ["0-0"]}
 
 
-@pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
-def test_each_figure_target_plans_only_its_runs(fig, tmp_path, tiny_config):
-    cfg = tiny_config
+def _tables(kind, cases, seeds):
+    return {f"results/{kind}/{c.format(n=n)}/seeds~{s}.parquet" for c in cases for n, ss in seeds.items() for s in ss}
+
+
+# - Figs. 1 and 2 read the run of seed 0 of each case; Fig. 7 final states (results/snapshots/),
+#   no per-step table; every other figure the runs of its ensembles (counts: cases x tables of a case).
+EXPECTED_TABLES = {  # figure: (its run tables, its snapshot tables)
+    "fig1": (_tables("runs", [BINS, FIXED, COLLISION_1], SEED_0), set()),  # 3 x 2
+    "fig2": (_tables("runs", [BINS, FIXED, COLLISION_1], SEED_0), set()),  # 3 x 2
+    "fig3": (_tables("runs", [ADAPTIVE, SPH_1], CAPPED_AT_2), set()),  # 2 x 3
+    "fig4": (_tables("runs", [ADAPTIVE, SPH_1, COLLISION_1], CAPPED_AT_2), set()),  # 3 x 3
+    "fig5": (  # 5 x 3
+        _tables("runs", [COLLISION_1, COLLISION_01, SPH_1, SPH_01, COLLISION_025_CUT], CAPPED_AT_2),
+        set(),
+    ),
+    "fig6": (_tables("runs", [COLLISION_1], FIG6_SEEDS), set()),  # 1 x 6
+    "fig7": (set(), _tables("snapshots", [COLLISION_01, FIXED], SEED_0)),  # 2 x 2 snapshots
+    "fig8": (_tables("runs", [FD], FIG8_SEEDS), set()),  # 1 x 4
+    "fig9": (  # 6 x 8
+        _tables(
+            "runs",
+            [COLLISION_1, SPH_1, COLLISION_05, COLLISION_1_CUT, COLLISION_1_CUT_SEQUENTIAL, SPH_AUTHORS],
+            FIG9_SEEDS,
+        ),
+        set(),
+    ),
+    "tradeoff": (  # 1 x 2 + 4 x 2
+        _tables("runs", [FD], TRADEOFF_FD_SEEDS)
+        | _tables("runs", [ADAPTIVE, COLLISION_1, COLLISION_1_CUT, COLLISION_1_CUT_SEQUENTIAL], TRADEOFF_SEEDS),
+        set(),
+    ),
+}
+
+
+@pytest.mark.parametrize("fig", list(EXPECTED_TABLES))
+def test_each_figure_target_plans_only_its_runs(fig, tmp_path):
+    runs, snapshots = EXPECTED_TABLES[fig]
     proc = run_snakemake(tmp_path, f"figures/{fig}.png", dry_run=True, configfile=TINY)
-    assert set(planned_outputs(proc)) == _expected_runs(cfg, fig)
-    snaps = planned_outputs(proc, prefix="results/snapshots/")
-    assert (len(snaps) > 0) == (fig == "fig7")  # particle snapshots only where a figure plots them
+    assert set(planned_outputs(proc)) == runs
+    # particle snapshots only where a figure plots them
+    assert set(planned_outputs(proc, prefix="results/snapshots/")) == snapshots
     assert planned_outputs(proc, prefix="results/shear/") == []
 
 
