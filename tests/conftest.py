@@ -1,17 +1,28 @@
-"""Shared references and helpers for the particle_entropy test suite.
+"""Shared references, paths and fixtures for the particle_entropy test suite.
 
 Every reference here is built from the paper's formulas with plain dense numpy, independently
-of the library code it is compared with.
+of the library code it is compared with. Paths are module constants, imported as
+``from conftest import ROOT, TINY`` (pytest puts tests/ on sys.path), so that module-level code
+such as parametrize lists can use them; what a test may change is a fixture, fresh for each test.
 """
 
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
+import sys
 import warnings
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]  # the checkout: Snakefile, config.yaml, workflow/
+TINY = ROOT / "tests" / "data" / "tiny_config.yaml"  # the small config of the workflow tests
+SNAKEFILE = ROOT / "Snakefile"
 
 
 # --------------------------------------------------------------------------- dense references
@@ -77,7 +88,69 @@ def no_runtime_warnings():
             yield
 
 
+# --------------------------------------------------------------------------- the workflow
+def snakemake_command(
+    workdir=None, *args, snakefile=SNAKEFILE, dry_run=False, configfile=None, launcher=("-m", "snakemake")
+) -> list[str]:
+    """``python -m snakemake -s SNAKEFILE -d WORKDIR -j2 [-n] ARGS --configfile CONFIGFILE``.
+
+    ``snakefile=None`` or ``workdir=None`` leaves out -s or -d: Snakemake then takes the Snakefile
+    and config.yaml of the directory it runs in. ``launcher`` replaces ``-m snakemake`` with a
+    script that runs Snakemake itself. --configfile comes last: it takes every following word
+    as a file."""
+    cmd = [sys.executable, *launcher]
+    if snakefile is not None:
+        cmd += ["-s", str(snakefile)]
+    if workdir is not None:
+        cmd += ["-d", str(workdir)]
+    cmd.append("-j2")
+    if dry_run:
+        cmd.append("-n")
+    cmd += [str(a) for a in args]
+    if configfile is not None:
+        cmd += ["--configfile", str(configfile)]
+    return cmd
+
+
+def run_snakemake(workdir=None, *args, check=True, cwd=None, env=None, preexec_fn=None, **options):
+    """Runs ``snakemake_command(workdir, *args, **options)`` (in ``cwd``, with ``env``) and returns
+    the finished process, its output as text; with ``check``, AssertionError unless it succeeded."""
+    proc = subprocess.run(
+        snakemake_command(workdir, *args, **options),
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        preexec_fn=preexec_fn,
+    )
+    if check and proc.returncode != 0:
+        words = " ".join(map(str, args))
+        raise AssertionError(f"snakemake {words} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
+    return proc
+
+
 # --------------------------------------------------------------------------- fixtures
 @pytest.fixture
 def rng():
     return np.random.default_rng(20200101)
+
+
+@pytest.fixture
+def tiny_config() -> dict:
+    """The tiny config, parsed afresh for each test: a test may edit it."""
+    return yaml.safe_load(TINY.read_text())
+
+
+@pytest.fixture
+def workflow_copy(tmp_path) -> Path:
+    """A copy of the workflow as a user clones it, at tmp_path / "repo" (returned): Snakefile,
+    config.yaml, workflow/ (library, rules, scripts) and the tiny config at tests/data/. A test
+    may edit it: Snakemake run with its Snakefile sees the copy's code, not the checkout's."""
+    root = tmp_path / "repo"
+    shutil.copytree(ROOT / "workflow", root / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    for name in ("Snakefile", "config.yaml"):
+        shutil.copy(ROOT / name, root / name)
+    tiny = root / TINY.relative_to(ROOT)
+    tiny.parent.mkdir(parents=True)
+    shutil.copy(TINY, tiny)
+    return root

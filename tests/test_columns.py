@@ -5,16 +5,15 @@ which holds the shear flow's), so editing a description reruns no simulation."""
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 from particle_entropy.core import case, columns, records
 from particle_entropy.core.registry import METHODS
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, SIMULATION_ENTRIES, closure, modules
 
-ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = ROOT / "workflow" / "scripts"
 PRESENTATION = (
     "core.columns",

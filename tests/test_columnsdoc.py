@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
 from particle_entropy.analysis import aggregate, claims, optimum
 from particle_entropy.core import case, columns, records
@@ -16,7 +16,6 @@ from particle_entropy.figures import fig10, style
 from particle_entropy.pipeline import columnsdoc
 from particle_entropy.pipeline.columnsdoc import COMMAND, PAGE, main, render, sections, split_unit
 
-ROOT = Path(__file__).resolve().parents[1]
 REGENERATE = f"run `{COMMAND} {PAGE}` from the repository root to regenerate it"
 MODULES = {  # the module names the page cites as sources of its columns
     "columns": columns,

@@ -5,18 +5,16 @@ checks). Each bad input is a one-key change of the shipped config.yaml."""
 from __future__ import annotations
 
 import copy
-from pathlib import Path
 
 import pytest
 import yaml
+from conftest import ROOT, TINY
 
 from particle_entropy.cli import main
 from particle_entropy.core.case import SettingError
 from particle_entropy.pipeline.configcheck import ConfigFileError, check_config, load_yaml
 
-ROOT = Path(__file__).resolve().parents[1]
 BASE = yaml.safe_load((ROOT / "config.yaml").read_text())
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
 
 
 def _set(path, value):

@@ -6,10 +6,10 @@ import math
 import subprocess
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from particle_entropy.core import measures as M
 from particle_entropy.core.runconfig import RunConfig, SettingError
@@ -67,7 +67,7 @@ def test_one_particle_and_a_huge_growth_are_refused_by_the_config_and_the_cli(tm
     from particle_entropy.cli import main
     from particle_entropy.pipeline.configcheck import check_config
 
-    base = yaml.safe_load((Path(__file__).parents[1] / "config.yaml").read_text())
+    base = yaml.safe_load((ROOT / "config.yaml").read_text())
     one = copy.deepcopy(base)
     one["figures"]["fig9"]["n"] = [1, 100]
     with pytest.raises(SettingError, match=r"figures.fig9.n\[0\]=1 is not allowed"):

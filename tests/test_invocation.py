@@ -10,14 +10,13 @@ import inspect
 import subprocess
 import sys
 import textwrap
-from pathlib import Path
 
 import pytest
+from conftest import ROOT
 from snakemake import cli
 
 from particle_entropy.pipeline.invocation import NO_JOB_OPTIONS, REPORT_OPTIONS, runs_no_job, snakemake_options
 
-ROOT = Path(__file__).resolve().parents[1]
 PARSER = cli.get_argument_parser()
 ACTIONS = {action.dest: action for action in PARSER._actions}
 VALUES = {"deploy_sources": ["query", "checksum"], "cleanup_metadata": ["a.parquet"], "list_changes": ["code"]}

@@ -5,21 +5,17 @@ block the run, and a bad value in a section a target uses is still refused befor
 from __future__ import annotations
 
 import copy
-import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
+from conftest import ROOT, TINY, run_snakemake
 from snakemake.utils import update_config
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.pipeline.configcheck import check_config
 from particle_entropy.pipeline.crosschecks import check_sweeps, optimum_searches
-
-ROOT = Path(__file__).resolve().parents[1]
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
 
 
 def _merged() -> dict:
@@ -29,20 +25,11 @@ def _merged() -> dict:
     return config
 
 
-def _checkout(tmp_path) -> Path:
-    """The repository as a user clones it: config.yaml at the root, the tiny config beside."""
-    root = tmp_path / "repo"
-    shutil.copytree(ROOT / "workflow", root / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    for name in ("Snakefile", "config.yaml"):
-        shutil.copy(ROOT / name, root / name)
-    (root / "tests" / "data").mkdir(parents=True)
-    shutil.copy(TINY, root / "tests" / "data" / TINY.name)
-    return root
-
-
 def _dry_run(root: Path, *targets: str) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-m", "snakemake", "-j2", "-n", *targets, "--configfile", "tests/data/tiny_config.yaml"]
-    return subprocess.run(cmd, cwd=root, capture_output=True, text=True)
+    """`snakemake -j2 -n TARGETS --configfile tests/data/tiny_config.yaml` run in ``root``, as a
+    user runs it there: no -s or -d, so Snakemake takes root's Snakefile and config.yaml."""
+    configfile = TINY.relative_to(ROOT)
+    return run_snakemake(None, *targets, snakefile=None, dry_run=True, configfile=configfile, cwd=root, check=False)
 
 
 def test_the_merge_keeps_config_yamls_searches_past_the_tiny_t_final():
@@ -51,14 +38,14 @@ def test_the_merge_keeps_config_yamls_searches_past_the_tiny_t_final():
     assert "fd_t250" in config["optimum"] and config["optimum"]["fd_t250"]["time"] > config["physics"]["t_final"]
 
 
-def test_unused_searches_do_not_block_the_case_sections():
+def test_unused_searches_do_not_block_the_case_sections(tiny_config):
     config = _merged()
     check_sweeps(config)  # the figures, the mechanism, the trade-off: all fine
     searches = optimum_searches(config)
     assert "fd_t250" in list(searches)  # named, not yet judged
     with pytest.raises(SettingError, match=r"optimum\.fd_t250\.time=250"):
         searches["fd_t250"]
-    tiny_search = next(n for n in yaml.safe_load(TINY.read_text())["optimum"])
+    tiny_search = next(n for n in tiny_config["optimum"])
     assert searches[tiny_search].name == tiny_search  # the tiny config's own search is fine
 
 
@@ -68,18 +55,18 @@ def test_check_config_still_judges_every_search():
         check_config(_merged())
 
 
-def test_a_bad_search_is_refused_when_it_is_used():
+def test_a_bad_search_is_refused_when_it_is_used(tiny_config):
     config = copy.deepcopy(_merged())
     del config["optimum"]  # only the tiny config's searches, then break one of them
-    config["optimum"] = copy.deepcopy(yaml.safe_load(TINY.read_text())["optimum"])
+    config["optimum"] = tiny_config["optimum"]
     name = next(iter(config["optimum"]))
     config["optimum"][name]["time"] = 1e6
     with pytest.raises(SettingError, match=rf"optimum\.{name}\.time"):
         optimum_searches(config)[name]
 
 
-def test_the_tiny_config_runs_from_the_repository_root(tmp_path):
-    root = _checkout(tmp_path)
+def test_the_tiny_config_runs_from_the_repository_root(workflow_copy):
+    root = workflow_copy  # the repository as a user clones it: config.yaml at the root, the tiny config beside
     proc = _dry_run(root)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = proc.stdout + proc.stderr
@@ -88,8 +75,8 @@ def test_the_tiny_config_runs_from_the_repository_root(tmp_path):
     assert "n~30000" not in out and "n~100/" in out
 
 
-def test_the_optimum_target_refuses_config_yamls_search_before_any_job(tmp_path):
-    root = _checkout(tmp_path)
+def test_the_optimum_target_refuses_config_yamls_search_before_any_job(workflow_copy):
+    root = workflow_copy
     proc = _dry_run(root, "optimum")
     assert proc.returncode != 0
     assert "optimum.fd_t250.time=250" in proc.stdout + proc.stderr

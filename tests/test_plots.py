@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import math
 import zlib
-from pathlib import Path
 
 import matplotlib
 import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from conftest import ROOT
 
 from particle_entropy.core.labels import case_label
 
@@ -35,7 +35,7 @@ from particle_entropy.figures import (  # noqa: E402
 )
 from particle_entropy.models.simulate import run  # noqa: E402
 
-CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config.yaml").read_text())
+CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 NS = (30, 100)
 T = np.array([0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0])
 KW = {"D": 1e-3, "t_final": 20.0}
@@ -459,14 +459,3 @@ def test_fig9_draws_the_papers_bars_at_half_eq43s_width_when_asked():
     assert any("COMIC of mean SSE, the paper's bars" in t for t in legends)
     with pytest.raises(ValueError, match=r"figures.fig9.bars = 'nosuch': expected one of eq43, paper"):
         figure_function("fig9")([comic], cases, **KW, bars="nosuch")
-
-
-def test_figure_options_are_the_schemas_and_defaults_fill_in():
-    from particle_entropy.figures import figure_options
-
-    schema = yaml.safe_load((Path(__file__).parents[1] / "workflow" / "schemas" / "config.schema.yaml").read_text())
-    bars = schema["properties"]["figures"]["properties"]["fig9"]["properties"]["bars"]
-    assert bars["enum"] == ["eq43", "paper"] and bars["default"] == "eq43"  # the paper's drawing: eq43
-    assert figure_options("fig9", {"cases": [], "n": [30]}) == {"bars": "eq43"}
-    assert figure_options("fig9", {"bars": "paper"}) == {"bars": "paper"}
-    assert figure_options("fig1", {"bars": "paper"}) == {}  # no options: nothing passed on

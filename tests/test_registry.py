@@ -3,16 +3,14 @@ the shipped config.yaml, and the command line's defaults and choices."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 import yaml
+from conftest import ROOT
 
 from particle_entropy.cli import build_parser
 from particle_entropy.core.registry import ALL_KERNELS, KERNELS, METHODS, SCHEMES, SHEAR_CASES, TRANSFER_METHODS
 from particle_entropy.core.settings import PAPER
 
-ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
 CONFIG = yaml.safe_load((ROOT / "config.yaml").read_text())
 

@@ -4,10 +4,10 @@ pre-flight checks of check_sweeps, on the shipped config, the tiny test config a
 from __future__ import annotations
 
 import copy
-from pathlib import Path
 
 import pytest
 import yaml
+from conftest import ROOT
 
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.crosschecks import check_sweeps
@@ -24,9 +24,7 @@ from particle_entropy.pipeline.sweeps import (
     spec_ensembles,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
 SHIPPED = yaml.safe_load((ROOT / "config.yaml").read_text())
-TINY = yaml.safe_load((ROOT / "tests" / "data" / "tiny_config.yaml").read_text())
 PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact"
 
 
@@ -132,8 +130,8 @@ def test_shipped_fig3_is_capped_at_20():
     }
 
 
-def test_spec_ensembles_take_case_defaults_where_they_apply():
-    config = {**TINY, "case_defaults": {"eta": 1, "truncation": "none", "dt_growth": 1.3}}
+def test_spec_ensembles_take_case_defaults_where_they_apply(tiny_config):
+    config = {**tiny_config, "case_defaults": {"eta": 1, "truncation": "none", "dt_growth": 1.3}}
     spec = {
         "cases": [
             {"method": "fd", "kernel": "implicit"},
@@ -171,8 +169,8 @@ def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
     assert {e.case.n for e in mech - fig9} >= {100000, 300000}
 
 
-def test_check_sweeps_refuses_a_bad_mechanism_case():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_a_bad_mechanism_case(tiny_config):
+    config = tiny_config
     config["mechanism"]["sweeps"][0]["cases"].append({"method": "mtpt", "kernel": "collision", "scheme": "compensated"})
     msg = _refused(config)
     assert "mechanism.sweeps[0].cases[4].scheme" in msg and "needs a truncation" in msg
@@ -218,9 +216,9 @@ def test_run_config_is_the_case_at_the_seed():
 
 
 # --------------------------------------------------------------------------- check_sweeps
-def test_check_sweeps_accepts_the_shipped_and_tiny_configs():
+def test_check_sweeps_accepts_the_shipped_and_tiny_configs(tiny_config):
     check_sweeps(SHIPPED)
-    check_sweeps(TINY)
+    check_sweeps(tiny_config)
 
 
 def _refused(config) -> str:
@@ -229,29 +227,29 @@ def _refused(config) -> str:
     return str(e.value)
 
 
-def test_check_sweeps_refuses_a_kernel_of_another_method():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_a_kernel_of_another_method(tiny_config):
+    config = tiny_config
     config["figures"]["fig1"]["cases"][0]["kernel"] = "collision"
     msg = _refused(config)
     assert "figures.fig1.cases[0].kernel" in msg and "collision" in msg
 
 
-def test_check_sweeps_refuses_an_inapplicable_dimension_in_tradeoff():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_an_inapplicable_dimension_in_tradeoff(tiny_config):
+    config = tiny_config
     config["tradeoff"]["cases"][1]["eta"] = 0.5  # pt adaptive
     msg = _refused(config)
     assert "tradeoff.cases[1].eta" in msg and "0.5" in msg
 
 
-def test_check_sweeps_refuses_an_odd_fd_n():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_an_odd_fd_n(tiny_config):
+    config = tiny_config
     config["figures"]["fig8"]["n"] = [30, 61]
     msg = _refused(config)
     assert "figures.fig8.cases[0].n" in msg and "61" in msg
 
 
-def test_check_sweeps_refuses_explicit_fd_past_stability():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_explicit_fd_past_stability(tiny_config):
+    config = tiny_config
     config["figures"]["fig8"]["cases"] = [{"method": "fd", "kernel": "explicit"}]
     config["figures"]["fig8"]["n"] = [30, 200]
     check_sweeps(config)  # n = 200: dx = 0.06, r = D dt / dx^2 = 1e-3 * 0.5 / 0.0036 = 0.14 <= 1/2
@@ -260,53 +258,54 @@ def test_check_sweeps_refuses_explicit_fd_past_stability():
     assert "figures.fig8.cases[0]" in msg and "explicit" in msg
 
 
-def test_check_sweeps_refuses_a_missing_realisations_entry():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_a_missing_realisations_entry(tiny_config):
+    config = tiny_config
     config["tradeoff"]["n"] = [30, 40]  # ensemble, and the table has no N = 40
     msg = _refused(config)
     assert "tradeoff.n" in msg and "40" in msg
 
 
 @pytest.mark.parametrize("key", ["comic_times", "tradeoff.times"])
-def test_check_sweeps_refuses_a_time_past_t_final(key):
-    config = copy.deepcopy(TINY)  # t_final 20
+def test_check_sweeps_refuses_a_time_past_t_final(key, tiny_config):
+    config = tiny_config  # t_final 20
     section = config["tradeoff"] if key == "tradeoff.times" else config
     section[key.split(".")[-1]] = [5, 25]
     msg = _refused(config)
     assert key in msg and "25" in msg
 
 
-def test_fd_only_section_needs_no_realisations_entry():
-    cfg = copy.deepcopy(TINY)
+def test_fd_only_section_needs_no_realisations_entry(tiny_config):
+    cfg = tiny_config
     cfg["figures"]["fig8"].update(realisations="ensemble", n=[30, 40])  # no realisations entry for n = 40
     check_sweeps(cfg)
     assert [e.realisations for e in figure_ensembles(cfg, "fig8")] == [1, 1]
 
 
-def test_physics_settings_from_config_reach_the_run():
-    cfg = copy.deepcopy(TINY)
+def test_physics_settings_from_config_reach_the_run(tiny_config):
+    cfg = tiny_config
     cfg["physics"].update(fixed_kernel_time=2.5, D=2e-3)
     run = run_config(Case("pt", "fixed", 30), cfg)
     assert (run.fixed_kernel_time, run.D, run.t_final) == (2.5, 2e-3, cfg["physics"]["t_final"])
 
 
-def test_a_case_listed_twice_is_one_ensemble():
-    cfg = copy.deepcopy(TINY)
+def test_a_case_listed_twice_is_one_ensemble(tiny_config):
+    cfg = tiny_config
+    once = len(figure_ensembles(cfg, "fig9"))
     cases = cfg["figures"]["fig9"]["cases"]
     cases.append({**cases[0], "eta": 1.0, "scheme": "symmetric"})  # the first case again, written another way
-    assert len(figure_ensembles(cfg, "fig9")) == len(figure_ensembles(TINY, "fig9"))
+    assert len(figure_ensembles(cfg, "fig9")) == once
 
 
-def test_lattice_cases_and_their_checks():
+def test_lattice_cases_and_their_checks(tiny_config):
     from particle_entropy.pipeline.sweeps import lattice_cases
 
     cases = lattice_cases(SHIPPED)
     assert {c.n for c in cases} == {3001} and all(c.eta == 1.0 and c.method == "mtpt" for c in cases)
     assert any(c.dt_growth == 1.01 for c in cases) and len(cases) == len(set(cases))
-    config = copy.deepcopy(TINY)
+    config = copy.deepcopy(tiny_config)
     config["mechanism"]["lattice"]["n"] = 60
     assert "mechanism.lattice.n" in _refused(config)
-    config = copy.deepcopy(TINY)
+    config = tiny_config
     config["mechanism"]["lattice"]["cases"].append({"method": "mtpt", "kernel": "collision", "eta": 0.5})
     assert "eta = 1 only" in _refused(config)
 
@@ -322,8 +321,8 @@ def test_lattice_cases_and_their_checks():
         (("shear", "dt"), float("inf")),
     ],
 )
-def test_check_sweeps_refuses_nan_and_infinity_anywhere(path, value):
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_nan_and_infinity_anywhere(path, value, tiny_config):
+    config = tiny_config
     node = config
     for key in path[:-1]:
         node = node[key]
@@ -333,15 +332,15 @@ def test_check_sweeps_refuses_nan_and_infinity_anywhere(path, value):
     assert msg.startswith(f"{where}=") and "finite" in msg
 
 
-def test_check_sweeps_refuses_a_realisations_entry_given_twice():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_a_realisations_entry_given_twice(tiny_config):
+    config = tiny_config
     config["realisations"].append({"n": config["realisations"][0]["n"], "count": 99})
     last = len(config["realisations"]) - 1
     assert f"realisations[{last}].n" in _refused(config) and "also at realisations[0]" in _refused(config)
 
 
-def test_check_sweeps_refuses_a_claims_range_written_high_to_low():
-    config = copy.deepcopy(TINY)
+def test_check_sweeps_refuses_a_claims_range_written_high_to_low(tiny_config):
+    config = tiny_config
     config["claims"]["collision_eta1_optimum"] = [10000, 1000]
     msg = _refused(config)
     assert msg.startswith("claims.collision_eta1_optimum=[10000, 1000]") and "low <= high" in msg

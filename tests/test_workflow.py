@@ -6,7 +6,6 @@ import hashlib
 import re
 import shutil
 import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -14,14 +13,15 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from conftest import ROOT, TINY, run_snakemake, snakemake_command
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
 from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, models_in, rows_of
 from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
+from particle_entropy.figures import CASE_FIGURES, FIGURES
 from particle_entropy.pipeline.sweeps import (
-    FIGURE_READS,
     Ensemble,
     case_run_paths,
     figure_ensembles,
@@ -29,23 +29,15 @@ from particle_entropy.pipeline.sweeps import (
     spec_ensembles,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
-TINY = ROOT / "tests" / "data" / "tiny_config.yaml"
+
+# figures.FIGURES, the one list: the default target draws every figure but the mechanism figure
+# and the searches, which are their own targets (fig1 ... fig10 and tradeoff: test_settings holds the names)
+DEFAULT_FIGURES = [f.name for f in FIGURES if f.name not in ("fig9_mechanism", "optimum")]
 
 
 def load(path):
     return yaml.safe_load(Path(path).read_text())
-
-
-def snakemake(workdir, *args, configfile=None, check=True):
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2", *args]
-    if configfile:  # last: --configfile takes every following word as a file
-        cmd += ["--configfile", str(configfile)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if check and proc.returncode != 0:
-        raise AssertionError(f"snakemake failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}")
-    return proc
 
 
 def planned_outputs(proc, prefix="results/runs/"):
@@ -93,7 +85,7 @@ def test_bad_config_stops_before_any_job(tmp_path):
     cfg["figures"]["fig9"]["cases"][0]["eta"] = 2
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     out = proc.stdout + proc.stderr
     assert "eta" in out and "maximum" in out and "2" in out
@@ -105,7 +97,7 @@ def test_kernel_method_mismatch_is_refused(tmp_path):
     cfg["figures"]["fig1"]["cases"][0] = {"method": "pt", "kernel": "sph"}
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     assert "figures.fig1.cases[0].kernel='sph'" in proc.stdout + proc.stderr
 
@@ -115,7 +107,7 @@ def test_nan_in_the_yaml_is_refused_before_any_job(tmp_path):
     assert "D: .nan" in text
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     assert proc.returncode != 0
     assert "physics.D=nan is not allowed: a finite number" in proc.stdout + proc.stderr
     assert not (tmp_path / "results").exists()
@@ -125,19 +117,19 @@ def test_nan_in_the_yaml_is_refused_before_any_job(tmp_path):
 
 
 def test_full_dry_run_plans_every_figure(tmp_path):
-    proc = snakemake(tmp_path, "-n", configfile=ROOT / "config.yaml")
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=ROOT / "config.yaml")
     out = proc.stdout + proc.stderr
-    for k in range(1, 11):
-        assert f"figures/fig{k}.png" in out
-    assert "figures/tradeoff.png" in out and "results/paper_claims.md" in out
-    fig9 = planned_outputs(snakemake(tmp_path, "-n", "figures/fig9.png", configfile=ROOT / "config.yaml"))
+    for fig in DEFAULT_FIGURES:
+        assert f"figures/{fig}.png" in out, fig
+    assert "results/paper_claims.md" in out
+    fig9 = planned_outputs(run_snakemake(tmp_path, "figures/fig9.png", dry_run=True, configfile=ROOT / "config.yaml"))
     # 3 models x 2 schemes x (80 + 80 + 60 + 50 + 20 + 6 + 4 seeds in blocks of 20, N <= 30,000)
     assert len(fig9) == 6 * (4 + 4 + 3 + 3 + 1 + 1 + 1)
     assert "figures/fig9_mechanism.png" not in out  # its own target, not part of the paper's run
 
 
 def test_one_figure_runs_only_its_jobs(tmp_path):
-    proc = snakemake(tmp_path, "-n", "figures/fig8.png", configfile=ROOT / "config.yaml")
+    proc = run_snakemake(tmp_path, "figures/fig8.png", dry_run=True, configfile=ROOT / "config.yaml")
     runs = planned_outputs(proc)
     assert len(runs) == 7
     assert all(r.startswith("results/runs/fd/implicit/") for r in runs)
@@ -145,12 +137,12 @@ def test_one_figure_runs_only_its_jobs(tmp_path):
 
 
 def test_slurm_profile_parses(tmp_path):
-    proc = snakemake(
+    proc = run_snakemake(
         tmp_path,
-        "-n",
         "--profile",
         str(ROOT / "workflow/profiles/slurm"),
         "figures/fig8.png",
+        dry_run=True,
         configfile=ROOT / "config.yaml",
     )
     assert len(planned_outputs(proc)) == 7
@@ -162,23 +154,23 @@ def test_slurm_profile_parses(tmp_path):
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory):
     work = tmp_path_factory.mktemp("tiny")
-    snakemake(work, configfile=TINY)
+    run_snakemake(work, configfile=TINY)
     return work
 
 
 def test_tiny_run_builds_every_figure(tiny_run):
-    for k in range(1, 11):
+    for fig in DEFAULT_FIGURES:
         for ext in ("png", "pdf"):
-            f = tiny_run / "figures" / f"fig{k}.{ext}"
+            f = tiny_run / "figures" / f"{fig}.{ext}"
             assert f.exists() and f.stat().st_size > 5000, f
 
 
-def test_tiny_run_tables_have_documented_columns(tiny_run):
+def test_tiny_run_tables_have_documented_columns(tiny_run, tiny_config):
     comic = pd.read_parquet(tiny_run / "results/tables/comic.parquet")
     assert {"label", *CASE_COLUMNS, "time", "COMIC_mean", "COMIC_std", "SSE_mean", "SSE_std", "n_realisations"} <= set(
         comic.columns
     )
-    cfg = load(TINY)
+    cfg = tiny_config
     expected = {e.case.model for f in ("fig8", "fig9") for e in figure_ensembles(cfg, f)}
     assert set(models_in(comic)) == expected
     minima = pd.read_parquet(tiny_run / "results/tables/comic_minima.parquet")
@@ -224,13 +216,13 @@ def test_summary_averages_its_realisations(tiny_run):
     assert summary["COMIC_mean"].iloc[last] == pytest.approx(expected[last], rel=1e-12)
 
 
-def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
-    cfg = load(TINY)
+def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["figures"]["fig9"]["n"] = cfg["figures"]["fig9"]["n"] + [400]
     cfg["realisations"].append({"n": 400, "count": 2})
     new = tmp_path / "more.yaml"
     new.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tiny_run, "-n", configfile=new)
+    proc = run_snakemake(tiny_run, dry_run=True, configfile=new)
     runs = planned_outputs(proc)
     assert runs and all("/n~400/" in r for r in runs)
     models = len(cfg["figures"]["fig9"]["cases"])
@@ -239,12 +231,12 @@ def test_new_sweep_value_adds_only_its_jobs(tiny_run, tmp_path):
     assert figs == {"figures/fig9.png", "figures/fig9.pdf"}
 
 
-def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
-    cfg = load(TINY)
+def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["realisations"] = [dict(e, count=e["count"] + 2) if e["n"] == 200 else e for e in cfg["realisations"]]
     new = tmp_path / "seeds.yaml"
     new.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    runs = planned_outputs(snakemake(tiny_run, "-n", configfile=new))
+    runs = planned_outputs(run_snakemake(tiny_run, dry_run=True, configfile=new))
     assert runs and all("/n~200/" in r for r in runs)
     assert all(not r.endswith("seeds~0-0.parquet") and not r.endswith("seeds~1-1.parquet") for r in runs)
 
@@ -252,28 +244,85 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path):
 # --- a figure target pulls only its own simulations ------------------------------------------
 
 
-def _expected_runs(cfg, fig):
-    ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
-    reads = FIGURE_READS.get(fig, "summaries")
-    if reads == "snapshots":
-        return set()
-    if reads == "runs":
-        return {run_path(e.case, cfg["base_seed"]) for e in ensembles}
-    return {p for e in ensembles for p in case_run_paths(e, cfg)}
+# What each figure target of tests/data/tiny_config.yaml plans in an empty directory, written
+# out by hand from that file, not from the library (layout: README "Output layout"; seeds:
+# docs/architecture.md "Seeds"): results/{runs|snapshots}/<case>/seeds~A-B.parquet.
+# - <case> is method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S/grid~R. What a case leaves unset
+#   comes from case_defaults (eta 1, truncation none, dt_growth 1.3), else the paper's (scheme
+#   symmetric, time grid exact); `preset: authors` is truncation 3, scheme authors, grid authors.
+#   FD takes eta 1, truncation none, growth 1 whatever the defaults.
+BINS = "pt/bins/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+FIXED = "pt/fixed/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+ADAPTIVE = "pt/adaptive/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1 = "mtpt/collision/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_05 = "mtpt/collision/n~{n}/eta~0.5/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_01 = "mtpt/collision/n~{n}/eta~0.1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_025_CUT = "mtpt/collision/n~{n}/eta~0.25/trunc~3/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1_CUT = "mtpt/collision/n~{n}/eta~1/trunc~3/growth~1.3/scheme~symmetric/grid~exact"
+COLLISION_1_CUT_SEQUENTIAL = "mtpt/collision/n~{n}/eta~1/trunc~3/growth~1.3/scheme~sequential/grid~exact"
+SPH_1 = "mtpt/sph/n~{n}/eta~1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+SPH_01 = "mtpt/sph/n~{n}/eta~0.1/trunc~none/growth~1.3/scheme~symmetric/grid~exact"
+SPH_AUTHORS = "mtpt/sph/n~{n}/eta~1/trunc~3/growth~1.3/scheme~authors/grid~authors"
+FD = "fd/implicit/n~{n}/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact"
+# - Seeds A-B of each N. Realisation r has seed base_seed + r = r. `realisations: 1` is seed 0,
+#   and FD runs once; `ensemble` is the `realisations` count of N (30: 3, 60: 3, 100: 2, 200: 2),
+#   capped at max_realisations. For N <= seed_blocks.max_n = 60, seeds run seed_blocks.size = 2
+#   to a job, in blocks starting at 0, 2, ...; above it, one seed a job.
+SEED_0 = {30: ["0-0"], 100: ["0-0"]}  # n [30, 100], one realisation
+CAPPED_AT_2 = {30: ["0-1"], 100: ["0-0", "1-1"]}  # n [30, 100]: 3 -> 2 seeds, one block; 2 seeds, two jobs
+FIG6_SEEDS = {30: ["0-1"], 60: ["0-1"], 100: ["0-0", "1-1"], 200: ["0-0", "1-1"]}  # each capped at 2
+FIG8_SEEDS = {30: ["0-0"], 60: ["0-0"], 100: ["0-0"], 200: ["0-0"]}  # FD: once
+FIG9_SEEDS = {30: ["0-1", "2-2"], 60: ["0-1", "2-2"], 100: ["0-0", "1-1"], 200: ["0-0", "1-1"]}  # 3, 3, 2, 2: no cap
+TRADEOFF_SEEDS = {30: ["0-1"], 60: ["0-1"]}  # capped at 2 (3 -> 2 both)
+TRADEOFF_FD_SEEDS = {30: ["0-0"], 60: ["0-0"]}
 
 
-@pytest.mark.parametrize("fig", [f"fig{k}" for k in range(1, 10)] + ["tradeoff"])
+def _tables(kind, cases, seeds):
+    return {f"results/{kind}/{c.format(n=n)}/seeds~{s}.parquet" for c in cases for n, ss in seeds.items() for s in ss}
+
+
+# - Figs. 1 and 2 read the run of seed 0 of each case; Fig. 7 final states (results/snapshots/),
+#   no per-step table; every other figure the runs of its ensembles (counts: cases x tables of a case).
+EXPECTED_TABLES = {  # figure: (its run tables, its snapshot tables)
+    "fig1": (_tables("runs", [BINS, FIXED, COLLISION_1], SEED_0), set()),  # 3 x 2
+    "fig2": (_tables("runs", [BINS, FIXED, COLLISION_1], SEED_0), set()),  # 3 x 2
+    "fig3": (_tables("runs", [ADAPTIVE, SPH_1], CAPPED_AT_2), set()),  # 2 x 3
+    "fig4": (_tables("runs", [ADAPTIVE, SPH_1, COLLISION_1], CAPPED_AT_2), set()),  # 3 x 3
+    "fig5": (  # 5 x 3
+        _tables("runs", [COLLISION_1, COLLISION_01, SPH_1, SPH_01, COLLISION_025_CUT], CAPPED_AT_2),
+        set(),
+    ),
+    "fig6": (_tables("runs", [COLLISION_1], FIG6_SEEDS), set()),  # 1 x 6
+    "fig7": (set(), _tables("snapshots", [COLLISION_01, FIXED], SEED_0)),  # 2 x 2 snapshots
+    "fig8": (_tables("runs", [FD], FIG8_SEEDS), set()),  # 1 x 4
+    "fig9": (  # 6 x 8
+        _tables(
+            "runs",
+            [COLLISION_1, SPH_1, COLLISION_05, COLLISION_1_CUT, COLLISION_1_CUT_SEQUENTIAL, SPH_AUTHORS],
+            FIG9_SEEDS,
+        ),
+        set(),
+    ),
+    "tradeoff": (  # 1 x 2 + 4 x 2
+        _tables("runs", [FD], TRADEOFF_FD_SEEDS)
+        | _tables("runs", [ADAPTIVE, COLLISION_1, COLLISION_1_CUT, COLLISION_1_CUT_SEQUENTIAL], TRADEOFF_SEEDS),
+        set(),
+    ),
+}
+
+
+@pytest.mark.parametrize("fig", list(EXPECTED_TABLES))
 def test_each_figure_target_plans_only_its_runs(fig, tmp_path):
-    cfg = load(TINY)
-    proc = snakemake(tmp_path, "-n", f"figures/{fig}.png", configfile=TINY)
-    assert set(planned_outputs(proc)) == _expected_runs(cfg, fig)
-    snaps = planned_outputs(proc, prefix="results/snapshots/")
-    assert (len(snaps) > 0) == (fig == "fig7")  # particle snapshots only where a figure plots them
+    runs, snapshots = EXPECTED_TABLES[fig]
+    proc = run_snakemake(tmp_path, f"figures/{fig}.png", dry_run=True, configfile=TINY)
+    assert set(planned_outputs(proc)) == runs
+    # particle snapshots only where a figure plots them
+    assert set(planned_outputs(proc, prefix="results/snapshots/")) == snapshots
     assert planned_outputs(proc, prefix="results/shear/") == []
 
 
 def test_fig10_target_runs_only_the_shear_cases(tmp_path):
-    proc = snakemake(tmp_path, "-n", "figures/fig10.png", configfile=TINY)
+    proc = run_snakemake(tmp_path, "figures/fig10.png", dry_run=True, configfile=TINY)
     assert planned_outputs(proc) == []
     shear = planned_outputs(proc, prefix="results/shear/")
     assert sorted(shear) == sorted(
@@ -290,19 +339,7 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     import time
 
     target = "results/tables/comic.parquet"
-    cmd = [
-        sys.executable,
-        "-m",
-        "snakemake",
-        "-s",
-        str(ROOT / "Snakefile"),
-        "-d",
-        str(tmp_path),
-        "-j2",
-        target,
-        "--configfile",
-        str(TINY),
-    ]
+    cmd = snakemake_command(tmp_path, target, configfile=TINY)
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.time() + 120
     while time.time() < deadline and len(list((tmp_path / "results").rglob("*.parquet"))) < 6:
@@ -310,10 +347,10 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)  # no clean-up: jobs die mid-write or mid-run
     proc.wait()
     assert not (tmp_path / target).exists(), "the run finished before it could be killed"
-    again = snakemake(tmp_path, target, configfile=TINY, check=False)  # the killed run's lock is still there
+    again = run_snakemake(tmp_path, target, configfile=TINY, check=False)  # the killed run's lock is still there
     assert again.returncode != 0 and "--unlock" in again.stdout + again.stderr
-    snakemake(tmp_path, "--unlock", configfile=TINY)  # README: after a kill -9, unlock, then the same command
-    snakemake(tmp_path, target, configfile=TINY)
+    run_snakemake(tmp_path, "--unlock", configfile=TINY)  # README: after a kill -9, unlock, then the same command
+    run_snakemake(tmp_path, target, configfile=TINY)
     assert (tmp_path / target).read_bytes() == (tiny_run / target).read_bytes()
     for new in (tmp_path / "results/runs").rglob("*.parquet"):
         old = tiny_run / new.relative_to(tmp_path)
@@ -323,17 +360,17 @@ def test_sigkill_then_rerun_gives_identical_tables(tiny_run, tmp_path):
 
 
 def test_report_holds_every_figure_with_its_caption(tiny_run):
-    snakemake(tiny_run, "--report", "report.html", configfile=TINY)
+    run_snakemake(tiny_run, "--report", "report.html", configfile=TINY)
     html = (tiny_run / "report.html").read_text(errors="replace")
     assert len(html) > 100_000
-    for k in range(1, 11):
-        assert f"fig{k}.png" in html
-    assert "Reproduces" in html and "tradeoff.png" in html
+    for fig in DEFAULT_FIGURES:
+        assert f"{fig}.png" in html, fig
+    assert "Reproduces" in html
 
 
 # --- every case a section lists is drawn and tabulated, and cases stay apart -------------------
 
-PLOTTED = [f"fig{k}" for k in range(1, 10)] + ["tradeoff"]
+PLOTTED = list(CASE_FIGURES)  # the figures drawn from the cases of their section
 
 
 def _cases_in(table):
@@ -343,16 +380,16 @@ def _cases_in(table):
 
 
 @pytest.mark.parametrize("fig", PLOTTED)
-def test_each_figure_writes_the_data_of_exactly_its_cases(tiny_run, fig):
-    cfg = load(TINY)
+def test_each_figure_writes_the_data_of_exactly_its_cases(tiny_run, fig, tiny_config):
+    cfg = tiny_config
     ensembles = spec_ensembles(cfg["tradeoff"], cfg) if fig == "tradeoff" else figure_ensembles(cfg, fig)
     data = pd.read_parquet(tiny_run / f"results/figures/{fig}.parquet")
     assert {"series", *CASE_COLUMNS, "x", "y"} <= set(data.columns)
     assert _cases_in(data) == {e.case for e in ensembles}
 
 
-def test_an_added_case_is_drawn_from_its_summary(tiny_run):
-    cfg = load(TINY)
+def test_an_added_case_is_drawn_from_its_summary(tiny_run, tiny_config):
+    cfg = tiny_config
     spec = {"method": "mtpt", "kernel": "collision", "eta": 0.25, "truncation": 3}
     assert spec in cfg["figures"]["fig5"]["cases"]  # the tiny config's added case
     added = Case.from_spec(spec, 100, cfg["case_defaults"])
@@ -363,8 +400,8 @@ def test_an_added_case_is_drawn_from_its_summary(tiny_run):
     np.testing.assert_array_equal(rows["y"].to_numpy(), plotted)  # the figure shows the summary's values
 
 
-def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
-    cfg = load(TINY)
+def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run, tiny_config):
+    cfg = tiny_config
     base = Case.from_spec({"method": "mtpt", "kernel": "collision", "eta": 1}, None, cfg["case_defaults"])
     truncated = replace(base, truncation=3.0)
     sequential = replace(truncated, scheme="sequential")
@@ -387,14 +424,14 @@ def test_cases_differing_in_one_dimension_stay_apart_in_every_table(tiny_run):
         assert claims["claim"].str.startswith(case_label(m) + ": COMIC minimum").sum() == 2, case_label(m)
 
 
-def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run):
-    cfg = load(TINY)
-    proc = snakemake(tiny_run, "-n", "figures/fig9_mechanism.png", configfile=TINY)
+def test_mechanism_target_shares_runs_and_draws_the_controlled_experiments(tiny_run, tiny_config):
+    cfg = tiny_config
+    proc = run_snakemake(tiny_run, "figures/fig9_mechanism.png", dry_run=True, configfile=TINY)
     planned = [e for e in re.findall(r"wildcards: (.*)", proc.stdout) if "scheme=" in e]
     # the equations and the sequential loop are Fig. 9's cases: already run, never planned again
     assert planned and not any("trunc=none" in e and "scheme=symmetric" in e for e in planned)
     assert not any("scheme=sequential," in e or e.endswith("scheme=sequential") for e in planned)
-    snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+    run_snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
     assert (tiny_run / "figures/fig9_mechanism.png").stat().st_size > 5000
     data = pd.read_parquet(tiny_run / "results/figures/fig9_mechanism.parquet")
     assert set(data["panel"]) == set("abcd")
@@ -428,27 +465,19 @@ def _planned_rules(proc):
     return set(re.findall(r"^\s*(?:local)?rule (\w+):", proc.stdout + proc.stderr, flags=re.M)) - {"all"}
 
 
-def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
-    src = tmp_path / "src"  # a copy of the workflow whose library we edit
-    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
+@pytest.fixture
+def tiny_run_copy(tiny_run, tmp_path):
+    """A copy of the finished tiny run (its report left out), for dry runs of an edited workflow_copy."""
     work = tmp_path / "work"
     shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
+    return work
+
+
+def test_code_edits_rerun_only_the_rules_that_use_that_code(workflow_copy, tiny_run_copy):
+    src, work = workflow_copy, tiny_run_copy  # the library of src is edited
 
     def plan():
-        cmd = [
-            sys.executable,
-            "-m",
-            "snakemake",
-            "-s",
-            str(src / "Snakefile"),
-            "-d",
-            str(work),
-            "-n",
-            "--configfile",
-            str(TINY),
-        ]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        proc = run_snakemake(work, snakefile=src / "Snakefile", dry_run=True, configfile=TINY)
         return _planned_rules(proc), proc
 
     assert plan()[0] == set()  # the same code in another place: nothing to do
@@ -476,45 +505,45 @@ def test_code_edits_rerun_only_the_rules_that_use_that_code(tiny_run, tmp_path):
         assert plan()[0] == set(), module
 
 
-def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path):
-    cfg = load(TINY)
+def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path, tiny_config):
+    cfg = tiny_config
     del cfg["shear"], cfg["tradeoff"]
     path = tmp_path / "lean.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    proc = snakemake(tmp_path, "-n", configfile=path)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=path)
     assert "figures/fig9.png" in proc.stdout and "fig10" not in proc.stdout and "tradeoff" not in proc.stdout
 
 
 # --- corrupt tables are found before use and rebuilt ------------------------------------------
 
 
-def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run):
-    cfg = load(TINY)
+def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]  # a table Fig. 9 reads
     good = run.read_bytes()
     before = pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS))
     summaries = sorted((tiny_run / "results/tables/cases").rglob("*.parquet"))
     run.write_bytes(good[:100])  # truncate -s 100
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS)), before)  # rebuilt
     assert (run.parent / (run.name + ".corrupt")).exists()
     assert all(s.exists() for s in summaries)  # no good table was lost on the way
-    again = snakemake(tiny_run, "-n", configfile=TINY)
+    again = run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
-def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run):
-    cfg = load(TINY)
+def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[-1], cfg)[-1]
     good = run.read_bytes()
     run.write_bytes(good[:100])
     files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
-    snakemake(tiny_run, "-n", configfile=TINY)
+    run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert run.read_bytes() == good[:100]  # not moved, not repaired
     assert not (run.parent / (run.name + ".corrupt")).exists()
     assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
-    proc = snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
+    proc = run_snakemake(tiny_run, configfile=TINY)  # the run checks, sets aside and rebuilds
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0
 
@@ -530,16 +559,16 @@ def test_set_aside_derived_tables_are_rebuilt_by_the_next_run(tiny_run):
     before = {p: p.read_bytes() for p in derived}
     for p in derived:
         p.write_bytes(before[p][:100])
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     for p in derived:
         assert f"corrupt table {p.relative_to(tiny_run)}" in proc.stderr
         assert p.read_bytes() == before[p], p  # rebuilt, byte for byte
-    again = snakemake(tiny_run, "-n", configfile=TINY)
+    again = run_snakemake(tiny_run, dry_run=True, configfile=TINY)
     assert "Nothing to be done" in again.stdout + again.stderr
 
 
-def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run):
-    cfg = load(TINY)
+def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run, tiny_config):
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]
     good = run.read_bytes()
     run.write_bytes(good[:100])
@@ -552,21 +581,21 @@ def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_r
     outputs = [p.relative_to(tiny_run).as_posix() for p in (tiny_run / "results").rglob("*.parquet")]
     (locks / "0.output.lock").write_text("\n".join(outputs) + "\n")
     files = {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()}
-    snakemake(tiny_run, configfile=TINY, check=False)
+    run_snakemake(tiny_run, configfile=TINY, check=False)
     assert run.read_bytes() == good[:100]  # not set aside: no file under results/ added, moved or changed
     assert {p: p.stat().st_mtime_ns for p in (tiny_run / "results").rglob("*") if p.is_file()} == files
-    unlock = snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
+    unlock = run_snakemake(tiny_run, "--unlock", configfile=TINY, check=False)
     assert unlock.returncode == 0, unlock.stderr[-2000:]
     assert not (locks.exists() and any(locks.iterdir())) and run.read_bytes() == good[:100]  # only looked
-    proc = snakemake(tiny_run, configfile=TINY)  # the lock gone: checked, set aside, rebuilt
+    proc = run_snakemake(tiny_run, configfile=TINY)  # the lock gone: checked, set aside, rebuilt
     assert f"corrupt table {run.relative_to(tiny_run)}" in proc.stderr and pd.read_parquet(run).shape[0] > 0
     assert f"corrupt table {other.relative_to(tiny_run)}" not in proc.stderr  # read whole: sound
     record.rmdir()  # the module's run as it was, for the tests after this one
     record.write_text(f"{hashlib.sha256(other.read_bytes()).hexdigest()}  {other.name}\n")
 
 
-def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run):
-    cfg = load(TINY)
+def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run, tiny_config):
+    cfg = tiny_config
     ensembles = figure_ensembles(cfg, "fig9")
     here, there = (tiny_run / case_run_paths(e, cfg)[0] for e in (ensembles[0], ensembles[1]))
     assert pd.read_parquet(here)["n"].iloc[0] != pd.read_parquet(there)["n"].iloc[0] or here.parent != there.parent
@@ -574,7 +603,7 @@ def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run)
     for suffix in ("", ".sha256"):  # a valid table and its matching checksum: whole, but the wrong case
         Path(str(here) + suffix).write_bytes(Path(str(there) + suffix).read_bytes())
     (here.parent / (here.name + ".sha256")).write_text((there.parent / (there.name + ".sha256")).read_text())
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table {here.relative_to(tiny_run)}" in proc.stderr and "another case's table" in proc.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(here).drop(columns=list(TIMING_COLUMNS)), before)
 
@@ -586,13 +615,13 @@ def test_a_second_run_in_the_same_directory_is_refused_and_the_first_completes(t
     import time
 
     target = "results/figures/fig8.parquet"  # FD only: a short run, long enough to be running still
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2", target]
-    first = subprocess.Popen([*cmd, "--configfile", str(TINY)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    cmd = snakemake_command(tmp_path, target, configfile=TINY)
+    first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     locks = tmp_path / ".snakemake" / "locks"
     deadline = time.time() + 120
     while time.time() < deadline and not (locks.exists() and any(locks.iterdir())):
         time.sleep(0.1)
-    second = snakemake(tmp_path, target, configfile=TINY, check=False)
+    second = run_snakemake(tmp_path, target, configfile=TINY, check=False)
     out, _ = first.communicate(timeout=600)
     assert second.returncode != 0 and "cannot be locked" in second.stdout + second.stderr
     assert first.returncode == 0, out[-3000:]
@@ -607,24 +636,23 @@ def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
         resource.setrlimit(resource.RLIMIT_FSIZE, (100 * 1024, 100 * 1024))
 
     env = {**os.environ, "PARTICLE_ENTROPY_MIN_FREE_MB": "1e12"}  # and every disk looks nearly full
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(tmp_path), "-j2"]
-    cmd += ["figures/fig8.png", "--configfile", str(TINY)]
-    full = subprocess.run(cmd, capture_output=True, text=True, env=env, preexec_fn=small_files)
+    target = "figures/fig8.png"
+    full = run_snakemake(tmp_path, target, configfile=TINY, env=env, preexec_fn=small_files, check=False)
     assert full.returncode != 0 and "Error in rule plot_fig8" in full.stdout + full.stderr
     assert "No space left on device? The file system holding" in full.stderr
     assert "rerun the same command" in full.stderr
-    subprocess.run(cmd, capture_output=True, text=True, env=env, check=True)  # room again: it completes
+    run_snakemake(tmp_path, target, configfile=TINY, env=env)  # room again: it completes
     assert (tmp_path / "figures" / "fig8.png").stat().st_size > 100 * 1024
 
 
-def test_a_config_without_figures_judges_no_claim(tmp_path):
-    cfg = load(TINY)
+def test_a_config_without_figures_judges_no_claim(tmp_path, tiny_config):
+    cfg = tiny_config
     cfg["figures"] = {}
     for key in ("shear", "tradeoff", "mechanism"):
         del cfg[key]
     path = tmp_path / "none.yaml"
     path.write_text(yaml.safe_dump(cfg, sort_keys=True))
-    snakemake(tmp_path, configfile=path)
+    run_snakemake(tmp_path, configfile=path)
     assert "No claim judged" in (tmp_path / "results/paper_claims.md").read_text()
     assert list(pd.read_parquet(tmp_path / "results/tables/paper_claims.parquet").columns) == [
         "claim",
@@ -643,7 +671,7 @@ def test_a_short_message_for_a_misspelt_key(tmp_path):
     text = (ROOT / "config.yaml").read_text().replace("physics:", "physic:", 1)
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
-    proc = snakemake(tmp_path, "-n", configfile=bad, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=bad, check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "did you mean physics?" in out
     assert len(out.splitlines()) < 12  # not the whole schema and config around the one useful line
@@ -651,7 +679,7 @@ def test_a_short_message_for_a_misspelt_key(tmp_path):
 
 def test_a_yaml_error_in_config_yaml_names_its_line(tmp_path):
     (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\nshear: {n: 10\n")
-    proc = snakemake(tmp_path, "-n", check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, check=False)
     assert proc.returncode != 0 and "config.yaml: not valid YAML at line" in proc.stdout + proc.stderr
 
 
@@ -662,7 +690,7 @@ TEMPLATE = '__use_yte__: true\n?if __import__("pathlib").Path("{mark}").touch() 
 def test_a_template_in_config_yaml_is_refused_before_it_runs(tmp_path):
     mark = tmp_path / "ran"
     (tmp_path / "config.yaml").write_text((ROOT / "config.yaml").read_text() + "\n" + TEMPLATE.format(mark=mark))
-    proc = snakemake(tmp_path, "-n", check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "config.yaml: line" in out and "__use_yte__ makes Snakemake run" in out
     assert not mark.exists()  # checked before Snakemake loads it: the code never ran
@@ -671,7 +699,7 @@ def test_a_template_in_config_yaml_is_refused_before_it_runs(tmp_path):
 def test_a_template_configfile_is_refused_though_snakemake_ran_it(tmp_path):
     mark, template = tmp_path / "ran", tmp_path / "template.yaml"
     template.write_text(TEMPLATE.format(mark=mark))
-    proc = snakemake(tmp_path, "-n", configfile=template, check=False)
+    proc = run_snakemake(tmp_path, dry_run=True, configfile=template, check=False)
     assert proc.returncode != 0 and "template.yaml: line 1: __use_yte__" in proc.stdout + proc.stderr
     # Snakemake loads a --configfile before the Snakefile: the README says it is trusted as code
     assert mark.exists()
@@ -679,9 +707,9 @@ def test_a_template_configfile_is_refused_though_snakemake_ran_it(tmp_path):
 
 
 def test_nested_command_line_overrides_of_numbers_and_lists_work(tmp_path):
-    ok = snakemake(tmp_path, "-n", "--config", "physics={D: 0.002}", "comic_times=[5, 20]", configfile=TINY)
+    ok = run_snakemake(tmp_path, "--config", "physics={D: 0.002}", "comic_times=[5, 20]", dry_run=True, configfile=TINY)
     assert "physics.D" not in ok.stdout + ok.stderr
-    bad = snakemake(tmp_path, "-n", "--config", "physics={D: -1}", configfile=TINY, check=False)
+    bad = run_snakemake(tmp_path, "--config", "physics={D: -1}", dry_run=True, configfile=TINY, check=False)
     assert bad.returncode != 0 and "physics.D=-1 is not allowed" in bad.stdout + bad.stderr
 
 
@@ -701,7 +729,7 @@ CASE_PATH = "mtpt/collision/n~100/eta~1/trunc~none/growth~1.05/scheme~symmetric/
     ids=["seeds reversed", "seeds huge", "r 0", "eta 1e", "n 1", "unknown search"],
 )
 def test_a_hand_written_target_that_names_no_valid_run_is_refused_by_its_pattern(tmp_path, target, expected):
-    proc = snakemake(tmp_path, "-n", target, configfile=ROOT / "config.yaml", check=False)
+    proc = run_snakemake(tmp_path, target, dry_run=True, configfile=ROOT / "config.yaml", check=False)
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and "WorkflowError" in out and expected in out, out[-1500:]
     assert not (tmp_path / "results").exists()
@@ -760,9 +788,9 @@ def test_every_derived_table_column_is_documented(tiny_run):
     import pyarrow.parquet as pq
 
     if not (tiny_run / "results/figures/fig9_mechanism.parquet").exists():  # the mechanism tables too
-        snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
+        run_snakemake(tiny_run, "figures/fig9_mechanism.png", configfile=TINY)
     if not (tiny_run / "results/optimum").exists():  # and the optimum searches' plans and results
-        snakemake(tiny_run, "optimum", configfile=TINY)
+        run_snakemake(tiny_run, "optimum", configfile=TINY)
     sections = _column_doc_sections()
     tables = sorted((tiny_run / "results").rglob("*.parquet"))
     found = {}  # section heading -> {table: its columns}
@@ -791,11 +819,11 @@ def test_every_derived_table_column_is_documented(tiny_run):
             assert not absent, f"{copy}: documented but absent: {sorted(absent)}"
 
 
-def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
+def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run, tiny_config):
     from particle_entropy.analysis.optimum import REASONS, RESULT_COLUMNS, Search
 
-    cfg = load(TINY)
-    snakemake(tiny_run, "optimum", configfile=TINY)
+    cfg = tiny_config
+    run_snakemake(tiny_run, "optimum", configfile=TINY)
     for name, spec in cfg["optimum"].items():
         search = Search.from_config(name, spec, cfg)
         for ext in ("png", "pdf"):
@@ -815,19 +843,15 @@ def test_optimum_search_runs_round_by_round_on_the_tiny_config(tiny_run):
         assert int(table["realisations"].sum()) == int(row["runs_spent"])
         for r in plan.itertuples():  # every block is an ordinary simulation table
             assert (tiny_run / run_path(search.case_at(getattr(r, search.over)), r.first, r.last)).exists(), r
-    proc = snakemake(tiny_run, "-n", "optimum", configfile=TINY)
+    proc = run_snakemake(tiny_run, "optimum", dry_run=True, configfile=TINY)
     assert "Nothing to be done" in proc.stdout + proc.stderr
 
 
-def test_a_figure_edit_redraws_only_that_figure(tiny_run, tmp_path):
+def test_a_figure_edit_redraws_only_that_figure(workflow_copy, tiny_run_copy):
     from particle_entropy.figures import CASE_FIGURES
 
-    src, work = tmp_path / "src", tmp_path / "work"  # copies: the library edited, the finished run
-    shutil.copytree(ROOT / "workflow", src / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copy(ROOT / "Snakefile", src / "Snakefile")
-    shutil.copytree(tiny_run, work, ignore=shutil.ignore_patterns("report.html"))
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(src / "Snakefile"), "-d", str(work), "-n"]
-    plan = lambda: subprocess.run([*cmd, "--configfile", str(TINY)], capture_output=True, text=True, check=True)
+    src, work = workflow_copy, tiny_run_copy  # copies: the library edited, the finished run
+    plan = lambda: run_snakemake(work, snakefile=src / "Snakefile", dry_run=True, configfile=TINY)
     assert _planned_rules(plan()) == set()  # the same code in another place: nothing to do
     figures = src / "workflow/lib/particle_entropy/figures"
     every_figure = {f"plot_{fig}" for fig in CASE_FIGURES}
@@ -885,9 +909,8 @@ def test_parsing_the_workflow_imports_neither_scipy_nor_pandas(tmp_path):
     import json
 
     out = tmp_path / "imports.json"
-    args = ["-s", str(ROOT / "Snakefile"), "-d", str(tmp_path / "work"), "-n", "--configfile", str(TINY)]
-    proc = subprocess.run([sys.executable, "-c", RECORD_IMPORTS, f"{ROOT}/", str(out), *args], capture_output=True)
-    assert proc.returncode == 0, proc.stderr.decode()[-3000:]
+    launcher = ("-c", RECORD_IMPORTS, f"{ROOT}/", str(out))
+    run_snakemake(tmp_path / "work", dry_run=True, configfile=TINY, launcher=launcher)  # AssertionError if it fails
     seen = json.loads(out.read_text())
     assert not seen["scipy"]
     assert not [f for f in seen["by"] if not f.startswith("workflow/lib/")]  # Snakefile, rules, scripts: none
@@ -896,21 +919,21 @@ def test_parsing_the_workflow_imports_neither_scipy_nor_pandas(tmp_path):
     assert not seen["by"], seen["by"]
 
 
-def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run):
+def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_run, tiny_config):
     import json
 
     digests = tiny_run / ".snakemake" / "particle_entropy" / "table_digests.json"
     for _ in range(2):  # nothing to do; the parse checks every table (the second reads none settled before)
-        proc = snakemake(tiny_run, configfile=TINY)
+        proc = run_snakemake(tiny_run, configfile=TINY)
         assert "Nothing to be done" in proc.stdout + proc.stderr
     tables = {p.relative_to(tiny_run / "results").as_posix() for p in (tiny_run / "results").rglob("*.parquet")}
     assert set(json.loads(digests.read_text())["tables"]) == tables
     kept = digests.stat().st_mtime_ns
-    snakemake(tiny_run, configfile=TINY)
+    run_snakemake(tiny_run, configfile=TINY)
     assert digests.stat().st_mtime_ns == kept  # nothing changed, nothing rewritten
-    cfg = load(TINY)
+    cfg = tiny_config
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
     run.write_bytes(run.read_bytes()[:100])  # in place: the same inode
-    proc = snakemake(tiny_run, configfile=TINY)
+    proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0 and (run.parent / (run.name + ".corrupt")).exists()

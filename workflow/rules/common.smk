@@ -26,6 +26,7 @@ from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
 from particle_entropy.figures import BY_NAME as FIGURE, CASE_FIGURES, PAPER_FIGURES, figure_options
+from particle_entropy.figures import FIGURES as ALL_FIGURES
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
     FIGURE_DATA_PATTERN,
@@ -117,7 +118,7 @@ def looks_only():
 
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
 FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]  # figures.FIGURES: the one list
-SHEAR_FIGURE = ["fig10"] if "shear" in config else []
+SHEAR_FIGURE = [f.name for f in ALL_FIGURES if f.section == "shear" and "shear" in config]
 
 
 wildcard_constraints:
