@@ -123,3 +123,22 @@ def test_the_module_runs_as_the_page_says():
         text=True,
     )
     assert proc.returncode == 0, proc.stderr
+
+
+def test_the_readme_and_the_page_name_the_case_folder_as_the_code_builds_it():
+    """The README's output layout and this page spell a case's folder from case.CASE_DIR, every segment
+    included (a grid~ segment was once missing from both)."""
+    folder = columnsdoc.CASE_FOLDER
+    assert folder.count("/") == 7 and folder.endswith("/grid~R")  # method, kernel and six dimensions
+    assert folder in (ROOT / "README.md").read_text()
+    assert folder in (ROOT / "docs" / "columns.md").read_text()
+
+
+def test_the_page_says_what_every_figure_plots():
+    """Every figure that writes source data (all of figures.FIGURES but the searches) has its row in
+    the shared table, or, the shear flow with columns of its own, a section."""
+    from particle_entropy.figures import FIGURES
+
+    named = {name for row in columnsdoc.FIGURE_CONTENTS for name in row[0].split(", ")}
+    assert named == {f.name for f in FIGURES} - {"optimum", "fig10"}
+    assert any("results/figures/fig10.parquet" in s.paths for s in sections())

@@ -63,7 +63,7 @@ rule paper_claims:
         comic="results/tables/comic.parquet",
         realisations="results/tables/comic_realisations.parquet",
         summaries=summaries_of("fig3", "fig5"),
-        runs=section_inputs("fig1") if "fig1" in FIGURES else [],
+        runs=section_inputs("fig1") if "fig1" in PLOTTED else [],
     output:
         table="results/tables/paper_claims.parquet",
         md="results/paper_claims.md",

@@ -25,7 +25,7 @@ from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_asi
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
-from particle_entropy.figures import BY_NAME as FIGURE, CASE_FIGURES, PAPER_FIGURES, figure_options
+from particle_entropy.figures import BY_NAME as FIGURE, CASE_FIGURES, figure_options
 from particle_entropy.figures import FIGURES as ALL_FIGURES
 from particle_entropy.pipeline.sweeps import (
     CASE_DIR,
@@ -117,8 +117,22 @@ def looks_only():
 
 
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
-FIGURES = [f for f in PAPER_FIGURES if f in config["figures"]]  # figures.FIGURES: the one list
-SHEAR_FIGURE = [f.name for f in ALL_FIGURES if f.section == "shear" and "shear" in config]
+
+
+def in_config(section):
+    """Whether the config has ``section``, a dotted key (figures.fig3, tradeoff, shear)."""
+    node = config
+    for part in section.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
+
+
+# The figures of the default target whose section the config has (figures.FIGURES, the one list):
+# those drawn from their cases by the shared plot rule (figures.smk), and the shear flow's.
+PLOTTED = [f for f in CASE_FIGURES if in_config(FIGURE[f].section)]
+SHEAR_FIGURE = [f.name for f in ALL_FIGURES if f.section == "shear" and in_config(f.section)]
 
 
 wildcard_constraints:
@@ -138,9 +152,9 @@ wildcard_constraints:
 
 
 def all_targets():
-    figs = [f"figures/{f}.{ext}" for f in FIGURES + SHEAR_FIGURE for ext in ("png", "pdf")]
-    if "tradeoff" in config:
-        figs += ["figures/tradeoff.png", "figures/tradeoff.pdf", "results/tables/tradeoff.parquet"]
+    figs = [f"figures/{f}.{ext}" for f in PLOTTED + SHEAR_FIGURE for ext in ("png", "pdf")]
+    if in_config("tradeoff"):
+        figs.append("results/tables/tradeoff.parquet")
     return (
         rebuildable(CORRUPT)
         + figs

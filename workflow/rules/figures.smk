@@ -1,7 +1,7 @@
 # One rule per figure: tables in; figures/<fig>.png and .pdf and the plotted data
 # (results/figures/<fig>.parquet) out. Restyling reruns no simulation.
 
-for _fig in FIGURES + (["tradeoff"] if "tradeoff" in config else []):
+for _fig in PLOTTED:
 
     rule:
         name:

@@ -25,7 +25,7 @@ from ..analysis import claims, optimum
 from ..analysis.aggregate import ARGMIN_COLUMN_DOCS, MINIMA_COLUMN_DOCS, REALISATION_COLUMN_DOCS, SUMMARY_COLUMNS
 from ..analysis.resampling import CONFIDENCE, N_RESAMPLES
 from ..core import records
-from ..core.case import CASE_COLUMNS, MODEL_COLUMNS
+from ..core.case import CASE_COLUMNS, CASE_DIR, MODEL_COLUMNS
 from ..core.columns import CASE_COLUMN_DOCS, RECORD_COLUMN_DOCS
 from ..core.registry import SHEAR_CASES
 from ..core.settings import SHEAR
@@ -177,6 +177,10 @@ PLAN_COLUMN_DOCS = {  # optimum.PLAN_COLUMNS
 
 # ----------------------------------------------------------------------------- fixed prose
 TITLE = "# Columns of the tables the workflow writes"
+# a case's folder as the page writes it: case.CASE_DIR with each value's wildcard as a capital letter
+CASE_FOLDER = CASE_DIR.format(
+    method="{method}", kernel="{kernel}", n="N", eta="E", trunc="T", growth="G", scheme="S", grid="R"
+)
 INTRO = f"""\
 This page lists every Parquet table the workflow derives, one section per table: what one row
 holds, the rule that writes it, and each column with its meaning, unit and, where one applies,
@@ -196,7 +200,7 @@ unit (the total is 1 at t = 0), so a concentration is [1/L] and a sum of squared
 errors (SSE) is [1/L²]. Logarithms are natural. Equation numbers are those of Benson et al. (2020).
 
 **Paths.** `<case>` stands for a case's folder
-`{{method}}/{{kernel}}/n~N/eta~E/trunc~T/growth~G/scheme~S` (built by `Case.path`); other `<...>`
+`{CASE_FOLDER}` (built by `Case.path`); other `<...>`
 stand for one path segment. Every table has a `<name>.parquet.sha256` beside it (its checksum,
 not a table).
 
