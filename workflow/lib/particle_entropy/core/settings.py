@@ -3,7 +3,8 @@
 Each config section is declared here once, as a tuple of ``Setting``: the run settings
 (``SETTINGS``: physics, time, numerics, case_defaults), the keys of every section that lists cases
 (``CASE_SECTION``: figures, tradeoff, mechanism sweeps), the figures' drawing options
-(``FIGURE_OPTIONS``), the trade-off sweep (``TRADEOFF``), the mechanism experiments
+(``FIGURE_OPTIONS``), seeds and their blocks (``SEEDS``), the COMIC times (``COMIC_TIMES``), the
+claims' tolerances (``CLAIMS``), the trade-off sweep (``TRADEOFF``), the mechanism experiments
 (``MECHANISM``), the shear flow (``SHEAR``) and an adaptive search (``SEARCH``), with the caps
 they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``SHEAR_MAX_N``). From them come the paper's
 defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
@@ -64,8 +65,9 @@ class Setting:
 
     @property
     def section(self) -> str:
-        """The key of the mapping the setting sits in (``physics``, ``mechanism.lattice``)."""
-        return self.key.rsplit(".", 1)[0]
+        """The key of the mapping the setting sits in (``physics``, ``mechanism.lattice``; the
+        config itself: empty)."""
+        return self.key.rsplit(".", 1)[0] if "." in self.key else ""
 
     @property
     def has_default(self) -> bool:
@@ -343,6 +345,8 @@ SECTION_DOCS = {
     "figures": "The cases of each figure (figures.FIGURES: fig1 ... fig9; fig10 is the shear section).",
     "<section>": "Cases x n: the models drawn, the N and the realisations of each N.",
     "realisations[]": "One N and its number of realisations.",
+    "seed_blocks": "Blocks of seeds run by one job (results do not depend on the blocking).",
+    "claims": "Tolerances for judging the paper's claims.",
     "tradeoff": "Speed-accuracy sweep: cases x n like a figure, plus the times to tabulate.",
     "mechanism": "Controlled experiments behind figures/fig9_mechanism.png (its own target): case sweeps at "
     "shared seeds, and the Fig. 8 domain experiment.",
@@ -356,6 +360,91 @@ SECTION_DOCS = {
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }
+
+# ------------------------------------------------------------------------------ seeds, times, claims
+SEEDS = (
+    Setting(
+        "base_seed",
+        "base_seed",
+        0,
+        "realisation r of every case uses seed base_seed + r",
+        kind="integer",
+        low=0,
+        high=MAX_SEED,
+        range_text="an integer >= 0 whose seeds stay within int64 (base_seed + realisations - 1 <= 2^63 - 1)",
+        required=True,
+    ),
+    Setting("size", "seed_blocks.size", 20, "seeds per job for N <= max_n", kind="integer", low=1, required=True),
+    Setting(
+        "max_n",
+        "seed_blocks.max_n",
+        30_000,
+        "largest N run in blocks; larger N run one seed a job",
+        kind="integer",
+        low=0,
+        required=True,
+    ),
+)
+COMIC_TIMES = (
+    Setting(
+        "comic_times",
+        "comic_times",
+        NO_DEFAULT,
+        "times at which COMIC tables and minima are reported (nearest step)",
+        "T",
+        kind="shape",
+        shape={"type": "array", "minItems": 1, "uniqueItems": True, "items": {"type": "number", "minimum": 0}},
+        range_text="times in [0, physics.t_final], each once",
+        required=True,
+    ),
+)
+_RANGE = {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}
+CLAIMS = (  # the tolerances the paper's claims are judged at (analysis/claims.py); the paper's own
+    Setting(
+        "fd_optimum_nodes",
+        "claims.fd_optimum_nodes",
+        [1000, 10000],
+        "allowed range of the FD COMIC optimum N, met at half the COMIC times or more",
+        kind="shape",
+        shape=_RANGE,
+        range_text="[low, high] with low <= high",
+    ),
+    Setting(
+        "collision_eta1_optimum",
+        "claims.collision_eta1_optimum",
+        [1000, 10000],
+        "allowed range of the collision eta = 1 optimum N at the last COMIC time",
+        kind="shape",
+        shape=_RANGE,
+        range_text="[low, high] with low <= high",
+    ),
+    Setting(
+        "collision_eta05_optimum",
+        "claims.collision_eta05_optimum",
+        [100, 1000],
+        "allowed range of the collision eta = 0.5 optimum N at the last COMIC time",
+        kind="shape",
+        shape=_RANGE,
+        range_text="[low, high] with low <= high",
+    ),
+    Setting(
+        "sph_flat_min_n",
+        "claims.sph_flat_min_n",
+        100,
+        "SPH COMIC is roughly flat when, for every N >= this, |mean(N) - mean(N_opt)| <= sqrt(std(N)^2 + "
+        "std(N_opt)^2) (within the +-1 std error bars of the minimum)",
+        kind="integer",
+        low=1,
+    ),
+    Setting(
+        "adaptive_pt_hc_tolerance",
+        "claims.adaptive_pt_hc_tolerance",
+        0.05,
+        "allowed |H_C - analytic| of adaptive-kernel PT at t = 1000",
+        "nats",
+        low=0.0,
+    ),
+)
 
 # ------------------------------------------------------------------------------ the shear flow
 SHEAR = (  # Appendix B; ShearConfig's fields (models/shear2d.py) besides `case`
@@ -590,5 +679,17 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
     ),
 )
 
-DECLARED = (*SETTINGS, *CASE_SECTION, *REALISATIONS_ENTRY, *FIGURE_OPTIONS, *TRADEOFF, *MECHANISM, *SHEAR, *SEARCH)
+DECLARED = (
+    *SETTINGS,
+    *SEEDS,
+    *COMIC_TIMES,
+    *CLAIMS,
+    *CASE_SECTION,
+    *REALISATIONS_ENTRY,
+    *FIGURE_OPTIONS,
+    *TRADEOFF,
+    *MECHANISM,
+    *SHEAR,
+    *SEARCH,
+)
 BY_KEY = {s.key: s for s in DECLARED}  # every declared setting by its config key

@@ -27,6 +27,8 @@ from ..core.registry import ALL_KERNELS, METHODS, PRESETS
 from ..core.settings import (
     BY_KEY,
     CASE_SECTION,
+    CLAIMS,
+    COMIC_TIMES,
     FIGURE_OPTIONS,
     MAX_REALISATIONS,
     MECHANISM,
@@ -34,6 +36,7 @@ from ..core.settings import (
     REALISATIONS_ENTRY,
     SEARCH,
     SECTION_DOCS,
+    SEEDS,
     SETTINGS,
     SHEAR,
     TRADEOFF,
@@ -204,6 +207,9 @@ def blocks() -> dict[str, Block]:
     )
     out["defs"] = defs
     generated = {name: Block(pairs) for name, pairs in out.items()}
+    generated["seeds"] = Block(base_seed=entry(SEEDS[0]), seed_blocks=object_body("seed_blocks", SEEDS))
+    generated["comic_times"] = Block(comic_times=entry(COMIC_TIMES[0]))
+    generated["claims"] = object_body("claims", CLAIMS)
     generated["figures"] = figures_body()
     generated["tradeoff"] = object_body("tradeoff", case_section("tradeoff", TRADEOFF))
     generated["mechanism"] = object_body("mechanism", MECHANISM)

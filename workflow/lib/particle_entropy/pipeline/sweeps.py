@@ -109,18 +109,22 @@ def figure_ensembles(config: Mapping, fig: str) -> list[Ensemble]:
     return spec_ensembles(config["figures"][fig], config)
 
 
+def _block(ens: Ensemble, config: Mapping) -> int:
+    """Seeds a job of ``ens`` runs: seed_blocks.size up to N = seed_blocks.max_n, else one (a config
+    without seed_blocks, as a library caller's may be: one seed a job)."""
+    blocks = config.get("seed_blocks")
+    return int(blocks["size"]) if blocks and ens.case.n <= int(blocks["max_n"]) else 1
+
+
 def block_size(ens: Ensemble, config: Mapping) -> int:
     """Seeds in the largest job of an ensemble (``seed_blocks``), without building the blocks."""
-    blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
-    size = int(blocks["size"]) if ens.case.n <= int(blocks["max_n"]) else 1
-    return min(size, ens.realisations)
+    return min(_block(ens, config), ens.realisations)
 
 
 def seed_blocks(ens: Ensemble, config: Mapping) -> list[tuple[int, int]]:
     """Inclusive seed ranges of the jobs behind an ensemble: blocks aligned to multiples of the
     block size (config seed_blocks.size, for N <= seed_blocks.max_n; else one seed a job)."""
-    blocks = config.get("seed_blocks", {"size": 1, "max_n": 0})
-    size = int(blocks["size"]) if ens.case.n <= int(blocks["max_n"]) else 1
+    size = _block(ens, config)
     base, count = int(config["base_seed"]), ens.realisations
     return [(base + r, base + min(r + size, count) - 1) for r in range(0, count, size)]
 
