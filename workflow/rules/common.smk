@@ -44,6 +44,7 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
+from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 
 check_sweeps(config)
@@ -286,6 +287,12 @@ def sim_mem_mb(wildcards):
     """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
     seeds = int(wildcards.last) - int(wildcards.first) + 1
     return estimate_mb(run_config(target_case(wildcards, RUN_PATTERN), config), seeds)
+
+
+def sim_priority(wildcards):
+    """The job's estimated seconds (jobcost): Snakemake starts the longest simulations first."""
+    seeds = int(wildcards.last) - int(wildcards.first) + 1
+    return estimated_seconds(run_config(target_case(wildcards, RUN_PATTERN), config), seeds)
 
 
 def sim_runtime_min(wildcards):

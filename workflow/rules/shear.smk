@@ -15,6 +15,7 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
             "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
         wildcard_constraints:
             case="|".join(SHEAR_CASES),
+        priority: lambda w: shear_seconds(w.case, config["shear"])  # the longest first
         conda:
             "../../envs/particle-entropy.yaml"
         resources:

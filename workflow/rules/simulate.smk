@@ -9,6 +9,7 @@ rule simulate:
         f"logs/simulate/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.log",
     benchmark:
         f"results/benchmarks/simulate/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
+    priority: sim_priority  # the longest first (jobcost.estimated_seconds)
     conda:
         "../../envs/particle-entropy.yaml"
     resources:

@@ -19,7 +19,7 @@ share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
   O(N x P_TERMS x boxes-in-range), kept as an independent cross-check of ``fgt``.
 
 For the untruncated Gaussian all methods drop pairs farther apart than
-``CUTOFF_SIGMAS`` sigma, where the kernel is below exp(-CUTOFF_SIGMAS^2 / 2) = 2.6e-18,
+``kernels.CUTOFF_SIGMAS`` sigma, where the kernel is below exp(-CUTOFF_SIGMAS^2 / 2) = 2.6e-18,
 i.e. below double-precision resolution of the self term (which is 1).
 """
 
@@ -33,15 +33,7 @@ from numba import njit
 
 from ..core.registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
 from .fastexp import exp_neg
-
-CUTOFF_SIGMAS = 9.0  # kernel widths searched when the kernel is not truncated
-
-
-def cutoff_radius(sigma: float, truncation: float | None) -> float:
-    """Distance beyond which a kernel of width ``sigma`` is dropped: ``truncation`` widths (the
-    authors' cut), or CUTOFF_SIGMAS for the whole Gaussian (below round-off of the self term)."""
-    return (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
-
+from .kernels import cutoff_radius
 
 P_TERMS = 24
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes

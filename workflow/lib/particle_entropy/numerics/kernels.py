@@ -8,6 +8,14 @@ import numpy as np
 
 from ..core.registry import SPH_CONSTANT
 
+CUTOFF_SIGMAS = 9.0  # kernel widths searched when the kernel is not truncated
+
+
+def cutoff_radius(sigma: float, truncation: float | None) -> float:
+    """Distance beyond which a kernel of width ``sigma`` is dropped: ``truncation`` widths (the
+    authors' cut), or CUTOFF_SIGMAS for the whole Gaussian (below round-off of the self term)."""
+    return (CUTOFF_SIGMAS if truncation is None else float(truncation)) * sigma
+
 
 def collision_sigma(eta: float, D: float, dt: float) -> float:
     """Standard deviation of the collision kernel, variance 4 eta D dt (Eq. 17)."""
