@@ -54,8 +54,6 @@ def available_bytes() -> float | None:
 # measured on one mt transfer step (N = 20,000 and 80,000): 16-18 B a pair in numpy arrays, about
 # 35 B a pair of resident memory with the KD tree's; rounded up, as memory.py's per-particle bytes
 SHEAR_PAIR_BYTES = 64.0
-
-
 SHEAR_PARTICLE_BYTES = 400.0
 
 
