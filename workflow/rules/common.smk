@@ -21,6 +21,7 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
+from particle_entropy.numerics.compiled import kernels_folder
 from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
@@ -309,6 +310,7 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
+KERNELS = kernels_folder()  # the ahead-of-time kernels of this code, numba and CPU
 SUMMARY_CODE = code_version(
     "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
 )

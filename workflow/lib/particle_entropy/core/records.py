@@ -8,6 +8,7 @@ import sys
 import time
 from collections.abc import Callable
 
+import numpy as np
 import pyarrow as pa
 
 # a run table's own columns, first in this order (their meanings: columns.RECORD_COLUMN_DOCS)
@@ -79,11 +80,33 @@ def arrow_table(columns: dict, constants: dict, length: int) -> pa.Table:
     """A table of ``columns`` (name -> values) and ``constants`` (name -> the value of every row,
     replacing a column of that name in place, else added after them), COLUMNS' names first in its
     order, then the others as given."""
-    arrays = {k: pa.array(v) for k, v in columns.items()}
+    arrays = {k: _array(v) for k, v in columns.items()}
     for k, v in constants.items():
-        arrays[k] = pa.nulls(length) if v is None else pa.array([v] * length)
+        arrays[k] = pa.nulls(length) if v is None else _array([v] * length)
     ordered = [c for c in COLUMNS if c in arrays]
     return pa.table({k: arrays[k] for k in ordered + [c for c in arrays if c not in COLUMNS]})
+
+
+def _array(values) -> pa.Array:
+    """``pa.array(values)`` built from the values' buffers where they make a float64, int64, bool
+    or str column without nulls (the types pa.array infers for them): pa.array itself imports
+    pandas (0.2 s) to ask whether the values are a pandas object, and a simulation job has none."""
+    a = np.asarray(values)
+    if a.ndim != 1 or a.size == 0:  # pa.array makes an empty list a column of nulls
+        return pa.array(values)
+    if a.dtype in (np.float64, np.int64):
+        return pa.Array.from_buffers(
+            pa.from_numpy_dtype(a.dtype), a.size, [None, pa.py_buffer(np.ascontiguousarray(a))]
+        )
+    if a.dtype == np.bool_:
+        bits = np.packbits(a, bitorder="little")
+        return pa.Array.from_buffers(pa.bool_(), a.size, [None, pa.py_buffer(bits)])
+    if a.dtype.kind == "U":
+        data = [s.encode() for s in a.tolist()]
+        offsets = np.zeros(a.size + 1, np.int32)
+        np.cumsum([len(b) for b in data], out=offsets[1:])
+        return pa.Array.from_buffers(pa.string(), a.size, [None, pa.py_buffer(offsets), pa.py_buffer(b"".join(data))])
+    return pa.array(values)  # anything else (nulls, mixed or other types): as pa.array infers it
 
 
 def _peak_rss_mb() -> float:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ..core import measures as M
 from ..core.runconfig import RunConfig
+from ..numerics.compiled import kernels
 
 
 def grid(cfg: RunConfig) -> tuple[np.ndarray, float]:
@@ -26,43 +26,16 @@ def initial_concentration(cfg: RunConfig) -> np.ndarray:
     return c
 
 
-@njit(cache=True)
-def _thomas_factor(n: int, r: float):
-    """LU factors of the constant tridiagonal (-r, 1 + 2r, -r) (Thomas algorithm)."""
-    inv_piv = np.empty(n)
-    upper = np.empty(n)
-    piv = 1.0 + 2.0 * r
-    inv_piv[0] = 1.0 / piv
-    upper[0] = -r * inv_piv[0]
-    for i in range(1, n):
-        piv = 1.0 + 2.0 * r + r * upper[i - 1]
-        inv_piv[i] = 1.0 / piv
-        upper[i] = -r * inv_piv[i]
-    return inv_piv, upper
-
-
-@njit(cache=True)
-def _thomas_solve(inv_piv, upper, r, d):
-    n = d.shape[0]
-    y = np.empty(n)
-    y[0] = d[0] * inv_piv[0]
-    for i in range(1, n):
-        y[i] = (d[i] + r * y[i - 1]) * inv_piv[i]
-    for i in range(n - 2, -1, -1):
-        y[i] -= upper[i] * y[i + 1]
-    return y
-
-
 class ImplicitSolver:
     """(I - r A) c^{n+1} = c^n on the interior nodes, r = D dt / dx^2; factorised once
     (Thomas algorithm: O(N) memory and work, stable since the matrix is diagonally dominant)."""
 
     def __init__(self, n_interior: int, r: float):
         self.r = float(r)
-        self._inv_piv, self._upper = _thomas_factor(n_interior, self.r)
+        self._inv_piv, self._upper = kernels().thomas_factor(n_interior, self.r)
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
-        return _thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
+        return kernels().thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
 
 
 class ExplicitSolver:

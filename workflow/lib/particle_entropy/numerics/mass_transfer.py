@@ -21,8 +21,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from .compiled import kernels
 from .gauss import FGT_TOLERANCE, choose_method, cutoff_radius, gauss_transform
 
 
@@ -91,76 +91,29 @@ def _substeps(c):
     return max(1, math.ceil(c / (1.0 - 1e-9)))
 
 
-@njit(cache=True)
-def _weights(r, m):
-    """1/r and the (3, N) right-hand sides [1/r, m, m/r] of the second pass."""
-    n = m.shape[0]
-    inv_r = np.empty(n)
-    q = np.empty((3, n))
-    for i in range(n):
-        ir = 1.0 / r[i]
-        inv_r[i] = ir
-        q[0, i] = ir
-        q[1, i] = m[i]
-        q[2, i] = m[i] * ir
-    return inv_r, q
-
-
-@njit(cache=True)
-def _offdiag(W_inv_r, inv_r, m, beta):
-    """sum_{j != i} P_ij = (1 + sum_j W_ij / r_j) / 2 - 1 / r_i (P_ii = 1 / r_i), and beta times
-    its maximum over mass-holding particles and over all particles."""
-    n = m.shape[0]
-    out = np.empty(n)
-    c_mass = 0.0
-    c_all = 0.0
-    for i in range(n):
-        o = 0.5 * (1.0 + W_inv_r[i]) - inv_r[i]
-        out[i] = o
-        c_all = max(c_all, beta * o)
-        if m[i] != 0.0:
-            c_mass = max(c_mass, beta * o)
-    return out, c_mass, c_all
-
-
-@njit(cache=True)
-def _update(m, offdiag, b, Wm, Wmr, inv_r):
-    """m (1 - b offdiag) + b/2 (sum_{j != i} W_ij m_j / r_i + sum_{j != i} W_ij m_j / r_j)."""
-    # Both sums are of non-negative terms. The fast transform leaves them within its
-    # tolerance (1e-17 of the summed mass in reach by default), which can dip below 0 where
-    # all neighbours are empty; 0 is their bound.
-    n = m.shape[0]
-    out = np.empty(n)
-    for i in range(n):
-        s1 = max(Wm[i] - m[i], 0.0)
-        s2 = max(Wmr[i] - m[i] * inv_r[i], 0.0)
-        out[i] = m[i] * (1.0 - b * offdiag[i]) + 0.5 * b * (s1 * inv_r[i] + s2)
-    return out
-
-
 def _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance):
     """The step on the particles within reach of mass (targets) with all particles as
     sources of the row sums r; None when it needs substeps (mass then travels further)."""
     xa = np.ascontiguousarray(x[active])
     ma = np.ascontiguousarray(m[active])
     r = gauss_transform(xa, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
-    inv_r, q = _weights(r, ma)
+    inv_r, q = kernels().weights(r, ma)
     # every particle within reach of a mass holder is in xa: its sums over xa are complete
     W3 = gauss_transform(xa, xa, q, sigma, truncation, method, tolerance=tolerance)
-    offdiag, c, _ = _offdiag(W3[0], inv_r, ma, beta)
+    offdiag, c, _ = kernels().offdiag(W3[0], inv_r, ma, beta)
     if _substeps(c) > 1:
         return None
     out = m.copy()
-    out[active] = _update(ma, offdiag, beta, W3[1], W3[2], inv_r)
+    out[active] = kernels().update(ma, offdiag, beta, W3[1], W3[2], inv_r)
     return TransferResult(out, 1, c)
 
 
 def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
     r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
-    inv_r, q = _weights(r, m)
+    inv_r, q = kernels().weights(r, m)
     # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
     W3 = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
-    offdiag, c, c_all = _offdiag(W3[0], inv_r, m, beta)
+    offdiag, c, c_all = kernels().offdiag(W3[0], inv_r, m, beta)
     substeps = _substeps(c)
     if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
         c = c_all
@@ -170,5 +123,5 @@ def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
     for k in range(substeps):
         if k > 0:
             Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
-        m = _update(m, offdiag, b, Wm, Wmr, inv_r)
+        m = kernels().update(m, offdiag, b, Wm, Wmr, inv_r)
     return TransferResult(m, substeps, c)

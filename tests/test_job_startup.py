@@ -1,0 +1,128 @@
+"""A simulation job loads kernels compiled ahead of time (numerics/compiled.py) and so imports
+neither numba nor what numba pulls in (scipy), nor pandas; its kernels give the JIT's bits."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from particle_entropy.core.case import Case
+from particle_entropy.numerics import compiled, gauss
+from particle_entropy.pipeline.sweeps import run_settings
+
+LIB = ROOT / "workflow" / "lib"
+# the job script run as Snakemake runs it, with a stand-in `snakemake`; prints the modules it imported
+JOB = """
+import json, runpy, sys, types
+w, settings, kernels, out, log = json.loads(sys.argv[1])
+class Wildcards(dict):
+    __getattr__ = dict.__getitem__
+snakemake = types.SimpleNamespace(wildcards=Wildcards(w), params=types.SimpleNamespace(settings=settings),
+    input=types.SimpleNamespace(kernels=kernels), output=[out], log=[log])
+runpy.run_path(sys.argv[2], init_globals={"snakemake": snakemake}, run_name="__main__")
+print(json.dumps(sorted(sys.modules)))
+"""
+CASES = [
+    {"method": "pt", "kernel": "bins"},
+    {"method": "pt", "kernel": "adaptive"},
+    {"method": "mtpt", "kernel": "collision"},
+    {"method": "mtpt", "kernel": "sph", "eta": 0.1},
+    {"method": "fd", "kernel": "implicit"},
+]
+
+
+@pytest.fixture(scope="module")
+def kernels(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("kernels")
+    compiled.build(folder)
+    return folder
+
+
+def _job(spec: dict, kernels: Path, tmp_path: Path, kind: str = "runs") -> tuple[set, str]:
+    case = Case.from_spec(spec, 30)
+    config = {"physics": {"t_final": 0.5}, "time": {"dt0": 0.01, "fixed_dt": 0.1, "fd_dt": 0.05}}
+    w = {**case.wildcards(), "kind": kind, "first": "0", "last": "1"}
+    log = tmp_path / "job.log"
+    arg = json.dumps([w, run_settings(case, config), str(kernels), str(tmp_path / "t.parquet"), str(log)])
+    env = {**os.environ, "PYTHONPATH": str(LIB)}
+    script = str(ROOT / "workflow" / "scripts" / "simulate.py")
+    res = subprocess.run([sys.executable, "-c", JOB, arg, script], env=env, capture_output=True, text=True, check=True)
+    return set(json.loads(res.stdout.splitlines()[-1])), log.read_text()
+
+
+@pytest.mark.parametrize("spec", CASES, ids=lambda s: f"{s['method']}-{s['kernel']}")
+def test_a_simulation_job_imports_neither_numba_nor_scipy_nor_pandas(spec, kernels, tmp_path):
+    for kind in ("runs", "snapshots"):
+        modules, log = _job(spec, kernels, tmp_path, kind)
+        assert "JIT" not in log, log  # the compiled module was taken
+        heavy = {m.split(".")[0] for m in modules} & {"numba", "llvmlite", "scipy", "pandas"}
+        assert not heavy, (spec, kind, heavy)
+
+
+def test_without_its_module_a_job_runs_the_jit(tmp_path):
+    modules, log = _job(CASES[2], tmp_path / "none", tmp_path)
+    assert "numba's JIT runs them" in log and "numba" in modules
+
+
+def test_a_module_built_for_another_target_is_refused(kernels, tmp_path):
+    other = tmp_path / "other"
+    other.mkdir()
+    for f in kernels.iterdir():
+        (other / f.name).write_bytes(f.read_bytes())
+    (other / compiled.TARGET_FILE).write_text((kernels / compiled.TARGET_FILE).read_text().replace("cpu ", "cpu x"))
+    code = f"from particle_entropy.numerics import compiled; print(compiled.use({str(other)!r}))"
+    res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)
+    assert res.stdout.decode().strip() == "False" and b"other code, numba, CPU" in res.stderr
+
+
+def test_the_compiled_kernels_give_the_jits_bits(kernels):
+    """Every exported kernel, on inputs of several sizes and widths, against numba's JIT."""
+    code = f"""
+import numpy as np
+from particle_entropy.numerics import compiled, gauss
+jit = compiled._jit()
+assert compiled.use({str(kernels)!r})
+aot = compiled.kernels()
+rng = np.random.default_rng(7)
+def same(a, b):
+    a, b = (a if isinstance(a, tuple) else (a,)), (b if isinstance(b, tuple) else (b,))
+    assert all(np.asarray(u).tobytes() == np.asarray(v).tobytes() for u, v in zip(a, b, strict=True))
+for n in (2, 37, 3000):
+    x = np.sort(rng.normal(0, 1, n)); q = rng.random((3, n)); y = np.sort(rng.uniform(-2, 2, n // 2 + 1))
+    for s in (1e-3, 0.3):
+        r = 9 * s
+        same(aot.direct_symmetric(x, q, s, r), jit.direct_symmetric(x, q, s, r))
+        same(aot.direct(y, x, q, s, r, False), jit.direct(y, x, q, s, r, False))
+        for ratio in gauss.FGT_BOX_RATIOS:
+            w = gauss.fgt_box_width(s, ratio); t = gauss.fgt_offset_terms(s, r, w)
+            same(aot.fgt(y, x, q, s, w, t), jit.fgt(y, x, q, s, w, t))
+        c, A = jit.taylor_moments(x, q, s, float(x[0]), gauss.P_TERMS)
+        same(aot.taylor_moments(x, q, s, float(x[0]), gauss.P_TERMS), (c, A))
+        same(aot.taylor_eval(y, c, A, s, r), jit.taylor_eval(y, c, A, s, r))
+        rr, m = rng.random(n) + 1, rng.random(n)
+        inv, qq = jit.weights(rr, m)
+        same(aot.weights(rr, m), (inv, qq))
+        same(aot.offdiag(q[0], inv, m, 0.4), jit.offdiag(q[0], inv, m, 0.4))
+        same(aot.update(m, q[1], 0.3, q[0], q[2], inv), jit.update(m, q[1], 0.3, q[0], q[2], inv))
+    f = jit.thomas_factor(n, 0.7)
+    same(aot.thomas_factor(n, 0.7), f)
+    d = rng.random(n)
+    same(aot.thomas_solve(f[0], f[1], 0.7, d), jit.thomas_solve(f[0], f[1], 0.7, d))
+print("ok")
+"""
+    res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)
+    assert res.returncode == 0 and res.stdout.decode().strip() == "ok", res.stderr.decode()[-3000:]
+
+
+def test_every_kernel_is_exported_and_reached_through_kernels():
+    ns = compiled._jit()
+    assert set(vars(ns)) == set(compiled.EXPORTS)
+    x = np.linspace(-1.0, 1.0, 20)
+    assert gauss.gauss_transform(x, x, np.ones(20), 0.3).shape == (20,)

@@ -1,0 +1,164 @@
+"""The compiled kernels a simulation calls: numba's JIT, or the same kernels compiled ahead of time.
+
+Callers reach every numba kernel of the symmetric MTPT transfer, the kernel reconstructions and
+the finite differences through ``kernels()``, by the names of ``EXPORTS``. By default that is
+numba's JIT: the kernels are compiled, or loaded from numba's on-disk cache, on first call, and
+a process pays for numba itself first (import 0.15 s, target set-up 0.3 s, which also imports
+scipy.linalg), more than a small job's whole run.
+
+A simulation job instead calls ``use(folder)`` with a module that ``build(folder)`` compiled
+ahead of time from the same kernels (the workflow's rule ``compile_kernels``, once per code
+version), and so imports no numba at all. Its results are the same bits as the JIT's: the build
+hands LLVM the target the JIT would (this CPU's name and features, numba's settings), each
+kernel keeps its own flags (fastmath where it has them), and each is exported with the one
+signature runs call it with. ``use`` takes the module only if it was built from this code, by
+this numba, for this CPU and numba settings (``target()``); else the job runs the JIT as before.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import importlib.util
+import os
+import sys
+import types
+from pathlib import Path
+
+MODULE = "particle_entropy_kernels"  # the extension module's name (its init function's)
+TARGET_FILE = "target.txt"  # beside the module: what it was built from and for (target())
+# kernel -> (module of numerics, signature): the arrays and scalars runs pass (C-contiguous
+# float64 arrays; Python floats, ints and bools), and what each kernel returns
+EXPORTS = {
+    "direct": ("gauss_kernels", "f8[:, ::1](f8[::1], f8[::1], f8[:, ::1], f8, f8, b1)"),
+    "direct_symmetric": ("gauss_kernels", "f8[:, ::1](f8[::1], f8[:, ::1], f8, f8)"),
+    "fgt": ("gauss_kernels", "f8[:, ::1](f8[::1], f8[::1], f8[:, ::1], f8, f8, i8[::1])"),
+    "taylor_moments": ("gauss_kernels", "Tuple((f8[::1], f8[:, :, ::1]))(f8[::1], f8[:, ::1], f8, f8, i8)"),
+    "taylor_eval": ("gauss_kernels", "f8[:, ::1](f8[::1], f8[::1], f8[:, :, ::1], f8, f8)"),
+    "weights": ("transfer_kernels", "Tuple((f8[::1], f8[:, ::1]))(f8[::1], f8[::1])"),
+    "offdiag": ("transfer_kernels", "Tuple((f8[::1], f8, f8))(f8[::1], f8[::1], f8[::1], f8)"),
+    "update": ("transfer_kernels", "f8[::1](f8[::1], f8[::1], f8, f8[::1], f8[::1], f8[::1])"),
+    "thomas_factor": ("thomas", "UniTuple(f8[::1], 2)(i8, f8)"),
+    "thomas_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8, f8[::1])"),
+}
+# numba settings that change the machine code the JIT makes (numba.core.config)
+CODEGEN_SETTINGS = ("NUMBA_OPT", "NUMBA_ENABLE_AVX", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_LOOP_VECTORIZE")
+
+_loaded: types.ModuleType | None = None
+
+
+def kernels():
+    """The kernels' namespace: the ahead-of-time module a job took (``use``), else numba's JIT."""
+    return _loaded if _loaded is not None else _jit()
+
+
+@functools.cache
+def _jit() -> types.SimpleNamespace:
+    from . import gauss_kernels, thomas, transfer_kernels
+
+    modules = {"gauss_kernels": gauss_kernels, "transfer_kernels": transfer_kernels, "thomas": thomas}
+    return types.SimpleNamespace(**{name: getattr(modules[mod], name) for name, (mod, _) in EXPORTS.items()})
+
+
+def code_key() -> str:
+    """SHA-256 of the kernels' code: this module, the kernel modules and what they import."""
+    digest = hashlib.sha256()
+    for name in ("compiled.py", "gauss_kernels.py", "transfer_kernels.py", "thomas.py", "fastexp.py"):
+        digest.update((Path(__file__).with_name(name)).read_bytes())
+    return digest.hexdigest()
+
+
+def _cpu() -> str | None:
+    """The first processor's vendor, model and flags (Linux's /proc/cpuinfo), which fix the CPU
+    name and features LLVM finds; None where there is no such file."""
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return None
+    first = text.split("\n\n")[0]
+    keep = ("vendor_id", "cpu family", "model", "model name", "stepping", "flags")
+    lines = [line for line in first.splitlines() if line.split(":")[0].strip() in keep]
+    return hashlib.sha256("\n".join(lines).encode()).hexdigest() if lines else None
+
+
+def target(numba_version: str | None = None) -> str | None:
+    """What a module must have been built from and for to stand in for the JIT here: the kernels'
+    code, numba's version, the CPU and numba's code-generation settings; None where the CPU is
+    unknown (the JIT then always runs)."""
+    cpu = _cpu()
+    if cpu is None:
+        return None
+    if numba_version is None:
+        from importlib.metadata import version
+
+        numba_version = version("numba")
+    settings = " ".join(f"{k}={os.environ[k]}" for k in CODEGEN_SETTINGS if k in os.environ)
+    return f"code {code_key()}\nnumba {numba_version}\ncpu {cpu}\nsettings {settings}\n"
+
+
+def kernels_folder(root: str = "results/kernels") -> str:
+    """Where the workflow keeps the module built for ``target()``: a folder named by its hash."""
+    here = target()
+    return f"{root}/{hashlib.sha256(here.encode()).hexdigest()[:16] if here else 'unknown-cpu'}"
+
+
+def use(folder: str | os.PathLike) -> bool:
+    """Call the kernels of the module ``build`` wrote to ``folder`` from now on -> whether it was
+    taken (built here for this code; else the JIT stays, and a line on stderr says why)."""
+    global _loaded
+    folder = Path(folder)
+    found = sorted(folder.glob(MODULE + ".*"))
+    built_for = (folder / TARGET_FILE).read_text() if (folder / TARGET_FILE).exists() else None
+    here = target()
+    if not found or built_for is None or built_for != here:
+        why = "no module" if not found or built_for is None else "built for other code, numba, CPU or settings"
+        print(f"compiled kernels in {folder}: {why}; numba's JIT runs them", file=sys.stderr)
+        return False
+    spec = importlib.util.spec_from_file_location(MODULE, found[0])
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    _loaded = module
+    return True
+
+
+def build(folder: str | os.PathLike) -> Path:
+    """Compile every kernel of EXPORTS ahead of time into ``folder`` (numba.pycc) for this CPU, as
+    the JIT compiles it -> the module's path. Writes TARGET_FILE beside it last."""
+    import inspect
+    import warnings
+
+    import numba
+    from numba.core import codegen
+    from numba.core.registry import cpu_target
+
+    from . import gauss_kernels, thomas, transfer_kernels
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    modules = {"gauss_kernels": gauss_kernels, "transfer_kernels": transfer_kernels, "thomas": thomas}
+    jit = cpu_target.target_context.codegen()  # the JIT's target: CPU name and features
+    cpu_name, features = jit._get_host_cpu_name(), jit._tm_features
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # pycc's deprecation notice
+        from numba.pycc import CC
+
+        cc = CC(MODULE)
+    cc.output_dir = str(folder)
+    cc.verbose = False
+    cc.target_cpu = cpu_name
+    for name, (mod, signature) in EXPORTS.items():
+        kernel = getattr(modules[mod], name)
+        params = ", ".join(inspect.signature(kernel.py_func).parameters)
+        namespace = {"kernel": kernel}  # a call of the kernel: compiled with the kernel's own flags
+        exec(f"def call({params}):\n    return kernel({params})\n", namespace)
+        cc.export(name, signature)(namespace["call"])
+    aot_features = codegen.AOTCPUCodegen._customize_tm_features
+    codegen.AOTCPUCodegen._customize_tm_features = lambda self: features  # pycc's default: the CPU model's
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            cc.compile()
+    finally:
+        codegen.AOTCPUCodegen._customize_tm_features = aot_features
+    (folder / TARGET_FILE).write_text(target(numba.__version__) or "")
+    return next(folder.glob(MODULE + ".*"))
