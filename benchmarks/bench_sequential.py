@@ -81,10 +81,8 @@ def main() -> None:
             radius = TRUNCATION * sigma
             seed = np.uint64(12345 + step)
             sweeps = {"ref": sequential_reference._sweep} | {f: getattr(sequential, FORMS[f][0]) for f in args.forms}
-            runs = {
-                f: (lambda fn=fn: fn(x, m.copy(), label, sigma, radius, BETA, seed, False, True))
-                for f, fn in sweeps.items()
-            }
+            rest = (label, sigma, radius, BETA, seed, False, True)
+            runs = {f: (lambda fn=fn, x=x, m=m, rest=rest: fn(x, m.copy(), *rest)) for f, fn in sweeps.items()}
             outs = {f: run() for f, run in runs.items()}  # compile or load from numba's cache, untimed
             best = dict.fromkeys(runs, math.inf)
             for _ in range(args.repeats):  # alternate, so drifts in the machine hit all alike

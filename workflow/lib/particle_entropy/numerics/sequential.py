@@ -51,7 +51,8 @@ Generator.
 
 Two forms of the loop compute this: ``_sweep``, bit for bit the loop before issue 20
 (tests/sequential_reference.py), and ``_sweep_fma``, the default, equal to it to round-off and
-at 0.5-0.6 of its time for N >= 10,000 (docs/speed.md); ``sequential_transfer(..., exact=True)`` selects the first.
+at 0.5-0.6 of its time for N >= 10,000 (docs/speed.md); ``sequential_transfer(..., exact=True)``
+selects the first.
 """
 
 from __future__ import annotations
