@@ -1,15 +1,18 @@
-"""The authors' loop, today's code against the reference it replaced, side by side in one process.
+"""The authors' loop, both its forms against the reference they replaced, side by side in one process.
 
     python benchmarks/bench_sequential.py                   # N = 3,000, 10,000, 30,000
-    python benchmarks/bench_sequential.py --n 3000 --repeats 5
+    python benchmarks/bench_sequential.py --n 3000 --repeats 5 --forms fast
 
-Reference: tests/sequential_reference.py, the loop as it was before issue 20 (bit for bit the
-same results, checked here on every timed step). States: N positions uniform on [-Omega/2,
-Omega/2] stored in random order, a Gaussian plume of variance 2 D t as masses, the collision
-kernel at eta = 1 cut at 3 widths, at steps 100, 140 and 174 of the authors' time grid (dt0 =
-0.01, growth 1.05): the late steps hold most of a run's pair updates. A pair update is one
-(i, j) exchange; the count is measured on the state, not modelled. Each timing is the least of
-``repeats`` alternating runs (old, new, old, new, ...), after one untimed run of each.
+Reference: tests/sequential_reference.py, the loop as it was before issue 20. Forms: ``exact``
+(sequential._sweep, bit for bit the reference's results, checked here on every timed step) and
+``fast`` (sequential._sweep_fma, the default, equal to it to round-off: the largest difference
+is printed, relative to the total mass). States: N positions uniform on [-Omega/2, Omega/2]
+stored in random order, a Gaussian plume of variance 2 D t as masses, the collision kernel at
+eta = 1 cut at 3 widths, at steps 100, 140 and 174 of the authors' time grid (dt0 = 0.01, growth
+1.05): the late steps hold most of a run's pair updates. A pair update is one (i, j) exchange;
+the count is measured on the state, not modelled. Each timing is the least of ``repeats``
+alternating runs (ref, exact, fast, ref, ...), after one untimed run of each; ``/ref`` is a
+form's time over the reference's.
 """
 
 from __future__ import annotations
@@ -57,42 +60,48 @@ def timed(fn, repeats: int) -> tuple[float, np.ndarray]:
     return best, out
 
 
+FORMS = {  # name: (sweep, held to the reference bit for bit)
+    "exact": ("_sweep", True),
+    "fast": ("_sweep_fma", False),
+}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, nargs="+", default=[3000, 10000, 30000])
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--forms", nargs="+", default=list(FORMS), choices=list(FORMS))
     args = ap.parse_args()
-    print(f"{'N':>7} {'step':>5} {'pairs':>11} {'old ns/pair':>12} {'new ns/pair':>12} {'ratio':>6}  identical")
+    head = " ".join(f"{f + ' ns':>9} {'/ref':>5}" for f in args.forms)
+    print(f"{'N':>7} {'step':>5} {'pairs':>11} {'ref ns':>8} {head}  {'max |diff| / mass':>17}")
     for n in args.n:
-        tot_pairs = tot_old = tot_new = 0.0
+        tot_pairs, tot = 0, dict.fromkeys(["ref", *args.forms], 0.0)
         for step in STEPS:
             x, m, label, sigma = state(n, step)
             radius = TRUNCATION * sigma
             seed = np.uint64(12345 + step)
-
-            def old(x=x, m=m, label=label, sigma=sigma, radius=radius, seed=seed):
-                return sequential_reference._sweep(x, m.copy(), label, sigma, radius, BETA, seed, False, True)
-
-            def new(x=x, m=m, label=label, sigma=sigma, radius=radius, seed=seed):
-                return sequential._sweep(x, m.copy(), label, sigma, radius, BETA, seed, False, True)
-
-            old(), new()  # compile or load from numba's cache, untimed
-            t_old = t_new = math.inf
-            for _ in range(args.repeats):  # alternate, so drifts in the machine hit both alike
-                a, ma = timed(old, 1)
-                b, mb = timed(new, 1)
-                t_old, t_new = min(t_old, a), min(t_new, b)
+            sweeps = {"ref": sequential_reference._sweep} | {f: getattr(sequential, FORMS[f][0]) for f in args.forms}
+            rest = (label, sigma, radius, BETA, seed, False, True)
+            runs = {f: (lambda fn=fn, x=x, m=m, rest=rest: fn(x, m.copy(), *rest)) for f, fn in sweeps.items()}
+            outs = {f: run() for f, run in runs.items()}  # compile or load from numba's cache, untimed
+            best = dict.fromkeys(runs, math.inf)
+            for _ in range(args.repeats):  # alternate, so drifts in the machine hit all alike
+                for f, run in runs.items():
+                    t, outs[f] = timed(run, 1)
+                    best[f] = min(best[f], t)
             pairs = pair_updates(x, radius)
-            same = ma.tobytes() == mb.tobytes()
-            tot_pairs, tot_old, tot_new = tot_pairs + pairs, tot_old + t_old, tot_new + t_new
-            print(
-                f"{n:>7} {step:>5} {pairs:>11,} {1e9 * t_old / pairs:>12.2f} {1e9 * t_new / pairs:>12.2f}"
-                f" {t_old / t_new:>6.2f}  {same}"
-            )
-        print(
-            f"{n:>7} {'all':>5} {int(tot_pairs):>11,} {1e9 * tot_old / tot_pairs:>12.2f}"
-            f" {1e9 * tot_new / tot_pairs:>12.2f} {tot_old / tot_new:>6.2f}"
-        )
+            for f in args.forms:
+                same = outs[f].tobytes() == outs["ref"].tobytes()
+                if FORMS[f][1] and not same:
+                    raise SystemExit(f"{f} is not bit-identical to the reference at N = {n}, step {step}")
+            diff = max(float(np.max(np.abs(outs[f] - outs["ref"]))) for f in args.forms) / m.sum()
+            tot_pairs += pairs
+            for f in best:
+                tot[f] += best[f]
+            cells = " ".join(f"{1e9 * best[f] / pairs:>9.2f} {best[f] / best['ref']:>5.2f}" for f in args.forms)
+            print(f"{n:>7} {step:>5} {pairs:>11,} {1e9 * best['ref'] / pairs:>8.2f} {cells}  {diff:>17.1e}")
+        cells = " ".join(f"{1e9 * tot[f] / tot_pairs:>9.2f} {tot[f] / tot['ref']:>5.2f}" for f in args.forms)
+        print(f"{n:>7} {'all':>5} {tot_pairs:>11,} {1e9 * tot['ref'] / tot_pairs:>8.2f} {cells}")
 
 
 if __name__ == "__main__":

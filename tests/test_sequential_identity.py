@@ -1,10 +1,13 @@
-"""The fast authors' loop (sequential._sweep) against the loop it replaced
-(tests/sequential_reference.py), bit for bit: on many random states (clipping acting or not,
-negative masses, storage in random or position order, tied positions, symmetric weights, N from 1
-to 3,000, cut-offs from 1 to 40 widths) and on whole runs; and fastexp.exp_neg against the table
-form it replaced, over the whole range of its argument."""
+"""The authors' loop against the loop it replaced (tests/sequential_reference.py), on many random
+states (clipping acting or not, negative masses, storage in random or position order, tied
+positions, symmetric weights, N from 1 to 3,000, cut-offs from 1 to 40 widths) and on whole runs:
+its bit-identical form (sequential._sweep, ``exact=True``) bit for bit, its default fast form
+(sequential._sweep_fma) to round-off; and fastexp.exp_neg against the table form it replaced,
+over the whole range of its argument."""
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import pytest
@@ -88,11 +91,90 @@ def test_whole_runs_bit_identical(monkeypatch, scheme, kernel, eta):
     cfg = RunConfig.of(
         method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3
     )
+    exact = functools.partial(sequential.sequential_transfer, exact=True)
+    monkeypatch.setattr(sequential, "sequential_transfer", exact)  # mtpt.step imports it when it runs
     _, new = simulate.run(cfg, want_state=True)
     monkeypatch.setattr(sequential, "_sweep", ref._sweep)
     _, old = simulate.run(cfg, want_state=True)
     assert new["mass"].to_numpy().tobytes() == old["mass"].to_numpy().tobytes()
     assert new["x"].to_numpy().tobytes() == old["x"].to_numpy().tobytes()
+
+
+# ---------------------------------------------------------------- the fast form, to round-off
+def _assert_round_off(a, b, m):
+    """Every mass within 1e-12 of the total (|m|) mass of the reference's, the total within 1e-13."""
+    total = max(np.abs(m).sum(), 1e-300)
+    assert np.max(np.abs(a - b), initial=0.0) <= 1e-12 * total
+    assert abs(a.sum() - b.sum()) <= 1e-13 * total
+
+
+@pytest.mark.parametrize("n, beta, sigma", CASES)
+def test_fast_form_equal_to_the_reference_loop_to_round_off(n, beta, sigma):
+    """The identity states of the bit-identical test, the fast form; with positive masses and
+    beta < 2 (where it uses the fused chain) its mass is conserved to 1e-13 too."""
+    rng = np.random.default_rng([n, int(beta * 10), int(sigma * 1000)])
+    for trial in range(4):
+        ties, negative, sorted_storage = trial == 1, trial == 2, trial == 3
+        x, m, label = _state(rng, n, ties, negative, sorted_storage)
+        for truncation in (1.0, 3.0) if n * sigma > 100 else (1.0, 3.0, 9.0, 40.0):
+            for symnorm, clip in ((False, True), (True, True), (False, False)):
+                seed = int(rng.integers(0, 2**63))
+                args = (label, sigma, truncation * sigma, beta, np.uint64(seed), symnorm, clip)
+                a, b = ref._sweep(x, m.copy(), *args), sequential._sweep_fma(x, m.copy(), *args)
+                _assert_round_off(a, b, m)
+                if beta < 2.0 and not negative:
+                    assert abs(b.sum() - m.sum()) <= 1e-13 * max(m.sum(), 1e-300)
+
+
+def test_fast_form_when_every_mass_is_clipped_or_none_is():
+    rng = np.random.default_rng(7)
+    x = np.sort(rng.uniform(-1.0, 1.0, 2000))
+    label = rng.permutation(2000).astype(np.int64)
+    for beta, m in ((10.0, rng.exponential(1.0, 2000)), (0.5, rng.random(2000) + 0.1), (1.9, rng.random(2000))):
+        args = (label, 0.02, 0.06, beta, np.uint64(99), False, True)
+        _assert_round_off(ref._sweep(x, m.copy(), *args), sequential._sweep_fma(x, m.copy(), *args), m)
+
+
+def test_fast_form_is_the_default_and_exact_selects_the_bit_identical_one():
+    rng = np.random.default_rng(8)
+    x = np.sort(rng.uniform(-1.0, 1.0, 500))
+    m, label = rng.random(500), rng.permutation(500).astype(np.int64)
+    out = {}
+    for exact in (False, True):
+        out[exact] = sequential.sequential_transfer(x, m, 0.02, 0.5, 3.0, np.random.default_rng(1), label, exact=exact)
+    seed = np.uint64(np.random.default_rng(1).integers(0, 2**63))
+    args = (label, 0.02, 0.06, 0.5, seed, False, True)  # (a sweep writes into the masses it is given)
+    assert out[True].tobytes() == ref._sweep(x, m.copy(), *args).tobytes()
+    assert out[False].tobytes() == sequential._sweep_fma(x, m.copy(), *args).tobytes()
+    assert out[False].tobytes() != out[True].tobytes()  # (the check above is sharp)
+
+
+@pytest.mark.parametrize(
+    "scheme, kernel, eta",
+    [
+        ("sequential", "collision", 1.0),
+        ("sequential", "sph", 1.0),
+        ("sequential", "collision", 0.5),
+        ("sequential_sorted", "collision", 1.0),
+        ("sequential_symnorm", "sph", 1.0),
+        ("sequential_noclip", "sph", 1.0),
+        ("authors", "sph", 1.0),
+    ],
+)
+def test_whole_runs_of_the_fast_form_within_round_off(monkeypatch, scheme, kernel, eta):
+    """The default (fast) form against the reference loop over whole runs: COMIC within 1e-9 at
+    every step, masses within 1e-12 of the total, mass conserved alike."""
+    cfg = RunConfig.of(
+        method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3
+    )
+    new_table, new = simulate.run(cfg, want_state=True)
+    monkeypatch.setattr(sequential, "_sweep_fma", ref._sweep)
+    old_table, old = simulate.run(cfg, want_state=True)
+    assert new["x"].to_numpy().tobytes() == old["x"].to_numpy().tobytes()
+    np.testing.assert_allclose(new_table["COMIC"], old_table["COMIC"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(new_table["mass_total"], old_table["mass_total"], rtol=0, atol=1e-13)
+    assert np.max(np.abs(new["mass"].to_numpy() - old["mass"].to_numpy())) <= 1e-12
+    assert new["mass"].to_numpy().tobytes() != old["mass"].to_numpy().tobytes()  # two forms ran
 
 
 @njit(cache=True)

@@ -35,6 +35,23 @@ def _f64_from_bits(typingctx, bits):
     return types.float64(types.int64), codegen
 
 
+@intrinsic
+def wide_vectors(typingctx):
+    """Let LLVM vectorise the calling function's loops with 512-bit vectors (AVX-512), where it
+    would stop at 256 bits on CPUs that have them (its default "prefer-vector-width" there): each
+    lane computes the same, but a sum the function lets LLVM reorder (fastmath reassoc) may round
+    differently. A no-op where the function attribute cannot be set (checked with llvmlite 0.50)."""
+
+    def codegen(context, builder, signature, args):
+        try:  # llvmlite accepts only its list of attribute names; LLVM takes this one as a string
+            set.add(builder.function.attributes, '"prefer-vector-width"="512"')
+        except Exception:  # pragma: no cover - another llvmlite
+            pass
+        return context.get_dummy_value()
+
+    return types.none(), codegen
+
+
 @njit(cache=True, inline="always")
 def pow2_neg(k):
     """2^-k for an integer-valued float 0 <= k <= 1100, as two factors whose product with a p in

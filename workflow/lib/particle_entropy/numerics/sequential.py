@@ -48,14 +48,22 @@ particle never changes again within the step, so the sweep keeps the unvisited o
 arrays in position order, and each window holds almost only partners. The random
 permutations come from a SplitMix64 stream that is seeded for each step from the run's numpy
 Generator.
+
+Two forms of the loop compute this: ``_sweep``, bit for bit the loop before issue 20
+(tests/sequential_reference.py), and ``_sweep_fma``, the default, equal to it to round-off and
+at 0.5-0.6 of its time for N >= 10,000 (docs/speed.md); ``sequential_transfer(..., exact=True)``
+selects the first.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
-from .fastexp import EXP_NEAR_MAX, exp_neg, exp_neg_near
+from .fastexp import EXP_NEAR_MAX, exp_neg, exp_neg_near, wide_vectors
 from .gauss import cutoff_radius
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)  # SplitMix64's increment: its state after k outputs is s + k G
@@ -328,6 +336,243 @@ def _visit_mass(mi, cnt, part, c, ms, state, clip):
     return mi, state
 
 
+# ------------------------------------------------------------------ the fast form (round-off)
+# The same loop (every fact above: the same visits, partners, partner orders and random stream),
+# with two sums rounded differently: r_i's partner sum is vectorised, and the chain through m_i is
+# one fused multiply-add, m_i <- m_i (1 - c) + c m_j, whose latency is half of m_i - c (m_i - m_j)'s.
+# Its passes over a window are vectorised (512-bit vectors where the CPU has them), the random
+# draws of a visit are made all at once before its exchanges, and two consecutive visits whose
+# windows are disjoint exchange interleaved, two independent chains through m_i. Where an exchange
+# could overshoot (beta > 1.9) or masses are negative with clipping, it keeps _sweep's arithmetic.
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):
+    """a b + c rounded once (llvm.fma)."""
+    if not all(isinstance(t, types.Float) for t in (a, b, c)):
+        return None
+
+    def codegen(context, builder, signature, args):
+        fnty = ir.FunctionType(ir.DoubleType(), [ir.DoubleType()] * 3)
+        return builder.call(cgutils.get_or_insert_function(builder.module, fnty, "llvm.fma.f64"), args)
+
+    return types.float64(types.float64, types.float64, types.float64), codegen
+
+
+@njit(cache=True, fastmath={"contract", "reassoc"})
+def _window_pass(i, xp, xw, lw, rw, inv2s2, near, w):
+    """W_ij over a window (positions xw, labels lw, row sums so far rw) into w, added to the
+    partners' row sums -> the sum of the partners' W (vectorised, in another order of rounding)."""
+    wide_vectors()
+    s = 0.0
+    if near:
+        for k in range(xw.shape[0]):
+            d = xp - xw[k]
+            wk = exp_neg_near(d * d * inv2s2)
+            w[k] = wk
+            wk = wk if lw[k] > i else 0.0
+            rw[k] += wk
+            s += wk
+    else:
+        for k in range(xw.shape[0]):
+            d = xp - xw[k]
+            wk = exp_neg(d * d * inv2s2)
+            w[k] = wk
+            wk = wk if lw[k] > i else 0.0
+            rw[k] += wk
+            s += wk
+    return s
+
+
+@njit(cache=True)
+def _compact(i, lw, part):
+    """part[:cnt] <- the window offsets of i's partners (later in storage), in window order -> cnt."""
+    cnt = 0
+    for k in range(lw.shape[0]):
+        part[cnt] = k
+        cnt += lw[k] > i
+    return cnt
+
+
+@njit(cache=True)
+def _draws(cnt, state, zz, jd):
+    """jd[k] <- the k-th draw of _draw for k < cnt, all at once (vectorised) -> the stream's state
+    after them (SplitMix64's state after t outputs is s + t G)."""
+    wide_vectors()
+    h = (cnt + 1) // 2
+    for t in range(h):
+        _, z = _splitmix(state + np.uint64(t) * _GOLDEN)
+        zz[t] = (z << np.uint64(32)) | (z >> np.uint64(32))  # halves swapped: draw 2t's bits first
+    bits = zz.view(np.uint32)
+    for k in range(cnt):
+        jd[k] = np.uint64(k) + ((np.uint64(bits[k]) * np.uint64(np.uint32(cnt - k))) >> np.uint64(32))
+    return state + np.uint64(h) * _GOLDEN
+
+
+@njit(cache=True, inline="always")
+def _weight(wq, b, hb, irf, p):
+    """c = beta W_ij / r_i (b = beta / r_i, hb = 0), or symnorm's beta W_ij (1/r_i + 1/r_j) / 2
+    (b = 1/r_i, hb = beta / 2, 1/r_j = irf[p]), as _sweep computes it."""
+    if hb == 0.0:
+        return wq * b
+    return wq * (hb * (b + irf[p]))
+
+
+@njit(cache=True, inline="always")
+def _step_fma(k, mi, part, jd, w, b, hb, irf, ms, lo):
+    """The visit's k-th exchange, unclipped: m_j <- m_j + c (m_i - m_j) and m_i <- m_i (1 - c) +
+    c m_j, one rounding on the chain through m_i -> m_i."""
+    j = jd[k]
+    q = part[j]
+    part[j] = part[k]
+    c = _weight(w[q], b, hb, irf, lo + q)
+    mj = ms[lo + q]
+    ms[lo + q] = _fma(c, mi - mj, mj)
+    return _fma(mi, 1.0 - c, c * mj)
+
+
+@njit(cache=True, inline="always")
+def _exchange_fma(mi, cnt, part, jd, w, b, hb, irf, ms, lo):
+    """The visit's exchanges in the drawn order, fused -> m_i."""
+    for k in range(cnt):
+        mi = _step_fma(k, mi, part, jd, w, b, hb, irf, ms, lo)
+    return mi
+
+
+@njit(cache=True, inline="always")
+def _exchange_fma_two(ma, cna, pa, ja, wa, ba, loa, mb, cnb, pb, jb, wb, bb, lob, hb, irf, ms):
+    """Two visits with disjoint windows, fused and interleaved: two independent chains -> (m_a,
+    m_b)."""
+    both = min(cna, cnb)
+    for k in range(both):
+        ma = _step_fma(k, ma, pa, ja, wa, ba, hb, irf, ms, loa)
+        mb = _step_fma(k, mb, pb, jb, wb, bb, hb, irf, ms, lob)
+    for k in range(both, cna):  # the longer visit's rest
+        ma = _step_fma(k, ma, pa, ja, wa, ba, hb, irf, ms, loa)
+    for k in range(both, cnb):
+        mb = _step_fma(k, mb, pb, jb, wb, bb, hb, irf, ms, lob)
+    return ma, mb
+
+
+@njit(cache=True, inline="always")
+def _exchange_plain(mi, cnt, part, w, b, hb, irf, ms, lo, state, clip):
+    """The visit's exchanges in random order in _sweep's arithmetic, clipped or not -> (m_i,
+    state)."""
+    z = np.uint64(0)
+    for k in range(cnt):
+        j, state, z = _draw(k, cnt, state, z)
+        q = part[j]
+        part[j] = part[k]
+        mj = ms[lo + q]
+        dm = _weight(w[q], b, hb, irf, lo + q) * (mi - mj)
+        if clip:
+            mi = max(0.0, mi - dm)
+            ms[lo + q] = max(0.0, mj + dm)
+        else:
+            mi = mi - dm
+            ms[lo + q] = mj + dm
+    return mi, state
+
+
+@njit(cache=True, inline="always")
+def _find(i, xp, xs, ls, left, radius):
+    """i's window [lo, hi) in the compact arrays and its own place me in it -> (lo, hi, me)."""
+    lo = np.searchsorted(xs[:left], xp - radius, side="left")
+    hi = np.searchsorted(xs[:left], xp + radius, side="right")
+    me = lo + np.searchsorted(xs[lo:hi], xp, side="left")
+    while ls[me] != i:
+        me += 1
+    return lo, hi, me
+
+
+@njit(cache=True, inline="always")
+def _prepare(i, xs, ls, rs, irf, lo, hi, me, inv2s2, near, beta, hb, part, w):
+    """The visit to i up to its weights: W over its window, the row sums, its partners
+    part[:cnt] -> (cnt, b: beta / r_i, or 1 / r_i for symnorm)."""
+    s = _window_pass(i, xs[me], xs[lo:hi], ls[lo:hi], rs[lo:hi], inv2s2, near, w)
+    cnt = _compact(i, ls[lo:hi], part)
+    return cnt, (irf[me] if hb != 0.0 else beta * (1.0 / (rs[me] + 1.0 + s)))
+
+
+@njit(cache=True, fastmath={"contract"})
+def _sweep_fma(x, m, label, sigma, radius, beta, seed, symnorm, clip):
+    """One step of the loop as _sweep does it, in the fast form (equal to it to round-off). Visits
+    go two at a time as in _sweep, interleaved when their windows are disjoint."""
+    n = x.shape[0]
+    inv2s2 = 0.5 / (sigma * sigma)
+    near = radius * radius * inv2s2 <= 0.99 * EXP_NEAR_MAX  # as in _sweep
+    where = np.empty(n, np.int64)  # sorted index of the particle stored at i
+    for p in range(n):
+        where[label[p]] = p
+    safe = True
+    for p in range(n):
+        if not (m[p] >= 0.0 and m[p] < np.inf):
+            safe = False
+    # c <= beta / 2, as r_i >= 1 + W_ij (symnorm: r_j too): up to beta = 1.9 (room for rounding)
+    # an exchange leaves each mass a weighted mean of m_i and m_j, so the clipping cannot act on
+    # masses >= 0 and the fused chain's rounding errors do not grow. Beyond, _sweep's arithmetic.
+    fused = beta <= 1.9 and (safe or not clip)
+    xs = x.copy()
+    ps = np.arange(n)
+    ls = label.copy()
+    ms = m.copy()
+    rs = np.zeros(n)
+    irf = 1.0 / _row_sums(x, radius, inv2s2) if symnorm else np.zeros(n)
+    hb = beta * 0.5 if symnorm else 0.0  # beta > 0: hb != 0 marks symnorm
+    left = n
+    chunk = max(64, n // 32)
+    pa = np.empty(n, np.uint32)
+    pb = np.empty(n, np.uint32)
+    ja = np.empty(n + 1, np.uint32)
+    jb = np.empty(n + 1, np.uint32)
+    zz = np.empty(n // 2 + 1, np.uint64)
+    wa = np.empty(n)
+    wb = np.empty(n)
+    state = np.uint64(seed)
+    i = 0
+    while i < n:
+        if i % chunk == 0 and i > 0:
+            k2 = 0
+            for k in range(left):
+                if ls[k] >= i:
+                    xs[k2] = xs[k]
+                    ps[k2] = ps[k]
+                    ls[k2] = ls[k]
+                    ms[k2] = ms[k]
+                    rs[k2] = rs[k]
+                    irf[k2] = irf[k]
+                    k2 += 1
+                else:
+                    m[ps[k]] = ms[k]
+            left = k2
+        lo, hi, me = _find(i, x[where[i]], xs, ls, left, radius)
+        cna, ba = _prepare(i, xs, ls, rs, irf, lo, hi, me, inv2s2, near, beta, hb, pa, wa)
+        ulo = np.uint64(lo)
+        if not fused:
+            ms[me], state = _exchange_plain(ms[me], cna, pa, wa, ba, hb, irf, ms, ulo, state, clip)
+            i += 1
+            continue
+        state = _draws(cna, state, zz, ja)
+        two = i + 1 < n and (i + 1) % chunk != 0  # no compaction between the two visits
+        cnb = 0
+        if two:
+            lob, hib, meb = _find(i + 1, x[where[i + 1]], xs, ls, left, radius)
+            cnb, bb = _prepare(i + 1, xs, ls, rs, irf, lob, hib, meb, inv2s2, near, beta, hb, pb, wb)
+            state = _draws(cnb, state, zz, jb)
+        if cnb > 0 and (hi <= lob or hib <= lo):  # disjoint windows: both at once
+            ms[me], ms[meb] = _exchange_fma_two(
+                ms[me], cna, pa, ja, wa, ba, ulo, ms[meb], cnb, pb, jb, wb, bb, np.uint64(lob), hb, irf, ms
+            )
+        else:  # one after the other
+            ms[me] = _exchange_fma(ms[me], cna, pa, ja, wa, ba, hb, irf, ms, ulo)
+            if cnb > 0:
+                ms[meb] = _exchange_fma(ms[meb], cnb, pb, jb, wb, bb, hb, irf, ms, np.uint64(lob))
+        i += 2 if two else 1
+    for k in range(left):
+        m[ps[k]] = ms[k]
+    return m
+
+
 def sequential_transfer(
     x: np.ndarray,
     m: np.ndarray,
@@ -338,15 +583,18 @@ def sequential_transfer(
     label: np.ndarray | None = None,
     symnorm: bool = False,
     clip: bool = True,
+    exact: bool = False,
 ) -> np.ndarray:
     """One step of the authors' loop on sorted positions ``x``; ``label`` is the storage index of
     each particle (None: storage order = position order, the ``sorted`` variant). ``rng`` seeds
-    the partner permutations of this step. The input masses are not changed."""
+    the partner permutations of this step. The input masses are not changed. ``exact``: the form
+    bit-identical to the loop before issue 20 (_sweep), else the fast form equal to it to
+    round-off (_sweep_fma, the default)."""
     radius = cutoff_radius(sigma, truncation)
     if label is None:
         label = np.arange(x.size, dtype=np.int64)
     seed = int(rng.integers(0, 2**63))
-    return _sweep(
+    return (_sweep if exact else _sweep_fma)(
         np.ascontiguousarray(x, dtype=np.float64),
         np.array(m, dtype=np.float64),
         np.ascontiguousarray(label, dtype=np.int64),
@@ -360,6 +608,6 @@ def sequential_transfer(
 
 
 def warm_up() -> None:
-    """Load the compiled loop (numba's on-disk cache) before the timed steps."""
+    """Load the compiled loop (numba's on-disk cache, the default form) before the timed steps."""
     x = np.linspace(-1.0, 1.0, 8)
     sequential_transfer(x, np.ones(8), 0.5, 0.5, 3.0, np.random.default_rng(0), label=np.arange(8)[::-1].copy())
