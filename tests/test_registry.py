@@ -154,6 +154,7 @@ def test_cli_defaults_equal_paper():
         "scheme",
         "transfer_method",
         "transfer_tolerance",
+        "loop_arithmetic",
     ]:
         assert getattr(a, key) == PAPER[key], key
 

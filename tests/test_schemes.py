@@ -45,8 +45,8 @@ def _state(n=40):
 def _calls(monkeypatch):
     seen = []
 
-    def fake(x, m, sigma, beta, truncation, rng, label=None, symnorm=False, clip=True):
-        seen.append({"label": label, "symnorm": symnorm, "clip": clip})
+    def fake(x, m, sigma, beta, truncation, rng, label=None, symnorm=False, clip=True, exact=False):
+        seen.append({"label": label, "symnorm": symnorm, "clip": clip, "exact": exact})
         return m.copy()
 
     monkeypatch.setattr(sequential, "sequential_transfer", fake)
@@ -63,6 +63,16 @@ def test_sequential_step_passes_the_records_flags(monkeypatch, name):
     assert (call["label"] is label) == EXPECTED[name]["by_label"]
     assert call["label"] is None or np.array_equal(call["label"], label)
     assert (call["symnorm"], call["clip"]) == (EXPECTED[name]["symnorm"], EXPECTED[name]["clip"])
+    assert call["exact"] is False  # numerics.loop_arithmetic: fused, the default
+
+
+def test_the_loop_arithmetic_setting_reaches_the_loop(monkeypatch):
+    seen = _calls(monkeypatch)
+    x, m, label = _state()
+    for arithmetic in ("exact", "fused"):
+        cfg = RunConfig.of(method="mtpt", n=40, truncation=3.0, scheme="authors", loop_arithmetic=arithmetic).resolved()
+        mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))
+    assert [c["exact"] for c in seen] == [True, False]
 
 
 def test_a_new_record_needs_no_string_test(monkeypatch):
@@ -78,7 +88,7 @@ def test_a_new_record_needs_no_string_test(monkeypatch):
     cfg = dataclasses.replace(cfg, case=case)
     x, m, label = _state()
     mtpt.step(cfg, x, m, label, 0.1, 1.0, np.random.default_rng(0))
-    assert seen == [{"label": label, "symnorm": True, "clip": False}]
+    assert seen == [{"label": label, "symnorm": True, "clip": False, "exact": False}]
 
 
 def test_compensated_widens_the_cut_kernel_and_symmetric_does_not():

@@ -27,6 +27,7 @@ CLI_SETTINGS = (
     "fixed_kernel_time",
     "transfer_method",
     "transfer_tolerance",
+    "loop_arithmetic",
     "time_grid",
 )
 CHOICE_DOCS = {"scheme": SCHEME_DOCS}  # what each choice means, in the option's help

@@ -88,6 +88,7 @@ SCHEME_DOCS = {name: s.description for name, s in SCHEME_RECORDS.items()}
 PRESETS = {"authors": {"scheme": "authors", "truncation": 3.0, "time_grid": "authors"}}
 TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or whole steps while t < t_final
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
+LOOP_ARITHMETICS = ("fused", "exact")  # the authors' loop: fused multiply-adds, or bit for bit as before issue 20
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
 # what an adaptive search minimises over N (aggregate.CONVENTIONS) and where it takes SSE (optimum.MEASURES)
 CONVENTION_NAMES = ("mean_COMIC", "COMIC_of_mean_SSE")

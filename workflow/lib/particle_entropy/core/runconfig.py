@@ -60,6 +60,7 @@ class RunConfig:
     fixed_kernel_time: float = PAPER["fixed_kernel_time"]
     transfer_method: str = PAPER["transfer_method"]
     transfer_tolerance: float = PAPER["transfer_tolerance"]
+    loop_arithmetic: str = PAPER["loop_arithmetic"]
 
     @classmethod
     def of(
@@ -141,6 +142,7 @@ class RunConfig:
                 f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
             )
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
+        check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
         self._check_reference()
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n

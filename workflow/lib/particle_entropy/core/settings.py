@@ -25,6 +25,7 @@ from .registry import (
     CONVENTION_NAMES,
     FGT_TOLERANCE,
     FGT_TOLERANCE_RANGE,
+    LOOP_ARITHMETICS,
     MEASURE_NAMES,
     SCHEMES,
     SHEAR_CASES,
@@ -153,6 +154,15 @@ SETTINGS = (
         "(1e-17 = round-off: mass conserved to 1e-13)",
         low=FGT_TOLERANCE_RANGE[0],
         high=FGT_TOLERANCE_RANGE[1],
+    ),
+    Setting(
+        "loop_arithmetic",
+        "numerics.loop_arithmetic",
+        "fused",
+        "arithmetic of the authors' sequential loop (mtpt schemes with the loop): fused = each exchange's mass "
+        "update one fused multiply-add and the row sums vectorised, equal to exact to round-off in about half its "
+        "time (docs/speed.md); exact = bit for bit the loop of tests/sequential_reference.py",
+        choices=LOOP_ARITHMETICS,
     ),
     Setting("eta", "case_defaults.eta", 1.0, "fraction of D done by mass transfer (mtpt only)", low=0.0, high=1.0),
     Setting(

@@ -59,6 +59,7 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
             label=label if scheme.by_label else None,
             symnorm=scheme.symnorm,
             clip=scheme.clip,
+            exact=cfg.loop_arithmetic == "exact",
         )
         return x, m, label, sigma, beta, 1
     if scheme.compensated:  # widen the cut kernel so that its variance is the whole one's
