@@ -4,15 +4,15 @@
     python benchmarks/bench_sequential.py --n 3000 --repeats 5 --forms fast
 
 Reference: tests/sequential_reference.py, the loop as it was before issue 20. Forms: ``exact``
-(sequential._sweep, bit for bit the reference's results, checked here on every timed step) and
-``fast`` (sequential._sweep_fma, the default, equal to it to round-off: the largest difference
-is printed, relative to the total mass). States: N positions uniform on [-Omega/2, Omega/2]
-stored in random order, a Gaussian plume of variance 2 D t as masses, the collision kernel at
-eta = 1 cut at 3 widths, at steps 100, 140 and 174 of the authors' time grid (dt0 = 0.01, growth
-1.05): the late steps hold most of a run's pair updates. A pair update is one (i, j) exchange;
-the count is measured on the state, not modelled. Each timing is the least of ``repeats``
-alternating runs (ref, exact, fast, ref, ...), after one untimed run of each; ``/ref`` is a
-form's time over the reference's.
+(sequential_kernels._sweep, bit for bit the reference's results, checked here on every timed
+step) and ``fast`` (sequential_kernels._sweep_fma, the default, equal to it to round-off: the
+largest difference is printed, relative to the total mass). States: N positions uniform on
+[-Omega/2, Omega/2] stored in random order, a Gaussian plume of variance 2 D t as masses, the
+collision kernel at eta = 1 cut at 3 widths, at steps 100, 140 and 174 of the authors' time grid
+(dt0 = 0.01, growth 1.05): the late steps hold most of a run's pair updates. A pair update is
+one (i, j) exchange; the count is measured on the state, not modelled. Each timing is the least
+of ``repeats`` alternating runs (ref, exact, fast, ref, ...), after one untimed run of each;
+``/ref`` is a form's time over the reference's.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from particle_entropy.numerics import sequential
+from particle_entropy.numerics import sequential_kernels
 from particle_entropy.numerics.kernels import collision_sigma
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -80,7 +80,8 @@ def main() -> None:
             x, m, label, sigma = state(n, step)
             radius = TRUNCATION * sigma
             seed = np.uint64(12345 + step)
-            sweeps = {"ref": sequential_reference._sweep} | {f: getattr(sequential, FORMS[f][0]) for f in args.forms}
+            forms = {f: getattr(sequential_kernels, FORMS[f][0]) for f in args.forms}
+            sweeps = {"ref": sequential_reference._sweep} | forms
             rest = (label, sigma, radius, BETA, seed, False, True)
             runs = {f: (lambda fn=fn, x=x, m=m, rest=rest: fn(x, m.copy(), *rest)) for f, fn in sweeps.items()}
             outs = {f: run() for f, run in runs.items()}  # compile or load from numba's cache, untimed

@@ -1,8 +1,8 @@
 """The authors' loop against the loop it replaced (tests/sequential_reference.py), on many random
 states (clipping acting or not, negative masses, storage in random or position order, tied
 positions, symmetric weights, N from 1 to 3,000, cut-offs from 1 to 40 widths) and on whole runs:
-its bit-identical form (sequential._sweep, ``exact=True``) bit for bit, its default fast form
-(sequential._sweep_fma) to round-off; and fastexp.exp_neg against the table form it replaced,
+its bit-identical form (sequential_kernels._sweep, ``exact=True``) bit for bit, its default fast
+form (sequential_kernels._sweep_fma) to round-off; and fastexp.exp_neg against the table form it replaced,
 over the whole range of its argument."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from numba import njit
 
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.models import simulate
-from particle_entropy.numerics import fastexp, sequential
+from particle_entropy.numerics import compiled, fastexp, sequential, sequential_kernels
 
 
 def _state(rng, n, ties, negative, sorted_storage):
@@ -30,7 +30,7 @@ def _state(rng, n, ties, negative, sorted_storage):
 
 def _both(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     a = ref._sweep(x, m.copy(), label, sigma, radius, beta, np.uint64(seed), symnorm, clip)
-    b = sequential._sweep(x, m.copy(), label, sigma, radius, beta, np.uint64(seed), symnorm, clip)
+    b = sequential_kernels._sweep(x, m.copy(), label, sigma, radius, beta, np.uint64(seed), symnorm, clip)
     return a, b
 
 
@@ -100,7 +100,7 @@ def test_whole_runs_bit_identical(monkeypatch, scheme, kernel, eta):
         loop_arithmetic="exact",
     )
     _, new = simulate.run(cfg, want_state=True)
-    monkeypatch.setattr(sequential, "_sweep", ref._sweep)
+    monkeypatch.setattr(compiled.kernels(), "_sweep", ref._sweep)  # what sequential_transfer calls
     _, old = simulate.run(cfg, want_state=True)
     assert new["mass"].to_numpy().tobytes() == old["mass"].to_numpy().tobytes()
     assert new["x"].to_numpy().tobytes() == old["x"].to_numpy().tobytes()
@@ -126,7 +126,7 @@ def test_fast_form_equal_to_the_reference_loop_to_round_off(n, beta, sigma):
             for symnorm, clip in ((False, True), (True, True), (False, False)):
                 seed = int(rng.integers(0, 2**63))
                 args = (label, sigma, truncation * sigma, beta, np.uint64(seed), symnorm, clip)
-                a, b = ref._sweep(x, m.copy(), *args), sequential._sweep_fma(x, m.copy(), *args)
+                a, b = ref._sweep(x, m.copy(), *args), sequential_kernels._sweep_fma(x, m.copy(), *args)
                 _assert_round_off(a, b, m)
                 if beta < 2.0 and not negative:
                     assert abs(b.sum() - m.sum()) <= 1e-13 * max(m.sum(), 1e-300)
@@ -138,7 +138,7 @@ def test_fast_form_when_every_mass_is_clipped_or_none_is():
     label = rng.permutation(2000).astype(np.int64)
     for beta, m in ((10.0, rng.exponential(1.0, 2000)), (0.5, rng.random(2000) + 0.1), (1.9, rng.random(2000))):
         args = (label, 0.02, 0.06, beta, np.uint64(99), False, True)
-        _assert_round_off(ref._sweep(x, m.copy(), *args), sequential._sweep_fma(x, m.copy(), *args), m)
+        _assert_round_off(ref._sweep(x, m.copy(), *args), sequential_kernels._sweep_fma(x, m.copy(), *args), m)
 
 
 def test_fast_form_is_the_default_and_exact_selects_the_bit_identical_one():
@@ -151,7 +151,7 @@ def test_fast_form_is_the_default_and_exact_selects_the_bit_identical_one():
     seed = np.uint64(np.random.default_rng(1).integers(0, 2**63))
     args = (label, 0.02, 0.06, 0.5, seed, False, True)  # (a sweep writes into the masses it is given)
     assert out[True].tobytes() == ref._sweep(x, m.copy(), *args).tobytes()
-    assert out[False].tobytes() == sequential._sweep_fma(x, m.copy(), *args).tobytes()
+    assert out[False].tobytes() == sequential_kernels._sweep_fma(x, m.copy(), *args).tobytes()
     assert out[False].tobytes() != out[True].tobytes()  # (the check above is sharp)
 
 
@@ -174,7 +174,7 @@ def test_whole_runs_of_the_fast_form_within_round_off(monkeypatch, scheme, kerne
         method="mtpt", kernel=kernel, n=400, eta=eta, truncation=3.0, scheme=scheme, t_final=50.0, seed=3
     )
     new_table, new = simulate.run(cfg, want_state=True)
-    monkeypatch.setattr(sequential, "_sweep_fma", ref._sweep)
+    monkeypatch.setattr(compiled.kernels(), "_sweep_fma", ref._sweep)  # what sequential_transfer calls
     old_table, old = simulate.run(cfg, want_state=True)
     assert new["x"].to_numpy().tobytes() == old["x"].to_numpy().tobytes()
     np.testing.assert_allclose(new_table["COMIC"], old_table["COMIC"], rtol=0, atol=1e-9)

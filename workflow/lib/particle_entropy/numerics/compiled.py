@@ -1,10 +1,10 @@
 """The compiled kernels a simulation calls: numba's JIT, or the same kernels compiled ahead of time.
 
-Callers reach every numba kernel of the symmetric MTPT transfer, the kernel reconstructions and
-the finite differences through ``kernels()``, by the names of ``EXPORTS``. By default that is
-numba's JIT: the kernels are compiled, or loaded from numba's on-disk cache, on first call, and
-a process pays for numba itself first (import 0.15 s, target set-up 0.3 s, which also imports
-scipy.linalg), more than a small job's whole run.
+Callers reach every numba kernel of the symmetric MTPT transfer, the kernel reconstructions, the
+finite differences and the authors' sequential loop through ``kernels()``, by the names of
+``EXPORTS``. By default that is numba's JIT: the kernels are compiled, or loaded from numba's
+on-disk cache, on first call, and a process pays for numba itself first (import 0.15 s, target
+set-up 0.3 s, which also imports scipy.linalg), more than a small job's whole run.
 
 A simulation job instead calls ``use(folder)`` with a module that ``build(folder)`` compiled
 ahead of time from the same kernels (the workflow's rule ``compile_kernels``, once per code
@@ -40,6 +40,9 @@ EXPORTS = {
     "update": ("transfer_kernels", "f8[::1](f8[::1], f8[::1], f8, f8[::1], f8[::1], f8[::1])"),
     "thomas_factor": ("thomas", "UniTuple(f8[::1], 2)(i8, f8)"),
     "thomas_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8, f8[::1])"),
+    # the authors' loop: (x, m, label, sigma, radius, beta, seed, symnorm, clip) -> m
+    "_sweep": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),
+    "_sweep_fma": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),
 }
 # numba settings that change the machine code the JIT makes (numba.core.config)
 CODEGEN_SETTINGS = ("NUMBA_OPT", "NUMBA_ENABLE_AVX", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_LOOP_VECTORIZE")
@@ -54,16 +57,27 @@ def kernels():
 
 @functools.cache
 def _jit() -> types.SimpleNamespace:
-    from . import gauss_kernels, thomas, transfer_kernels
-
-    modules = {"gauss_kernels": gauss_kernels, "transfer_kernels": transfer_kernels, "thomas": thomas}
+    modules = _kernel_modules()
     return types.SimpleNamespace(**{name: getattr(modules[mod], name) for name, (mod, _) in EXPORTS.items()})
+
+
+def _kernel_modules() -> dict[str, types.ModuleType]:
+    """The modules of EXPORTS' kernels by name (importing them imports numba)."""
+    from . import gauss_kernels, sequential_kernels, thomas, transfer_kernels
+
+    return {
+        "gauss_kernels": gauss_kernels,
+        "transfer_kernels": transfer_kernels,
+        "thomas": thomas,
+        "sequential_kernels": sequential_kernels,
+    }
 
 
 def code_key() -> str:
     """SHA-256 of the kernels' code: this module, the kernel modules and what they import."""
     digest = hashlib.sha256()
-    for name in ("compiled.py", "gauss_kernels.py", "transfer_kernels.py", "thomas.py", "fastexp.py"):
+    kernel_files = ("gauss_kernels.py", "transfer_kernels.py", "thomas.py", "sequential_kernels.py")
+    for name in ("compiled.py", *kernel_files, "fastexp.py"):
         digest.update((Path(__file__).with_name(name)).read_bytes())
     return digest.hexdigest()
 
@@ -131,11 +145,9 @@ def build(folder: str | os.PathLike) -> Path:
     from numba.core import codegen
     from numba.core.registry import cpu_target
 
-    from . import gauss_kernels, thomas, transfer_kernels
-
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    modules = {"gauss_kernels": gauss_kernels, "transfer_kernels": transfer_kernels, "thomas": thomas}
+    modules = _kernel_modules()
     jit = cpu_target.target_context.codegen()  # the JIT's target: CPU name and features
     cpu_name, features = jit._get_host_cpu_name(), jit._tm_features
     with warnings.catch_warnings():
