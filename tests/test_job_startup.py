@@ -36,6 +36,11 @@ CASES = [
     {"method": "mtpt", "kernel": "sph", "eta": 0.1},
     {"method": "fd", "kernel": "implicit"},
 ]
+# the authors' loop (registry.SCHEME_RECORDS[...].sequential), in each arithmetic
+SEQUENTIAL = [
+    ({"method": "mtpt", "kernel": "sph", "preset": "authors"}, "fused"),
+    ({"method": "mtpt", "kernel": "collision", "scheme": "sequential_symnorm"}, "exact"),
+]
 
 
 @pytest.fixture(scope="module")
@@ -45,9 +50,12 @@ def kernels(tmp_path_factory):
     return folder
 
 
-def _job(spec: dict, kernels: Path, tmp_path: Path, kind: str = "runs") -> tuple[set, str]:
-    case = Case.from_spec(spec, 30)
+def _job(
+    spec: dict, kernels: Path, tmp_path: Path, kind: str = "runs", n: int = 30, arithmetic: str = "fused"
+) -> tuple[set, str]:
+    case = Case.from_spec(spec, n)
     config = {"physics": {"t_final": 0.5}, "time": {"dt0": 0.01, "fixed_dt": 0.1, "fd_dt": 0.05}}
+    config["numerics"] = {"loop_arithmetic": arithmetic}
     w = {**case.wildcards(), "kind": kind, "first": "0", "last": "1"}
     log = tmp_path / "job.log"
     arg = json.dumps([w, run_settings(case, config), str(kernels), str(tmp_path / "t.parquet"), str(log)])
@@ -64,6 +72,15 @@ def test_a_simulation_job_imports_neither_numba_nor_scipy_nor_pandas(spec, kerne
         assert "JIT" not in log, log  # the compiled module was taken
         heavy = {m.split(".")[0] for m in modules} & {"numba", "llvmlite", "scipy", "pandas"}
         assert not heavy, (spec, kind, heavy)
+
+
+@pytest.mark.parametrize("spec, arithmetic", SEQUENTIAL, ids=["authors-fused", "sequential_symnorm-exact"])
+def test_a_job_of_the_authors_loop_imports_neither_numba_nor_scipy_nor_pandas(spec, arithmetic, kernels, tmp_path):
+    modules, log = _job(spec, kernels, tmp_path, n=100, arithmetic=arithmetic)
+    assert "JIT" not in log, log
+    assert "particle_entropy.numerics.sequential" in modules  # the loop ran
+    heavy = {m.split(".")[0] for m in modules} & {"numba", "llvmlite", "scipy", "pandas"}
+    assert not heavy, (spec, arithmetic, heavy)
 
 
 def test_without_its_module_a_job_runs_the_jit(tmp_path):
@@ -126,3 +143,35 @@ def test_every_kernel_is_exported_and_reached_through_kernels():
     assert set(vars(ns)) == set(compiled.EXPORTS)
     x = np.linspace(-1.0, 1.0, 20)
     assert gauss.gauss_transform(x, x, np.ones(20), 0.3).shape == (20,)
+
+
+def test_the_compiled_loop_gives_the_jits_bits(kernels):
+    """Both forms of the authors' loop (sequential_kernels._sweep, _sweep_fma) on states of several
+    sizes, cut-offs, weights (symnorm), clipping and beta (> 1.9: _sweep_fma's other path; negative
+    masses: clipping acts), with the arguments sequential_transfer passes, against numba's JIT."""
+    code = f"""
+import numpy as np
+from particle_entropy.numerics import compiled
+jit = compiled._jit()
+assert compiled.use({str(kernels)!r})
+aot = compiled.kernels()
+rng = np.random.default_rng(11)
+for n in (1, 2, 65, 3000, 20000):
+    x = np.sort(rng.uniform(-1, 1, n))
+    label = rng.permutation(n).astype(np.int64)
+    for negative in (False, True):
+        m = rng.exponential(1.0, n) * (rng.random(n) < 0.5)
+        if negative:
+            m[rng.random(n) < 0.1] *= -1.0
+        for sigma, truncation in ((0.002, 3.0), (0.02, 1.0), (0.01, 9.0)):
+            for beta in (0.5, 1.0, 1.95, 2.5):
+                for symnorm, clip in ((False, True), (True, True), (False, False)):
+                    args = (label, sigma, truncation * sigma, beta, np.uint64(rng.integers(0, 2**63)), symnorm, clip)
+                    for form in ("_sweep", "_sweep_fma"):
+                        a = getattr(aot, form)(x, m.copy(), *args)
+                        b = getattr(jit, form)(x, m.copy(), *args)
+                        assert a.tobytes() == b.tobytes(), (form, n, negative, sigma, truncation, beta, symnorm, clip)
+print("ok")
+"""
+    res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)
+    assert res.returncode == 0 and res.stdout.decode().strip() == "ok", res.stderr.decode()[-3000:]
