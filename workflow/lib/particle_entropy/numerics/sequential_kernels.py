@@ -183,6 +183,25 @@ def _exchange_two(ma, cna, pa, ca, mb, cnb, pb, cb, ms, state):
     return ma, mb, sb
 
 
+@njit(cache=True, inline="always")
+def _drop_visited(i, left, xs, ps, ls, ms, rs, rf, m):
+    """Keep the particles not yet visited (storage label >= i) at the front of the compact arrays,
+    in position order, and write the visited ones' masses back to m -> how many are kept."""
+    k2 = 0
+    for k in range(left):
+        if ls[k] >= i:
+            xs[k2] = xs[k]
+            ps[k2] = ps[k]
+            ls[k2] = ls[k]
+            ms[k2] = ms[k]
+            rs[k2] = rs[k]
+            rf[k2] = rf[k]
+            k2 += 1
+        else:
+            m[ps[k]] = ms[k]
+    return k2
+
+
 @njit(cache=True, fastmath={"contract"})
 def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     """One step of the loop on positions ``x`` sorted, ``label`` the storage index of each.
@@ -229,19 +248,7 @@ def _sweep(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     i = 0
     while i < n:
         if i % chunk == 0 and i > 0:
-            k2 = 0
-            for k in range(left):
-                if ls[k] >= i:
-                    xs[k2] = xs[k]
-                    ps[k2] = ps[k]
-                    ls[k2] = ls[k]
-                    ms[k2] = ms[k]
-                    rs[k2] = rs[k]
-                    rf[k2] = rf[k]
-                    k2 += 1
-                else:
-                    m[ps[k]] = ms[k]
-            left = k2
+            left = _drop_visited(i, left, xs, ps, ls, ms, rs, rf, m)
         lo, hi, me, cna, sa = _partners(i, x[where[i]], xs, ls, rs, left, radius, inv2s2, near, pa, u, w, ca)
         two = i + 1 < n and (i + 1) % chunk != 0  # no compaction between the two visits
         if two:  # i + 1's weights and row sums need only positions and i's row sums: found now
@@ -479,19 +486,7 @@ def _sweep_fma(x, m, label, sigma, radius, beta, seed, symnorm, clip):
     i = 0
     while i < n:
         if i % chunk == 0 and i > 0:
-            k2 = 0
-            for k in range(left):
-                if ls[k] >= i:
-                    xs[k2] = xs[k]
-                    ps[k2] = ps[k]
-                    ls[k2] = ls[k]
-                    ms[k2] = ms[k]
-                    rs[k2] = rs[k]
-                    irf[k2] = irf[k]
-                    k2 += 1
-                else:
-                    m[ps[k]] = ms[k]
-            left = k2
+            left = _drop_visited(i, left, xs, ps, ls, ms, rs, irf, m)
         lo, hi, me = _find(i, x[where[i]], xs, ls, left, radius)
         cna, ba = _prepare(i, xs, ls, rs, irf, lo, hi, me, inv2s2, near, beta, hb, pa, wa)
         ulo = np.uint64(lo)
