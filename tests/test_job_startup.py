@@ -46,7 +46,7 @@ SEQUENTIAL = [
 @pytest.fixture(scope="module")
 def kernels(tmp_path_factory):
     folder = tmp_path_factory.mktemp("kernels")
-    compiled.build(folder)
+    compiled.provide(folder)  # built, or copied from this machine's cache of this very target
     return folder
 
 
@@ -175,3 +175,45 @@ print("ok")
 """
     res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)
     assert res.returncode == 0 and res.stdout.decode().strip() == "ok", res.stderr.decode()[-3000:]
+
+
+# ------------------------------------------------------------------ the machine-wide cache
+@pytest.fixture
+def fake_build(tmp_path, monkeypatch):
+    """build() replaced by one that writes a stand-in module for this target; the cache in tmp_path."""
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "cache"))
+    builds = []
+
+    def build(folder):
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / f"{compiled.MODULE}.so").write_bytes(b"a module")
+        (folder / compiled.TARGET_FILE).write_text(compiled.target())
+        builds.append(folder)
+
+    monkeypatch.setattr(compiled, "build", build)
+    return builds
+
+
+def test_a_second_working_directory_copies_the_module_the_first_built(tmp_path, fake_build):
+    assert compiled.provide(tmp_path / "a" / "kernels") == "built"
+    assert compiled.provide(tmp_path / "b" / "kernels") == "copied"
+    assert fake_build == [tmp_path / "a" / "kernels"]  # compiled once on this machine
+    for name in (f"{compiled.MODULE}.so", compiled.TARGET_FILE):
+        assert (tmp_path / "b" / "kernels" / name).read_bytes() == (tmp_path / "a" / "kernels" / name).read_bytes()
+    assert not list((tmp_path / "cache").glob(".*.tmp"))  # published whole, nothing left half-written
+
+
+def test_a_cached_module_of_another_target_is_not_taken(tmp_path, fake_build):
+    cache = compiled.cache_folder()
+    cache.mkdir(parents=True)
+    (cache / f"{compiled.MODULE}.so").write_bytes(b"old")
+    (cache / compiled.TARGET_FILE).write_text("code another\n")
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert (tmp_path / "a" / f"{compiled.MODULE}.so").read_bytes() == b"a module"
+
+
+def test_an_empty_cache_setting_keeps_no_copy(tmp_path, fake_build, monkeypatch):
+    monkeypatch.setenv(compiled.CACHE_ENV, "")
+    assert compiled.cache_folder() is None
+    assert [compiled.provide(tmp_path / d) for d in "ab"] == ["built", "built"]

@@ -1,5 +1,6 @@
 """Compile the simulation kernels ahead of time for this CPU (numerics/compiled.py), once per
-code version: every simulate job then loads them instead of starting numba's JIT. Where they
+code version (a copy from the machine-wide cache where another working directory built them):
+every simulate job then loads them instead of starting numba's JIT. Where they
 cannot be built (no C compiler or Python headers in the job's environment), the folder is left
 without a module and the jobs run numba's JIT, as before: slower to start, the same results."""
 
@@ -9,10 +10,10 @@ from pathlib import Path
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from particle_entropy.numerics.compiled import build
+from particle_entropy.numerics.compiled import provide
 
 try:
-    print(f"built {build(snakemake.output[0])}", file=sys.stderr)
+    print(f"{provide(snakemake.output[0])} the compiled kernels into {snakemake.output[0]}", file=sys.stderr)
 except Exception:
     traceback.print_exc()
     Path(snakemake.output[0]).mkdir(parents=True, exist_ok=True)

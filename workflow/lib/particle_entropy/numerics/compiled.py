@@ -116,6 +116,52 @@ def kernels_folder(root: str = "results/kernels") -> str:
     return f"{root}/{hashlib.sha256(here.encode()).hexdigest()[:16] if here else 'unknown-cpu'}"
 
 
+CACHE_ENV = "PARTICLE_ENTROPY_KERNEL_CACHE"  # the machine-wide copies' folder; empty: keep none
+
+
+def cache_folder() -> Path | None:
+    """The machine-wide copy of the module built for ``target()``, which every working directory
+    shares (as numba shares its own cache): under $PARTICLE_ENTROPY_KERNEL_CACHE, else
+    $XDG_CACHE_HOME or ~/.cache + particle-entropy/kernels, a folder named by the target's hash;
+    None where that variable is set empty or the CPU is unknown."""
+    here, root = target(), os.environ.get(CACHE_ENV)
+    if here is None or root == "":
+        return None
+    if root is None:
+        root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "particle-entropy" / "kernels"
+    return Path(root) / hashlib.sha256(here.encode()).hexdigest()[:16]
+
+
+def _complete(folder: Path) -> bool:
+    """Whether ``folder`` holds a module and its TARGET_FILE says it was built for ``target()``."""
+    marker = folder / TARGET_FILE
+    return marker.is_file() and any(folder.glob(MODULE + ".*")) and marker.read_text() == target()
+
+
+def provide(folder: str | os.PathLike) -> str:
+    """The module for ``target()`` into ``folder``: copied from the machine-wide cache when that
+    holds one, else compiled (``build``) and then copied there for the next working directory ->
+    "copied" or "built". A cache that cannot be written is left out."""
+    import shutil
+
+    folder, cache = Path(folder), cache_folder()
+    if cache is not None and _complete(cache):
+        folder.mkdir(parents=True, exist_ok=True)
+        for f in sorted(cache.glob(MODULE + ".*")) + [cache / TARGET_FILE]:  # the target last, as build
+            shutil.copy2(f, folder / f.name)
+        return "copied"
+    build(folder)
+    if cache is not None:
+        tmp = cache.with_name(f".{cache.name}.{os.getpid()}.tmp")
+        try:
+            cache.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copytree(folder, tmp)
+            os.rename(tmp, cache)  # whole or not at all; another build's copy may have come first
+        except OSError:
+            shutil.rmtree(tmp, ignore_errors=True)
+    return "built"
+
+
 def use(folder: str | os.PathLike) -> bool:
     """Call the kernels of the module ``build`` wrote to ``folder`` from now on -> whether it was
     taken (built here for this code; else the JIT stays, and a line on stderr says why)."""
