@@ -27,6 +27,7 @@ from ..core.registry import ALL_KERNELS, METHODS, PRESETS
 from ..core.settings import (
     BY_KEY,
     CASE_SECTION,
+    CASE_SETTINGS,
     CLAIMS,
     COMIC_TIMES,
     FIGURE_OPTIONS,
@@ -176,14 +177,14 @@ def blocks() -> dict[str, Block]:
             out["case_defaults"].append((key, {"$ref": f"#/$defs/{key}", "default": d}))
         else:
             out[s.section].append((key, entry(s)))
-    dims = [s.key.split(".", 1)[1] for s in SETTINGS if s.section == "case_defaults"]
-    case = {k: {"$ref": f"#/$defs/{k}"} for k in ("method", "kernel", "preset", *dims)}
+    case = {k: {"$ref": f"#/$defs/{k}"} for k in ("method", "kernel", "preset", *CASE_SETTINGS)}
     defs.append(
         (
             "case",
             Block(
                 type="object",
-                description=f"One model: method and kernel, and the dimensions {', '.join(dims)} that apply to it "
+                description=f"One model: method and kernel, and the dimensions {', '.join(CASE_SETTINGS)} that apply "
+                "to it "
                 "(unset ones come from case_defaults).",
                 additionalProperties=False,
                 properties=Block(case),
