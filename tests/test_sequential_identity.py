@@ -74,18 +74,19 @@ def test_bit_identical_when_every_mass_is_clipped_or_none_is():
         assert a.tobytes() == b.tobytes()
 
 
-@pytest.mark.parametrize(
-    "scheme, kernel, eta",
-    [
-        ("sequential", "collision", 1.0),
-        ("sequential", "sph", 1.0),
-        ("sequential", "collision", 0.5),
-        ("sequential_sorted", "collision", 1.0),
-        ("sequential_symnorm", "sph", 1.0),
-        ("sequential_noclip", "sph", 1.0),
-        ("authors", "sph", 1.0),
-    ],
-)
+# whole runs of every loop scheme, each kernel and eta at least once (both forms are held to them)
+LOOP_RUNS = [
+    ("sequential", "collision", 1.0),
+    ("sequential", "sph", 1.0),
+    ("sequential", "collision", 0.5),
+    ("sequential_sorted", "collision", 1.0),
+    ("sequential_symnorm", "sph", 1.0),
+    ("sequential_noclip", "sph", 1.0),
+    ("authors", "sph", 1.0),
+]
+
+
+@pytest.mark.parametrize("scheme, kernel, eta", LOOP_RUNS)
 def test_whole_runs_bit_identical(monkeypatch, scheme, kernel, eta):
     """A run with `numerics.loop_arithmetic: exact` is the reference loop's, bit for bit."""
     cfg = RunConfig.of(
@@ -155,18 +156,7 @@ def test_fast_form_is_the_default_and_exact_selects_the_bit_identical_one():
     assert out[False].tobytes() != out[True].tobytes()  # (the check above is sharp)
 
 
-@pytest.mark.parametrize(
-    "scheme, kernel, eta",
-    [
-        ("sequential", "collision", 1.0),
-        ("sequential", "sph", 1.0),
-        ("sequential", "collision", 0.5),
-        ("sequential_sorted", "collision", 1.0),
-        ("sequential_symnorm", "sph", 1.0),
-        ("sequential_noclip", "sph", 1.0),
-        ("authors", "sph", 1.0),
-    ],
-)
+@pytest.mark.parametrize("scheme, kernel, eta", LOOP_RUNS)
 def test_whole_runs_of_the_fast_form_within_round_off(monkeypatch, scheme, kernel, eta):
     """The default (fast) form against the reference loop over whole runs: COMIC within 1e-9 at
     every step, masses within 1e-12 of the total, mass conserved alike."""
