@@ -202,3 +202,27 @@ def test_exp_neg_bit_identical_to_the_table_form():
     inside = a <= fastexp.EXP_NEAR_MAX
     assert near[inside].tobytes() == old[inside].tobytes()
     assert np.count_nonzero((old > 0) & (old < np.finfo(float).tiny)) > 0  # subnormal results were tested
+
+
+@pytest.mark.parametrize("compiled_path", [True, False])
+def test_partners_compacted_in_window_order(monkeypatch, compiled_path):
+    """_compact gives the window offsets of the labels above i, in order, on windows of every
+    length mod 16: compiled (vector compress blocks of 16 where this CPU has AVX-512, the scalar
+    loop elsewhere) and the scalar loop run by Python."""
+    compact = sequential_kernels._compact
+    if not compiled_path:  # the global is read at each call of the Python function
+        monkeypatch.setattr(sequential_kernels, "_VECTOR_COMPRESS", False)
+        compact = sequential_kernels._compact.py_func
+    rng = np.random.default_rng(5)
+    checked = 0
+    for length in [0, 1, 15, 16, 17, 31, 32, 33, 100, 257, 390]:
+        for lo in (0, 3):
+            ls = rng.permutation(400)[: lo + length + 5].astype(np.int64)
+            i = int(rng.integers(0, 400))
+            part = np.full(ls.size + 16, 999_999, np.uint32)
+            cnt = compact(i, ls, lo, lo + length, part)
+            expected = np.flatnonzero(ls[lo : lo + length] > i)
+            assert cnt == expected.size
+            assert part[:cnt].tolist() == expected.tolist()
+            checked += cnt
+    assert checked > 400  # partners, not only empty windows

@@ -6,6 +6,7 @@ of time, or through numba's JIT where there is no such module."""
 from __future__ import annotations
 
 import numpy as np
+from llvmlite import binding as llvm
 from llvmlite import ir
 from numba import njit, types
 from numba.core import cgutils
@@ -13,6 +14,9 @@ from numba.extending import intrinsic
 
 from .fastexp import EXP_NEAR_MAX, exp_neg, exp_neg_near, wide_vectors
 
+# vector compress in _compact: a vpcompressd where the CPU has AVX-512 (the JIT and the ahead-of-time
+# build, compiled.py, target this CPU), LLVM's scalar expansion elsewhere, slower than a loop
+_VECTOR_COMPRESS = "+avx512f" in llvm.get_host_cpu_features().flatten()
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)  # SplitMix64's increment: its state after k outputs is s + k G
 
 
@@ -338,13 +342,59 @@ def _window_pass(i, xp, xw, lw, rw, inv2s2, near, w):
     return s
 
 
+@intrinsic
+def _compress16(typingctx, part, cnt, lw, k, i):
+    """part[cnt:cnt + 16] <- the offsets k + t (t < 16) with lw[k + t] > i, packed in order, and
+    garbage after them (vector compress: one vpcompressd with AVX-512) -> cnt + how many. Needs
+    cnt + 16 <= len(part) and k + 16 <= len(lw); lw is C-contiguous int64, part uint32."""
+    if not (isinstance(lw, types.Array) and lw.dtype == types.int64 and lw.layout == "C"):
+        return None
+    if not (isinstance(part, types.Array) and part.dtype == types.uint32 and part.layout == "C"):
+        return None
+
+    def codegen(context, builder, signature, args):
+        part_a, cnt_v, lw_a, k_v, i_v = args
+        i32, i64 = ir.IntType(32), ir.IntType(64)
+        v64, v32, mask_t = ir.VectorType(i64, 16), ir.VectorType(i32, 16), ir.VectorType(ir.IntType(1), 16)
+        zeros = ir.Constant(v32, [0] * 16)
+
+        def splat(vec_t, value):
+            one = builder.insert_element(ir.Constant(vec_t, ir.Undefined), value, ir.Constant(i32, 0))
+            return builder.shuffle_vector(one, ir.Constant(vec_t, ir.Undefined), zeros)
+
+        labels_at = builder.gep(context.make_array(signature.args[2])(context, builder, lw_a).data, [k_v])
+        labels = builder.load(builder.bitcast(labels_at, v64.as_pointer()), align=8)
+        mask = builder.icmp_signed(">", labels, splat(v64, i_v))
+        offsets = builder.add(splat(v32, builder.trunc(k_v, i32)), ir.Constant(v32, list(range(16))))
+        compress = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(v32, [v32, mask_t, v32]), "llvm.experimental.vector.compress.v16i32"
+        )
+        packed = builder.call(compress, [offsets, mask, ir.Constant(v32, ir.Undefined)])
+        out_at = builder.gep(context.make_array(signature.args[0])(context, builder, part_a).data, [cnt_v])
+        builder.store(packed, builder.bitcast(out_at, v32.as_pointer()), align=4)
+        popcount = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.IntType(16), [ir.IntType(16)]), "llvm.ctpop.i16"
+        )
+        taken = builder.call(popcount, [builder.bitcast(mask, ir.IntType(16))])
+        return builder.add(cnt_v, builder.zext(taken, i64))
+
+    return types.int64(part, types.int64, lw, types.int64, types.int64), codegen
+
+
 @njit(cache=True)
-def _compact(i, lw, part):
-    """part[:cnt] <- the window offsets of i's partners (later in storage), in window order -> cnt."""
+def _compact(i, ls, lo, hi, part):
+    """part[:cnt] <- the window offsets (from lo) of i's partners in ls[lo:hi] (later in storage),
+    in window order -> cnt. Blocks of 16 by vector compress where the CPU has AVX-512; the scalar
+    loop elsewhere (LLVM would lower the compress to scalar stores)."""
     cnt = 0
-    for k in range(lw.shape[0]):
+    start = 0
+    if _VECTOR_COMPRESS:
+        while start + 16 <= hi - lo:
+            cnt = _compress16(part, cnt, ls[lo:], start, i)
+            start += 16
+    for k in range(start, hi - lo):
         part[cnt] = k
-        cnt += lw[k] > i
+        cnt += ls[lo + k] > i
     return cnt
 
 
@@ -387,8 +437,28 @@ def _step_fma(k, mi, part, jd, w, b, hb, irf, ms, lo):
 
 @njit(cache=True, inline="always")
 def _exchange_fma(mi, cnt, part, jd, w, b, hb, irf, ms, lo):
-    """The visit's exchanges in the drawn order, fused -> m_i."""
-    for k in range(cnt):
+    """The visit's exchanges in the drawn order, fused, two a link of the chain through m_i:
+    m_i after exchanges k and k + 1 is m_i (1 - c_k)(1 - c_k+1) + (c_k m_k (1 - c_k+1) + c_k+1
+    m_k+1), whose factors need no m_i, so the chain waits for one fused multiply-add every two
+    partners; m_i between them feeds only partner k + 1's update -> m_i."""
+    k = 0
+    while k + 1 < cnt:
+        j = jd[k]
+        q = part[j]
+        part[j] = part[k]
+        j1 = jd[k + 1]
+        q1 = part[j1]
+        part[j1] = part[k + 1]
+        c = _weight(w[q], b, hb, irf, lo + q)
+        c1 = _weight(w[q1], b, hb, irf, lo + q1)
+        mj = ms[lo + q]
+        mj1 = ms[lo + q1]
+        ms[lo + q] = _fma(c, mi - mj, mj)
+        mid = _fma(mi, 1.0 - c, c * mj)  # m_i after exchange k
+        ms[lo + q1] = _fma(c1, mid - mj1, mj1)
+        mi = _fma(mi, (1.0 - c) * (1.0 - c1), _fma(c * mj, 1.0 - c1, c1 * mj1))
+        k += 2
+    if k < cnt:
         mi = _step_fma(k, mi, part, jd, w, b, hb, irf, ms, lo)
     return mi
 
@@ -444,7 +514,7 @@ def _prepare(i, xs, ls, rs, irf, lo, hi, me, inv2s2, near, beta, hb, part, w):
     """The visit to i up to its weights: W over its window, the row sums, its partners
     part[:cnt] -> (cnt, b: beta / r_i, or 1 / r_i for symnorm)."""
     s = _window_pass(i, xs[me], xs[lo:hi], ls[lo:hi], rs[lo:hi], inv2s2, near, w)
-    cnt = _compact(i, ls[lo:hi], part)
+    cnt = _compact(i, ls, lo, hi, part)
     return cnt, (irf[me] if hb != 0.0 else beta * (1.0 / (rs[me] + 1.0 + s)))
 
 
