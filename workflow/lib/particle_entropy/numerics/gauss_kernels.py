@@ -10,18 +10,34 @@ import math
 import numpy as np
 from numba import njit
 
-from .fastexp import exp_neg
+from .fastexp import EXP_NEAR_MAX, exp_neg, exp_neg_near, wide_vectors
+
+
+@njit(cache=True, inline="always")
+def _window_weights(yi, x, lo, hi, inv2s2, near, buf):
+    """buf[j - lo] <- exp(-(yi - x_j)^2 / (2 sigma^2)) for lo <= j < hi; exp_neg_near (the same
+    bits, cheaper) where the window's largest argument allows it."""
+    if near:
+        for j in range(lo, hi):
+            d = yi - x[j]
+            buf[j - lo] = exp_neg_near(d * d * inv2s2)
+    else:
+        for j in range(lo, hi):
+            d = yi - x[j]
+            buf[j - lo] = exp_neg(d * d * inv2s2)
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
 def direct(y, x, q, sigma, radius, skip_self):
     """Windowed sum over sorted sources; the window's weights go to a buffer first, so the
-    exp and the sums vectorise."""
+    exp and the sums vectorise (512-bit vectors where the CPU has them)."""
+    wide_vectors()
     nk, ns = q.shape
     nt = y.shape[0]
     out = np.zeros((nk, nt))
     buf = np.empty(ns)
     inv2s2 = 0.5 / (sigma * sigma)
+    near = radius * radius * inv2s2 <= EXP_NEAR_MAX
     lo = 0
     hi = 0
     for i in range(nt):
@@ -32,9 +48,7 @@ def direct(y, x, q, sigma, radius, skip_self):
             hi = lo
         while hi < ns and x[hi] <= yi + radius:
             hi += 1
-        for j in range(lo, hi):
-            d = yi - x[j]
-            buf[j - lo] = exp_neg(d * d * inv2s2)
+        _window_weights(yi, x, lo, hi, inv2s2, near, buf)
         if skip_self and lo <= i < hi:
             buf[i - lo] = 0.0
         for k in range(nk):
@@ -48,10 +62,12 @@ def direct(y, x, q, sigma, radius, skip_self):
 @njit(cache=True, fastmath={"reassoc", "contract"})
 def direct_symmetric(x, q, sigma, radius):
     """Windowed sum with targets = sources: each pair's exp is evaluated once (into a
-    buffer, so that the exp and the sums vectorise over a window)."""
+    buffer, so that the exp and the sums vectorise over a window, 512-bit where the CPU has it)."""
+    wide_vectors()
     nk, n = q.shape
     out = q.copy()  # self terms, W_ii = 1
     inv2s2 = 0.5 / (sigma * sigma)
+    near = radius * radius * inv2s2 <= EXP_NEAR_MAX
     buf = np.empty(n)
     hi = 0
     for i in range(n):
@@ -60,10 +76,7 @@ def direct_symmetric(x, q, sigma, radius):
         while hi < n and x[hi] <= x[i] + radius:
             hi += 1
         lo = i + 1
-        xi = x[i]
-        for j in range(lo, hi):
-            d = xi - x[j]
-            buf[j - lo] = exp_neg(d * d * inv2s2)
+        _window_weights(x[i], x, lo, hi, inv2s2, near, buf)
         for k in range(nk):
             qi = q[k, i]
             acc = 0.0
