@@ -31,6 +31,7 @@ include: "workflow/rules/figures.smk"
 include: "workflow/rules/shear.smk"
 include: "workflow/rules/mechanism.smk"
 include: "workflow/rules/optimum.smk"
+include: "workflow/rules/scenes.smk"
 
 
 rule all:

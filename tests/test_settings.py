@@ -146,7 +146,7 @@ def test_every_declared_setting_reads_back_from_the_schema(setting):
         assert tuple(entry["enum"]) == setting.choices
     if setting.kind in ("number", "integer") and setting.choices is None and not setting.none:
         assert entry["type"] == setting.kind
-        low = entry.get("exclusiveMinimum" if setting.open_low else "minimum")
+        low = entry.get("exclusiveMinimum" if setting.open_low else "minimum", -math.inf)  # none: unbounded below
         assert low == setting.low and entry.get("maximum", math.inf) == setting.high
 
 

@@ -45,6 +45,8 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
+from particle_entropy.experiments.scene import scenes
+from particle_entropy.analysis.scene_search import SCENE_RUN_PATTERN
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 
@@ -56,6 +58,10 @@ if AVAILABLE is not None:
 # The adaptive COMIC searches (workflow/rules/optimum.smk), by name; each is checked when a
 # requested target first needs it, so a config layered over config.yaml's searches runs.
 OPTIMUM = optimum_searches(config, AVAILABLE)
+# The scenes (workflow/rules/scenes.smk), by name, every one checked here, before any job; the run
+# settings of each candidate by its identity (a digest of its physics: scenes share equal runs).
+SCENES = scenes(config)
+SCENE_SETTINGS = {sc.identity(c): sc.settings(c) for sc in SCENES.values() for c in sc.candidates}
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):
@@ -284,6 +290,38 @@ def optimum_final_inputs(wildcards):
     raise ValueError(f"optimum search {wildcards.name}: no finished plan after {MAX_ROUNDS + 2} rounds")
 
 
+def scene_round_inputs(wildcards):
+    """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
+    import pandas as pd
+
+    from particle_entropy.analysis.scene_search import plan_paths
+
+    if wildcards.name not in SCENES:
+        raise WorkflowError(f"no scene {wildcards.name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
+    k = int(wildcards.k)
+    if k == 0:
+        return {}
+    path = checkpoints.scene_round.get(name=wildcards.name, k=str(k - 1)).output[0]
+    plan = pd.read_parquet(path)
+    if plan["done"].any():
+        raise ValueError(f"scene {wildcards.name} stopped at round {k - 1}: there is no round {k}")
+    return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
+
+
+def scene_final_inputs(wildcards):
+    """The finished plan of a scene and its runs: rounds are requested one at a time."""
+    import pandas as pd
+
+    from particle_entropy.analysis.scene_search import MAX_ROUNDS, plan_paths
+
+    for k in range(MAX_ROUNDS + 1):
+        path = checkpoints.scene_round.get(name=wildcards.name, k=str(k)).output[0]
+        plan = pd.read_parquet(path)
+        if plan["done"].all():
+            return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
+    raise ValueError(f"scene {wildcards.name}: no finished plan after {MAX_ROUNDS + 1} rounds")
+
+
 def sim_mem_mb(wildcards):
     """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
     seeds = int(wildcards.last) - int(wildcards.first) + 1
@@ -329,3 +367,6 @@ LATTICE_CODE = code_version("experiments.lattice", "core.io", files=[SCRIPTS / "
 OPTIMUM_ROUND_CODE = code_version("analysis.optimum", "core.io", files=[SCRIPTS / "optimum_round.py"])
 OPTIMUM_TABLE_CODE = code_version("analysis.optimum", "core.io", files=[SCRIPTS / "optimum_table.py"])
 OPTIMUM_PLOT_CODE = code_version("figures.optimum", "core.io", files=[SCRIPTS / "plot_optimum.py"])
+SCENE_ROUND_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_round.py"])
+SCENE_TABLE_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_table.py"])
+SCENE_PLOT_CODE = code_version("figures.scene", "core.io", files=[SCRIPTS / "plot_scene.py"])

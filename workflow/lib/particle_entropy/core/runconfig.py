@@ -10,9 +10,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
+from .reference import Reference, Source
 from .registry import DEFAULT_KERNEL
 from .settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .timegrid import MAX_STEPS, max_first_step, step_count
+
+PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
+ADVECTION_SCHEMES = ("upwind", "central")  # FD's advection term (models/fd.py)
 
 
 def check_setting(setting: Setting, value):
@@ -61,6 +65,15 @@ class RunConfig:
     transfer_method: str = PAPER["transfer_method"]
     transfer_tolerance: float = PAPER["transfer_tolerance"]
     loop_arithmetic: str = PAPER["loop_arithmetic"]
+    # the scene (core/reference.py): the source and a uniform velocity; the paper's is a point at
+    # x = 0 at rest. FD's advection scheme is used only when v != 0.
+    source: Source = PAPER_SOURCE
+    v: float = 0.0
+    advection: str = "upwind"
+
+    def __post_init__(self):
+        if isinstance(self.source, Mapping):  # as a job's settings carry it
+            object.__setattr__(self, "source", Source(**self.source))
 
     @classmethod
     def of(
@@ -107,6 +120,27 @@ class RunConfig:
     time_grid = property(lambda self: self.case.time_grid)
 
     @property
+    def at_rest(self) -> bool:
+        """The paper's scene: a point source at x = 0 and no flow."""
+        return self.source == PAPER_SOURCE and self.v == 0.0
+
+    def reference(self, t: float) -> Reference:
+        """The exact solution at time t that this run is measured against."""
+        return Reference(self.source, self.D, self.v, t)
+
+    def points(self, t: float) -> np.ndarray:
+        """The measurement points at time t: the paper's 15 (measures.measurement_points), or a
+        scene's over its FD window, carried with the plume (Reference.points) [L]."""
+        return self.reference(t).points(None if self.at_rest else self.fd_length)
+
+    def fd_span(self) -> tuple[float, float]:
+        """(first node, length) of the FD grid: the paper's [-L/2, L/2] around the source's
+        centre, lengthened by the path v t_final so that the grid holds the plume all the way [L]."""
+        path = self.v * self.t_final
+        lo = self.source.centre - self.fd_length / 2.0 + min(0.0, path)
+        return lo, self.fd_length + abs(path)
+
+    @property
     def dV(self) -> float:
         """A particle's sampling volume dV = Omega / N (the Delta V of Eqs. 5-9; the bin width of Eq. 11)."""
         return self.omega / self.n
@@ -143,6 +177,12 @@ class RunConfig:
             )
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
         check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
+        if not isinstance(self.source, Source):
+            raise SettingError("source", self.source, "a Source (point, gaussian or box)")
+        if not (isinstance(self.v, (int, float)) and math.isfinite(self.v)):
+            raise SettingError("v", self.v, "a finite number [L/T]")
+        if self.advection not in ADVECTION_SCHEMES:
+            raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
@@ -169,14 +209,17 @@ class RunConfig:
         variance = 2.0 * self.D * self.t_final
         if not math.isfinite(4.0 * math.pi * math.e * variance):  # E = sqrt(2 pi e variance)
             raise SettingError("D", self.D, f"a number with 2 D t_final finite (t_final = {self.t_final:g})")
-        width = 2.0 * math.sqrt(variance)
-        if self.method == "fd" and self.fd_length < width:
-            raise SettingError(
-                "fd_length",
-                self.fd_length,
-                f"a domain >= 2 sqrt(2 D t_final) = {width:.6g} for D = {self.D:g}, t_final = {self.t_final:g}: "
-                "the plume would outgrow the grid",
-            )
+        width = 2.0 * (self.source.half_width + math.sqrt(variance))
+        source = "" if self.source == PAPER_SOURCE else f" + the source's extent {2 * self.source.half_width:.6g}"
+        for name, length, models in (("fd_length", self.fd_length, ("fd",)), ("omega", self.omega, ("pt", "mtpt"))):
+            if self.method in models and length < width and (name == "fd_length" or not self.at_rest):
+                raise SettingError(
+                    name,
+                    length,
+                    f"a domain >= 2 sqrt(2 D t_final){source} = {width:.6g} for D = {self.D:g}, "
+                    f"t_final = {self.t_final:g}: the plume would outgrow the "
+                    + ("grid" if name == "fd_length" else "particles"),
+                )
 
     def rng(self, stream: int = 0) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels, eta and schemes share positions and walks.

@@ -367,6 +367,11 @@ SECTION_DOCS = {
     "shear": "Fig. 10 (Appendix B): 2-D shear flow v_x = y - y^2, D = diag(alpha_L v_x, alpha_T v_x).",
     "optimum": "Adaptive searches for the N minimising mean COMIC (its own target: snakemake -j2 optimum; "
     "results/optimum/<name>.parquet, figures/optimum_<name>.png), one per key (letters, digits, _).",
+    "scenes": "Problems of your own (experiments/scene.py, docs/scenes.md; its own target: snakemake -j2 "
+    "scenes): for each, the cheapest model that reaches an accuracy, and the COMIC-best, one per key.",
+    "scenes.<name>": "One scene: D, v, a source, the observation time, the domains, the candidate models and "
+    "the accuracy to reach.",
+    "scenes.<name>.target": "The accuracy every candidate is held to at t_final.",
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }
@@ -689,6 +694,134 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
     ),
 )
 
+# ------------------------------------------------------------------------------ scenes
+# One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
+# (core/reference.py), the candidate models and the accuracy they must reach.
+SCENE_MEASURES = ("rmse", "entropy", "dilution")
+SOURCE_SHAPE = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["kind"],
+    "properties": {
+        "kind": {"type": "string", "enum": ["point", "gaussian", "box"]},
+        "x0": {"type": "number"},
+        "sd": {"type": "number", "exclusiveMinimum": 0},
+        "a": {"type": "number"},
+        "b": {"type": "number"},
+    },
+}
+CANDIDATE_SHAPE = {
+    "type": "array",
+    "minItems": 1,
+    "items": {
+        "type": "object",
+        "additionalProperties": False,
+        "required": ["method", "kernel", "n_range"],
+        "properties": {
+            "method": _ref("method"),
+            "kernel": _ref("kernel"),
+            "eta": _ref("eta"),
+            "truncation": _ref("truncation"),
+            "dt_growth": _ref("dt_growth"),
+            "scheme": _ref("scheme"),
+            "advection": {"type": "string", "enum": ["upwind", "central"]},
+            "fd_dt": {"type": "number", "exclusiveMinimum": 0},
+            "n_range": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2, "maxItems": 2},
+        },
+    },
+}
+SCENE = (
+    Setting("D", "scenes.<name>.D", 1e-3, "dispersion coefficient", "L^2/T", 0.0, open_low=True),
+    Setting("v", "scenes.<name>.v", 0.0, "uniform velocity", "L/T", -math.inf, range_text="a finite number"),
+    Setting("t_final", "scenes.<name>.t_final", 1000.0, "observation time", "T", 0.0, open_low=True),
+    Setting(
+        "source",
+        "scenes.<name>.source",
+        {"kind": "point", "x0": 0.0},
+        "the initial plume, unit mass: {kind: point, x0}, {kind: gaussian, x0, sd} or {kind: box, a, b}",
+        kind="shape",
+        shape=SOURCE_SHAPE,
+        range_text="a point (x0), a Gaussian (x0, sd > 0) or a box (a < b)",
+    ),
+    Setting(
+        "margin",
+        "scenes.<name>.margin",
+        6.0,
+        "the domains follow as the source's extent plus this many sqrt(2 D t_final) on either side: the "
+        "particles' Omega and the FD window (the FD grid adds the path v t_final)",
+        low=1.0,
+        high=100.0,
+    ),
+    Setting("omega", "scenes.<name>.omega", NO_DEFAULT, "particle domain (instead of margin)", "L", 0.0, open_low=True),
+    Setting(
+        "fd_length",
+        "scenes.<name>.fd_length",
+        NO_DEFAULT,
+        "FD window around the plume (instead of margin); the grid adds the path v t_final",
+        "L",
+        0.0,
+        open_low=True,
+    ),
+    Setting(
+        "measure",
+        "scenes.<name>.target.measure",
+        "rmse",
+        "the error judged at t_final: rmse = concentration RMSE at the common measurement points [1/L]; entropy "
+        "= |H_C - its exact value| [nats]; dilution = |E / E_exact - 1|",
+        choices=SCENE_MEASURES,
+    ),
+    Setting(
+        "value",
+        "scenes.<name>.target.value",
+        NO_DEFAULT,
+        "the accuracy to reach: the mean error's one-sided 95 % upper bound at most this",
+        "-",
+        0.0,
+        open_low=True,
+        required=True,
+    ),
+    Setting(
+        "realisations",
+        "scenes.<name>.realisations",
+        8,
+        "realisations at each visited resolution of a particle candidate (FD runs once)",
+        kind="integer",
+        low=2,
+        high=MAX_REALISATIONS,
+    ),
+    Setting(
+        "cost",
+        "scenes.<name>.cost",
+        {"fd": [3.5e-5, 1.5e-8], "pt": [6.0e-5, 3.5e-8], "mtpt": [8.0e-5, 2.5e-7]},
+        "the cost model of a run, by method: [seconds a time step, seconds a unit of work] (work = node- or "
+        "particle-steps); counted, never timed, so the answer is the same on every machine (measured on "
+        "the paper run of 2026-12-03, Intel Xeon)",
+        "s",
+        kind="shape",
+        shape={
+            "type": "object",
+            "additionalProperties": False,
+            "properties": {
+                m: {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2}
+                for m in ("fd", "pt", "mtpt")
+            },
+        },
+        range_text="per method fd, pt, mtpt: [seconds a step, seconds a unit of work], numbers >= 0",
+    ),
+    Setting(
+        "candidates",
+        "scenes.<name>.candidates",
+        NO_DEFAULT,
+        "the models to compare: method, kernel and case dimensions, n_range [low, high] (particles or FD "
+        "intervals); FD candidates may set advection (upwind, central) and fd_dt",
+        kind="shape",
+        shape=CANDIDATE_SHAPE,
+        range_text="a list of models, each with 2 <= n_range low < high",
+        required=True,
+    ),
+)
+
+
 DECLARED = (
     *SETTINGS,
     *SEEDS,
@@ -698,6 +831,7 @@ DECLARED = (
     *REALISATIONS_ENTRY,
     *FIGURE_OPTIONS,
     *TRADEOFF,
+    *SCENE,
     *MECHANISM,
     *SHEAR,
     *SEARCH,

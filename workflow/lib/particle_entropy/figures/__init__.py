@@ -1,7 +1,8 @@
 """The figures: the shared toolkit (`style`: palette, styles, series, drawing, byte-stable saving;
 `dilution`: the drawing Figs. 2, 4 and 5 share) and one module per figure, named for it: the
 function ``<name>`` of ``figures/<name>.py`` draws ``figures/<name>.png`` (the adaptive searches'
-``figures/optimum_<search>.png``: ``optimum.optimum_figure``). ``FIGURES`` is the one list of
+``figures/optimum_<search>.png``: ``optimum.optimum_figure``; the scenes' ``figures/scene_<name>.png``:
+``scene.scene``). ``FIGURES`` is the one list of
 figures; the rules, the report's captions (``workflow/report/<name>.rst``), the column page and the
 tests read it. A plot script imports only its figure's module and the workflow hashes only its
 code, so editing one figure redraws that figure alone. Imports from `core`, `numerics`, `models`,
@@ -20,7 +21,7 @@ class Figure:
     """One figure: ``name`` is its module, its target ``figures/<name>.png`` and its caption
     ``workflow/report/<name>.rst``; ``section`` the config section that lists what it draws;
     ``reads`` what its rule reads (runs, snapshots, summaries, comic, tradeoff, shear, mechanism,
-    search); ``category`` its heading in the report."""
+    search, scene); ``category`` its heading in the report."""
 
     name: str
     section: str
@@ -47,6 +48,7 @@ FIGURES = (
     Figure("tradeoff", "tradeoff", "tradeoff", "Speed and accuracy"),
     Figure("fig9_mechanism", "mechanism", "mechanism", "Mechanism"),
     Figure("optimum", "optimum", "search", "Optimum search"),
+    Figure("scene", "scenes", "scene", "Scenes"),
 )
 BY_NAME = {f.name: f for f in FIGURES}
 PAPER_FIGURES = tuple(f.name for f in FIGURES if f.section.startswith("figures."))  # fig1 ... fig9

@@ -1,5 +1,8 @@
 """Finite differences for 1-D diffusion (Section 6.1, Fig. 8): implicit (backward Euler, the
-paper's) and explicit (forward Euler, refused past its stability limit r = 1/2)."""
+paper's) and explicit (forward Euler, refused past its stability limit r = 1/2). With a uniform
+velocity v (a scene), the implicit scheme gains an advection term on the fixed grid: first-order
+upwind (monotone; numerical dispersion v dx / 2) or central differences (second order; oscillates
+where the grid Peclet number v dx / D exceeds 2)."""
 
 from __future__ import annotations
 
@@ -13,17 +16,39 @@ from ..numerics.compiled import kernels
 
 
 def grid(cfg: RunConfig) -> tuple[np.ndarray, float]:
-    """Nodes -L/2 + k dx, k = 0..N, dx = L / N (both end nodes held at zero)."""
-    dx = cfg.fd_length / cfg.n
-    return -cfg.fd_length / 2.0 + dx * np.arange(cfg.n + 1), dx
+    """Nodes lo + k dx, k = 0..N, dx = length / N (both end nodes held at zero): the paper's
+    [-L/2, L/2], lengthened by a scene's path v t_final (RunConfig.fd_span)."""
+    if cfg.at_rest:
+        dx = cfg.fd_length / cfg.n
+        return -cfg.fd_length / 2.0 + dx * np.arange(cfg.n + 1), dx
+    lo, length = cfg.fd_span()
+    dx = length / cfg.n
+    return lo + dx * np.arange(cfg.n + 1), dx
 
 
 def initial_concentration(cfg: RunConfig) -> np.ndarray:
-    """Discrete delta: 1 / dx at the centre node."""
+    """The paper's discrete delta, 1 / dx at the centre node; a scene's source as node masses
+    (Source.masses) over dx."""
     x, dx = grid(cfg)
-    c = np.zeros_like(x)
-    c[cfg.n // 2] = 1.0 / dx
-    return c
+    if cfg.at_rest:
+        c = np.zeros_like(x)
+        c[cfg.n // 2] = 1.0 / dx
+        return c
+    return cfg.source.masses(x, dx) / dx
+
+
+def solver(cfg: RunConfig, dt: float, dx: float):
+    """The solver of one step dt on the interior nodes: the case's diffusion scheme, with the
+    advection term when v != 0 (implicit only)."""
+    r = cfg.D * dt / dx**2
+    if cfg.v != 0.0:
+        return AdvectionSolver(cfg.n - 1, r, cfg.v * dt / dx, cfg.advection)
+    return (ExplicitSolver if cfg.kernel == "explicit" else ImplicitSolver)(cfg.n - 1, r)
+
+
+def grid_peclet(v: float, dx: float, D: float) -> float:
+    """|v| dx / D: central differences oscillate above 2 [-]."""
+    return abs(v) * dx / D if D > 0 else math.inf
 
 
 class ImplicitSolver:
@@ -36,6 +61,36 @@ class ImplicitSolver:
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         return kernels().thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
+
+
+class AdvectionSolver:
+    """(I - r A + p B) c^{n+1} = c^n, backward Euler with r = D dt / dx^2 and the Courant number
+    p = v dt / dx: B the upwind difference (c_i - c_{i-1} for v > 0, c_{i+1} - c_i for v < 0) or
+    the central one (c_{i+1} - c_{i-1}) / 2. Tridiagonal, factorised once by LAPACK's dgttrf and
+    solved by dgttrs (scipy.linalg.lapack)."""
+
+    def __init__(self, n_interior: int, r: float, p: float, scheme: str):
+        from scipy.linalg import lapack
+
+        if scheme == "upwind":
+            lower, diag, upper = -r - max(p, 0.0), 1.0 + 2.0 * r + abs(p), -r + min(p, 0.0)
+        elif scheme == "central":
+            lower, diag, upper = -r - 0.5 * p, 1.0 + 2.0 * r, -r + 0.5 * p
+        else:
+            raise ValueError(f"advection scheme {scheme!r}: upwind or central")
+        self.r, self.p, self.scheme = float(r), float(p), scheme
+        dl = np.full(n_interior - 1, lower)
+        d = np.full(n_interior, diag)
+        du = np.full(n_interior - 1, upper)
+        self._factors = lapack.dgttrf(dl, d, du)
+        if self._factors[-1] != 0:
+            raise ValueError(f"the advection-diffusion matrix is singular (dgttrf info {self._factors[-1]})")
+        self._solve = lapack.dgttrs
+
+    def solve(self, c_interior: np.ndarray) -> np.ndarray:
+        dl, d, du, du2, ipiv, _ = self._factors
+        out, info = self._solve(dl, d, du, du2, ipiv, c_interior)
+        return out
 
 
 class ExplicitSolver:
@@ -55,15 +110,17 @@ def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -
     p = c * dx
     total = float(p.sum())
     h_c = M.entropy_discrete(p / total) if total > 0 else -math.inf
-    err = M.sse(c, M.analytic_sampled(x, cfg.D, t, dx))
+    ref = cfg.reference(t)
+    err = M.sse(c, ref.sampled(x, dx))
     n = x.size
-    points = M.measurement_points()
-    err_points = M.sse_points(points, x, c, cfg.D, t, dx)
+    points = cfg.points(t)
+    err_points = ref.sse_points(points, x, c, dx)
+    length = cfg.fd_length if cfg.at_rest else cfg.fd_span()[1]
     return {
         "H_D": h_c,
         "H_C": h_c,
         "H_I": h_c + math.log(dx),
-        "H_PMF": M.entropy_pmf(h_c, cfg.fd_length, cfg.n),  # dV = L / N intervals
+        "H_PMF": M.entropy_pmf(h_c, length, cfg.n),  # dV = L / N intervals
         "E": M.dilution_index(h_c, dx),
         "SSE": err,
         "n_sse": n,

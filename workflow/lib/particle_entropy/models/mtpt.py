@@ -14,11 +14,19 @@ from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_varia
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
-    """N - 1 zero-mass particles uniform on [-Omega/2, Omega/2] and one unit mass at x = 0, stored
-    first: (positions sorted, masses, storage index of each), as sequential.py stores them."""
-    x = np.concatenate([[0.0], rng.uniform(-cfg.omega / 2.0, cfg.omega / 2.0, cfg.n - 1)])
-    m = np.zeros(cfg.n)
-    m[0] = 1.0
+    """A point source: N - 1 zero-mass particles uniform on [-Omega/2, Omega/2] around it and one
+    unit mass on it, stored first; a Gaussian or box source: N particles uniform on that domain,
+    the source's mass on them by its density (Source.masses) -> (positions sorted, masses, storage
+    index of each), as sequential.py stores them."""
+    source = cfg.source
+    lo, hi = source.centre - cfg.omega / 2.0, source.centre + cfg.omega / 2.0
+    if source.kind == "point":
+        x = np.concatenate([[source.x0], rng.uniform(lo, hi, cfg.n - 1)])
+        m = np.zeros(cfg.n)
+        m[0] = 1.0
+    else:
+        x = rng.uniform(lo, hi, cfg.n)
+        m = source.masses(x, cfg.dV)
     order = np.argsort(x, kind="stable")
     return x[order], m[order], order
 
@@ -37,6 +45,8 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
     """Random walk with (1 - eta) D, re-sort, then one mass transfer with eta D (Eq. 19) by the
     case's scheme -> (x, m, label, kernel width, beta, substeps). ``order_rng`` draws the
     sequential loop's partner orders (default: ``rng``)."""
+    if cfg.v != 0.0:  # carried by the flow: a uniform shift leaves the order and the transfer alone
+        x = x + cfg.v * dt
     d_walk = (1.0 - cfg.eta) * cfg.D
     if d_walk > 0:
         x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
@@ -77,11 +87,12 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
     dV = cfg.dV
     total = float(m.sum())
     h_d = M.entropy_discrete(m / total)
-    g = M.analytic_sampled(x, cfg.D, t, dV)
+    ref = cfg.reference(t)
+    g = ref.sampled(x, dV)
     c = m / dV
     err = M.sse(c, g)
-    points = M.measurement_points()
-    err_points = M.sse_points(points, x, c, cfg.D, t, dV)
+    points = cfg.points(t)
+    err_points = ref.sse_points(points, x, c, dV)
     return {
         "H_D": h_d,
         "H_C": h_d,  # particles carry the sampling volume dV = Omega / N: H_C = H_D

@@ -47,11 +47,19 @@ def kernel_density(points: np.ndarray, x_sorted: np.ndarray, h: float) -> np.nda
     return gauss_transform(points, x_sorted, w, h) / (math.sqrt(2.0 * math.pi) * h)
 
 
+def bin_origin(cfg: RunConfig, t: float) -> float:
+    """The bins' lattice starts at the particle domain's left end, -Omega/2, carried by v t with the
+    plume (and centred on the source) [L]."""
+    if cfg.at_rest:
+        return -cfg.omega / 2.0
+    return cfg.reference(t).centre - cfg.omega / 2.0
+
+
 def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
     """(points, density, point spacing, width) of the chosen reconstruction at time t."""
     h = reconstruction_width(cfg, t)
     if cfg.kernel == "bins":
-        pts, f = bin_density(x_sorted, h, -cfg.omega / 2.0)
+        pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         return pts, f, h, h
     if h == 0.0:  # adaptive kernel at t = 0: the reconstruction is the particles' delta
         return np.zeros(1), np.ones(1), 1.0, 0.0
@@ -65,13 +73,14 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     measurement points (measures.sse_points)."""
     dV = cfg.dV
     pts, f, spacing, h = reconstruct(cfg, x_sorted, t)
-    points = M.measurement_points()
+    ref = cfg.reference(t)
+    points = cfg.points(t)
     if h == 0.0:
         h_i, err, n_pts, err_points = -math.inf, 0.0, 1, 0.0
     else:
         h_i = M.entropy_inconsistent(f, spacing)
-        err, n_pts = M.sse(f, M.analytic_sampled(pts, cfg.D, t, spacing)), pts.size
-        err_points = M.sse_points(points, pts, f, cfg.D, t, spacing)
+        err, n_pts = M.sse(f, ref.sampled(pts, spacing)), pts.size
+        err_points = ref.sse_points(points, pts, f, spacing)
     h_c = M.entropy_consistent(h_i, dV)
     h_d = math.log(cfg.n)  # Eq. 13: equal masses 1/N
     return {
@@ -95,21 +104,24 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     }
 
 
-def initial_positions(cfg: RunConfig) -> np.ndarray:
-    """All N particles at x = 0 (a delta represented by N equal masses)."""
-    return np.zeros(cfg.n)
+def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
+    """N equal masses drawn from the source: the paper's delta puts all N at x = 0 and draws nothing."""
+    if cfg.at_rest:
+        return np.zeros(cfg.n)
+    return cfg.source.positions(cfg.n, rng)
 
 
-def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator) -> np.ndarray:
-    """Random-walk step X <- X + sqrt(2 D dt) xi (the Ito equation of Section 2, v = 0)."""
-    return x + math.sqrt(2.0 * D * dt) * rng.standard_normal(x.size)
+def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator, v: float = 0.0) -> np.ndarray:
+    """Random-walk step X <- X + v dt + sqrt(2 D dt) xi (the Ito equation of Section 2)."""
+    step = math.sqrt(2.0 * D * dt) * rng.standard_normal(x.size)
+    return x + step if v == 0.0 else (x + v * dt) + step
 
 
 def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     """Particle positions, masses and the reconstructed concentration at each particle."""
     h = reconstruction_width(cfg, t)
     if cfg.kernel == "bins":
-        pts, f = bin_density(x_sorted, h, -cfg.omega / 2.0)
+        pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         idx = np.floor((x_sorted - pts[0] + 0.5 * h) / h).astype(np.int64)
         c = f[idx]
     else:

@@ -19,9 +19,10 @@ if TYPE_CHECKING:
 
 
 def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
+    ref = cfg.reference(t)
     return {
-        "H_C_analytic": M.analytic_h_c(cfg.D, t, dV),
-        "E_analytic": M.analytic_dilution(cfg.D, t),
+        "H_C_analytic": ref.h_c(dV),
+        "E_analytic": ref.dilution(),
         "settled": bool(t > M.settling_time(dV, cfg.D)),
     }
 
@@ -75,11 +76,11 @@ def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: di
 def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
     pt = _model("pt")
     rng = cfg.rng()
-    x = pt.initial_positions(cfg)
+    x = np.sort(pt.initial_positions(cfg, rng))
     _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        x = np.sort(pt.walk(x, cfg.D, dt, rng))
+        x = np.sort(pt.walk(x, cfg.D, dt, rng, cfg.v))
         _row(rec, cfg, k, t, dt, pt.measure(cfg, x, t))
     return pt.final_state(cfg, x, t)
 
@@ -103,12 +104,11 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
     c = fd.initial_concentration(cfg)
     extra = {"beta": 0.0, "h": dx, "substeps": 1}
     _row(rec, cfg, 0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
-    solver_type = fd.ExplicitSolver if cfg.kernel == "explicit" else fd.ImplicitSolver
     solvers: dict = {}
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
         if dt not in solvers:  # one factorisation per distinct step size (one for a fixed dt)
-            solvers[dt] = solver_type(cfg.n - 1, cfg.D * dt / dx**2)
+            solvers[dt] = fd.solver(cfg, dt, dx)
         c[1:-1] = solvers[dt].solve(c[1:-1])
         _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
     return {"x": x, "c": c}

@@ -265,6 +265,13 @@ FIGURE_CONTENTS = (
         "`y_lo`, `y_hi` ± one standard error, `n_realisations` = the paired seeds; d: `time` → `ln(SSE/N)` of each "
         "FD grid and domain length (`n` is the paper's grid label, N in the ratio too, not the node count)",
     ),
+    (
+        "scene",
+        "`results/scenes/<name>.parquet` (drawn as `figures/scene_<name>.png`)",
+        "a, b",
+        "a: `cost_s` → `error_mean` with `error_lo`, `error_hi` per candidate, the `target`, the `recommended` row "
+        "starred; b: `n` → `COMIC_points` per candidate, the `comic_best` row ringed",
+    ),
 )
 FIGURE_NOTES = "\n".join(
     [

@@ -35,6 +35,7 @@ from ..core.settings import (
     MECHANISM,
     REALISATIONS_DOC,
     REALISATIONS_ENTRY,
+    SCENE,
     SEARCH,
     SECTION_DOCS,
     SEEDS,
@@ -93,7 +94,7 @@ def entry(s: Setting, default: bool = True) -> dict:
         out = {"type": "string", "enum": list(s.choices)}
     else:
         number = {"type": "integer" if s.kind == "integer" else "number"}
-        if s.low is not None:
+        if s.low is not None and s.low != -math.inf:
             number["exclusiveMinimum" if s.open_low else "minimum"] = _number(s.low)
         if s.high != math.inf:
             number["maximum"] = _number(s.high)
@@ -216,6 +217,7 @@ def blocks() -> dict[str, Block]:
     generated["mechanism"] = object_body("mechanism", MECHANISM)
     generated["shear"] = object_body("shear", SHEAR)
     generated["search"] = object_body("optimum.<name>", SEARCH)
+    generated["scene"] = object_body("scenes.<name>", SCENE)
     generated["realisations_entry"] = Block(items=object_body("realisations[]", REALISATIONS_ENTRY))
     return generated
 

@@ -1,0 +1,139 @@
+"""The exact references of a scene (core/reference.py) against independent quadrature, the PDE
+and the paper's own Gaussian formulas."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.special import erf
+
+from particle_entropy.core import measures as M
+from particle_entropy.core.reference import Reference, Source, box_entropy
+
+
+def _quad_box_entropy(width: float, dt: float) -> float:
+    """-integral c ln c dx of the dispersed box by scipy's adaptive quadrature, split at the edge."""
+    s = math.sqrt(4.0 * dt)
+    half = 0.5 * width
+
+    def minus_c_ln_c(x):
+        c = 0.5 * (math.erf((x + half) / s) - math.erf((x - half) / s)) / width
+        return -c * math.log(c) if c > 0 else 0.0
+
+    cuts = sorted({0.0, max(0.0, half - 12 * s), half, half + 12 * s})
+    total = sum(quad(minus_c_ln_c, lo, hi, limit=400, epsabs=1e-15, epsrel=1e-13)[0] for lo, hi in zip(cuts, cuts[1:]))
+    return 2.0 * total
+
+
+@pytest.mark.parametrize(
+    "width, dt", [(1.0, 1e-6), (1.0, 0.01), (1.0, 1.0), (0.001, 1.0), (10.0, 1e-8), (1.0, 100.0), (3.0, 0.2)]
+)
+def test_box_entropy_matches_scipy_quad(width, dt):
+    assert box_entropy(width, dt) == pytest.approx(_quad_box_entropy(width, dt), abs=1e-11)
+
+
+def test_box_entropy_limits():
+    assert box_entropy(2.5, 0.0) == math.log(2.5)  # uniform on the box
+    # a box much narrower than sqrt(4 D t) is a Gaussian of variance w^2/12 + 2 D t (to O((w/s)^4))
+    w, dt = 1e-3, 4.0
+    gaussian = 0.5 * math.log(2 * math.pi * math.e * (w * w / 12 + 2 * dt))
+    assert box_entropy(w, dt) == pytest.approx(gaussian, abs=1e-11)  # erf differences lose ~1e-12
+    # spreading only adds entropy
+    values = [box_entropy(1.0, dt) for dt in (0.0, 1e-4, 1e-2, 1.0)]
+    assert values == sorted(values) and len(set(values)) == 4
+
+
+@pytest.mark.parametrize(
+    "source",
+    [Source("point", x0=0.3), Source("gaussian", x0=-1.0, sd=0.2), Source("box", a=-0.5, b=0.25)],
+)
+def test_density_has_unit_mass_the_carried_centre_and_the_variance(source):
+    ref = Reference(source, D=0.01, v=0.7, t=2.0)
+    x = np.linspace(ref.centre - 20, ref.centre + 20, 400_001)
+    c = ref.density(x)
+    dx = x[1] - x[0]
+    assert c.sum() * dx == pytest.approx(1.0, abs=1e-10)
+    mean = (x * c).sum() * dx
+    assert mean == pytest.approx(source.centre + 0.7 * 2.0, abs=1e-9)
+    assert ((x - mean) ** 2 * c).sum() * dx == pytest.approx(source.variance + 2 * 0.01 * 2.0, rel=1e-8)
+    h = -(c[c > 0] * np.log(c[c > 0])).sum() * dx
+    assert ref.entropy() == pytest.approx(h, abs=1e-8)
+    assert ref.dilution() == pytest.approx(math.exp(h), rel=1e-8)
+
+
+@pytest.mark.parametrize("source", [Source("gaussian", x0=0.1, sd=0.3), Source("box", a=-0.2, b=0.4)])
+def test_density_solves_advection_dispersion(source):
+    """dc/dt + v dc/dx = D d2c/dx2, by centred differences in t and x."""
+    D, v, t, h, k = 0.05, -1.3, 0.8, 1e-3, 1e-4
+    x = np.linspace(-3, 3, 601)
+    dcdt = (Reference(source, D, v, t + k).density(x) - Reference(source, D, v, t - k).density(x)) / (2 * k)
+    now = Reference(source, D, v, t)
+    dcdx = (now.density(x + h) - now.density(x - h)) / (2 * h)
+    d2cdx2 = (now.density(x + h) - 2 * now.density(x) + now.density(x - h)) / h**2
+    residual = dcdt + v * dcdx - D * d2cdx2
+    assert np.max(np.abs(residual)) < 1e-5 * np.max(np.abs(dcdt))
+
+
+def test_point_source_is_the_papers_gaussian_carried_by_v():
+    D, t, v = 1e-3, 250.0, 0.02
+    ref = Reference(Source("point", x0=0.5), D, v, t)
+    narrow = Reference(Source("gaussian", x0=0.5, sd=1e-9), D, v, t)  # the general formula
+    assert ref.entropy() == pytest.approx(narrow.entropy(), rel=1e-14)
+    assert ref.entropy() == pytest.approx(0.5 * math.log(4 * math.pi * math.e * D * t), rel=1e-14)
+    assert ref.dilution() == pytest.approx(M.analytic_dilution(D, t), rel=1e-14)
+    assert ref.h_c(0.01) == pytest.approx(M.analytic_h_c(D, t, 0.01), rel=1e-14)
+    x = np.linspace(-1, 1, 21)
+    assert ref.density(x + 0.5 + v * t) == pytest.approx(M.gaussian_density(x, D, t), rel=1e-13)
+    at_rest = Reference(Source("point"), D, 0.0, t)
+    grid = np.linspace(-5, 5, 1001)
+    assert at_rest.sampled(grid, 0.01).tobytes() == M.analytic_sampled(grid, D, t, 0.01).tobytes()
+    assert at_rest.density(grid).tobytes() == M.gaussian_density(grid, D, t).tobytes()  # the paper's bits
+
+
+def test_a_point_at_t0_is_a_delta_on_the_nearest_sample():
+    ref = Reference(Source("point", x0=0.26), D=1.0, v=5.0, t=0.0)
+    x = np.linspace(-1, 1, 11)  # spacing 0.2: 0.2 is nearest to 0.26
+    g = ref.sampled(x, 0.2)
+    assert g.tolist() == [0.0] * 6 + [5.0] + [0.0] * 4
+    assert ref.entropy() == -math.inf and ref.dilution() == 0.0
+    with pytest.raises(ValueError, match="delta"):
+        ref.density(x)
+
+
+def test_box_density_at_t0_and_the_erf_difference():
+    ref = Reference(Source("box", a=1.0, b=3.0), D=0.5, v=1.0, t=0.0)
+    assert ref.density(np.array([0.9, 1.5, 2.9, 3.1])).tolist() == [0.0, 0.5, 0.5, 0.0]
+    later = Reference(Source("box", a=1.0, b=3.0), D=0.5, v=1.0, t=2.0)
+    x = np.array([2.0, 4.0, 6.0])
+    s = math.sqrt(4 * 0.5 * 2.0)
+    expected = [0.25 * (erf((xi - 3.0) / s) - erf((xi - 5.0) / s)) for xi in x]
+    assert later.density(x) == pytest.approx(expected, rel=1e-14)
+
+
+def test_source_masses_sum_to_one_and_a_narrow_box_takes_one_node():
+    x = np.linspace(-1, 1, 201)
+    for source in (Source("point", x0=0.013), Source("gaussian", sd=0.1), Source("box", a=-0.3, b=0.3)):
+        m = source.masses(x, 0.01)
+        assert m.sum() == pytest.approx(1.0, abs=1e-15) and (m >= 0).all()
+    narrow = Source("box", a=0.5001, b=0.5002).masses(x, 0.01)
+    assert np.count_nonzero(narrow) == 1 and narrow[150] == 1.0
+    box = Source("box", a=-0.3, b=0.3).masses(x, 0.01)
+    assert np.count_nonzero(box) == 61  # nodes -0.3 .. 0.3, the end ones half covered
+    assert box[70] == pytest.approx(box[100] / 2)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"kind": "line"}, "point, gaussian, box"),
+        ({"kind": "gaussian", "sd": 0.0}, "sd > 0"),
+        ({"kind": "box", "a": 1.0, "b": 1.0}, "a < b"),
+        ({"kind": "box", "a": 0.0, "b": math.inf}, "a < b"),
+    ],
+)
+def test_bad_sources_are_refused(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        Source(**kwargs)

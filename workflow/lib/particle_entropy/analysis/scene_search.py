@@ -1,0 +1,221 @@
+"""The cheapest model of a scene (experiments/scene.py) that reaches its accuracy, and the COMIC-best.
+
+For each candidate, a root search on its ladder of resolutions (Candidate.ladder) for the smallest
+one whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
+s / sqrt(R) of R realisations (FD is deterministic: one run, its error). Errors fall with
+resolution up to noise, so the search climbs the ladder two rungs (a factor of about 4) at a time
+until a rung passes, then halves the gap between the highest failing and the lowest passing rung
+until they are neighbours. Each round is a Snakemake checkpoint whose plan names the runs to make;
+the path depends on the config and the errors only, never on timings.
+
+Costs are counted, not timed: work (particle- or node-steps, the run tables' ``work``) times the
+scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work); the
+measured core-seconds stand beside them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ..core.case import CASE_DIR
+from ..experiments.scene import Candidate, Scene
+
+SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
+MAX_ROUNDS = 40  # a search's rounds at most: a ladder has at most ~40 rungs (ratio 2)
+CLIMB = 2  # rungs climbed a round while no rung passes
+PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
+NEGATIVE_TOLERANCE = 1e-12  # a node mass below -this (of unit total) is a negative concentration
+
+
+def error(scene: Scene, row: pd.Series | dict) -> float:
+    """The scene's error measure of one run at t_final (its last row)."""
+    if scene.measure == "rmse":
+        return math.sqrt(row["SSE_points"] / 15.0)
+    if scene.measure == "entropy":
+        return abs(row["H_C"] - row["H_C_analytic"])
+    return abs(row["E"] / row["E_analytic"] - 1.0)
+
+
+def unscored(scene: Scene, candidate: Candidate, row) -> str:
+    """Why a run cannot be judged ('' if it can): negative concentrations (an FD central scheme past
+    grid Peclet 2) have no entropy and are never chosen."""
+    if row["mass_min"] < -NEGATIVE_TOLERANCE:
+        dx = row["dV"]
+        peclet = abs(scene.v) * dx / scene.D
+        why = f"negative concentrations: grid Peclet {peclet:.3g}"
+        return why + (" > 2" if peclet > 2 else "")
+    if not np.isfinite(row["SSE_points"]):
+        return "SSE not finite"
+    return ""
+
+
+def upper_bound(errors: np.ndarray) -> float:
+    """The mean's one-sided 95 % upper bound (Student t); one value: itself."""
+    errors = np.asarray(errors, dtype=float)
+    if errors.size == 1:
+        return float(errors[0])
+    from scipy.stats import t
+
+    return float(errors.mean() + t.ppf(0.95, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
+
+
+def seeds(scene: Scene, candidate: Candidate, base_seed: int) -> tuple[int, int]:
+    """The first and last seed of a rung's runs (FD: one run)."""
+    count = 1 if candidate.case.method == "fd" else scene.realisations
+    return base_seed, base_seed + count - 1
+
+
+def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
+    """One row per (candidate, n) visited: error mean, its 95 % interval (two-sided, t) and upper
+    bound, whether it meets the target, why not scored, work and core-seconds, COMIC at the points."""
+    rows = []
+    for (ci, n), g in runs.groupby(["candidate", "n"], sort=True):
+        cand = scene.candidates[ci]
+        reasons = [unscored(scene, cand, r) for _, r in g.iterrows()]
+        errs = np.array([error(scene, r) for _, r in g.iterrows()])
+        reason = next((r for r in reasons if r), "")
+        k = errs.size
+        if k > 1:
+            from scipy.stats import t
+
+            half = t.ppf(0.975, k - 1) * errs.std(ddof=1) / math.sqrt(k)
+        else:
+            half = 0.0
+        up = upper_bound(errs)
+        rows.append(
+            {
+                "candidate": int(ci),
+                "label": cand.label,
+                "method": cand.case.method,
+                "n": int(n),
+                "realisations": int(k),
+                "error_mean": float(errs.mean()),
+                "error_lo": float(errs.mean() - half),
+                "error_hi": float(errs.mean() + half),
+                "error_upper95": up,
+                "meets": bool(not reason and up <= scene.value),
+                "unscored": reason,
+                "steps": float(g["steps"].mean()),
+                "work": float(g["work"].mean()),
+                "cost_s": scene.cost_s(cand.case.method, g["steps"].mean(), g["work"].mean()),
+                "core_s": float(g["core_s"].mean()),
+                "COMIC_points": float(g["COMIC_points"].mean()) if not reason else math.nan,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _next_rung(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tuple[int | None, str]:
+    """The next resolution of one candidate's search, or (None, why it stops)."""
+    ladder = candidate.ladder()
+    if visited.empty:
+        return ladder[0], ""
+    idx = {n: i for i, n in enumerate(ladder)}
+    passing = sorted(idx[n] for n in visited.loc[visited["meets"], "n"])
+    seen = sorted(idx[n] for n in visited["n"])
+    if not passing:
+        top = seen[-1]
+        if top == len(ladder) - 1:
+            return None, "not met within n_range"
+        return ladder[min(top + CLIMB, len(ladder) - 1)], ""
+    best = passing[0]
+    below = [i for i in seen if i < best]
+    if not below:
+        return None, "met at the lowest visited rung" if best > 0 else "met at n_range's low end"
+    gap = best - below[-1]
+    if gap <= 1:
+        return None, "met: bracketed by neighbouring rungs"
+    return ladder[below[-1] + gap // 2], ""
+
+
+def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None, base_seed: int) -> pd.DataFrame:
+    """The plan after ``plan`` (None: round 0) given the runs it made: every earlier row, and a row
+    per candidate still searching; ``done`` on every row when no candidate searches on."""
+    k = 0 if plan is None else int(plan["round"].max()) + 1
+    rows = [] if plan is None else plan.drop(columns="done").to_dict("records")
+    table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=["candidate", "n", "meets"])
+    first, _ = seeds(scene, scene.candidates[0], base_seed)
+    added = False
+    for ci, cand in enumerate(scene.candidates):
+        visited = table[table["candidate"] == ci] if len(table) else table
+        n, _why = _next_rung(scene, cand, visited)
+        if n is None:
+            continue
+        lo, hi = seeds(scene, cand, base_seed)
+        rows.append({"candidate": ci, "label": cand.label, "n": int(n), "first": lo, "last": hi, "round": k})
+        added = True
+    out = pd.DataFrame(rows, columns=PLAN_COLUMNS[:-1])
+    out["done"] = not added
+    return out
+
+
+def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
+    """Each candidate's reason to have stopped."""
+    return {ci: _next_rung(scene, cand, table[table["candidate"] == ci])[1] for ci, cand in enumerate(scene.candidates)}
+
+
+def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
+    """The scene's table: every visited (candidate, n) with its error, interval, counted cost, measured
+    core-seconds and COMIC at the common points; ``recommended`` on the cheapest row that meets the
+    target (at most one row), ``comic_best`` on the lowest COMIC_points of each candidate's passing
+    or, if none passes, highest visited resolution; ``stopped`` says why each candidate stopped."""
+    out = table.copy()
+    out["scene"] = scene.name
+    reasons = stop_reasons(scene, table)
+    out["stopped"] = [reasons[c] for c in out["candidate"]]
+    out["recommended"] = False
+    meets = out[out["meets"]]
+    if len(meets):
+        # per candidate its smallest passing rung; across candidates the cheapest of those
+        firsts = meets.sort_values("n").groupby("candidate", sort=False).head(1)
+        out.loc[firsts["cost_s"].idxmin(), "recommended"] = True
+    out["comic_best"] = False
+    scored = out[np.isfinite(out["COMIC_points"])]
+    if len(scored):
+        out.loc[scored["COMIC_points"].idxmin(), "comic_best"] = True
+    out["target"] = scene.value
+    out["measure"] = scene.measure
+    out["peclet"] = scene.peclet
+    return out.reset_index(drop=True)
+
+
+def run_path(scene: Scene, candidate: Candidate, n: int, first: int, last: int) -> str:
+    """The table of a candidate's runs at resolution n, seeds first..last (SCENE_RUN_PATTERN)."""
+    from dataclasses import replace
+
+    case = replace(candidate.case, n=int(n))
+    return SCENE_RUN_PATTERN.format(
+        scene_id=scene.identity(candidate), kind="runs", first=first, last=last, **case.wildcards()
+    )
+
+
+def plan_paths(scene: Scene, plan: pd.DataFrame) -> list[str]:
+    """The run tables of every row of a plan, in its order."""
+    return [
+        run_path(scene, scene.candidates[int(r.candidate)], r.n, int(r.first), int(r.last)) for r in plan.itertuples()
+    ]
+
+
+def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
+    """One row per run of a plan (``paths`` in its order): the last step's measures, the run's work
+    and its measured core-seconds (the sum of its steps' wall time)."""
+    keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_min", "dV", "work"]
+    rows = []
+    for r, path in zip(plan.itertuples(), paths):
+        table = pd.read_parquet(path)
+        for seed, g in table.groupby("seed", sort=True):
+            last = g.loc[g["step"].idxmax()]
+            rows.append(
+                {
+                    "candidate": int(r.candidate),
+                    "n": int(r.n),
+                    "seed": int(seed),
+                    **{k: float(last[k]) for k in keep},
+                    "steps": float(last["step"]),
+                    "core_s": float(g["wall_s"].sum()),
+                }
+            )
+    return pd.DataFrame(rows)

@@ -1,0 +1,237 @@
+"""The exact solution of 1-D advection-dispersion with uniform v and D from a point, Gaussian or box
+source: the reference that SSE, COMIC, H_C and the dilution index of a scene are measured against.
+
+A point source at x0 spreads into the Gaussian of variance 2 D t centred at x0 + v t (the paper's
+Eq. 2 carried by v); a Gaussian source of standard deviation sd into the Gaussian of variance
+sd^2 + 2 D t; a box of uniform concentration on [a, b] into
+
+    c(x, t) = [erf((x - a - v t) / s) - erf((x - b - v t) / s)] / (2 (b - a)),   s = sqrt(4 D t).
+
+The differential entropy H_I = -integral c ln c dx of a Gaussian is ln sqrt(2 pi e variance)
+(Eq. 14); the box's has no closed form for t > 0 and is computed by Gauss-Legendre quadrature of
+the exact density (``box_entropy``), ln(b - a) at t = 0. The dilution index is E = exp(H_I) (Eq. 8
+with dV = 1). Every quantity is unit mass: the source carries mass 1.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import measures as M
+
+SOURCE_KINDS = ("point", "gaussian", "box")
+_GL_NODES = 16  # Gauss-Legendre nodes per panel of box_entropy
+_TAIL_WIDTHS = 12.0  # box_entropy integrates to 12 s beyond each edge: erfc(12) ~ 1e-64
+
+
+@dataclass(frozen=True)
+class Source:
+    """The initial condition of a scene, unit mass: a point at x0, a Gaussian (mean x0, standard
+    deviation sd) or a box of uniform concentration on [a, b] [L]."""
+
+    kind: str = "point"
+    x0: float = 0.0
+    sd: float = 0.0
+    a: float = 0.0
+    b: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in SOURCE_KINDS:
+            raise ValueError(f"source kind {self.kind!r}: one of {', '.join(SOURCE_KINDS)}")
+        if self.kind == "gaussian" and not (self.sd > 0 and math.isfinite(self.sd)):
+            raise ValueError(f"a Gaussian source needs sd > 0 and finite, got {self.sd!r}")
+        if self.kind == "box" and not (self.b > self.a and math.isfinite(self.b - self.a)):
+            raise ValueError(f"a box source needs a < b, both finite, got [{self.a!r}, {self.b!r}]")
+
+    @property
+    def centre(self) -> float:
+        """The source's centre of mass [L]."""
+        return 0.5 * (self.a + self.b) if self.kind == "box" else self.x0
+
+    @property
+    def variance(self) -> float:
+        """The source's own variance: 0, sd^2 or (b - a)^2 / 12 [L^2]."""
+        if self.kind == "gaussian":
+            return self.sd * self.sd
+        if self.kind == "box":
+            return (self.b - self.a) ** 2 / 12.0
+        return 0.0
+
+    @property
+    def half_width(self) -> float:
+        """Half the source's extent where it holds all but ~1e-9 of its mass: 0, 6 sd, (b - a) / 2 [L]."""
+        return {"point": 0.0, "gaussian": 6.0 * self.sd, "box": 0.5 * (self.b - self.a)}[self.kind]
+
+    def positions(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """n particle positions drawn from the source (random walkers' starting points) [L]."""
+        if self.kind == "gaussian":
+            return self.x0 + self.sd * rng.standard_normal(n)
+        if self.kind == "box":
+            return rng.uniform(self.a, self.b, n)
+        return np.full(n, float(self.x0))
+
+    def masses(self, x: np.ndarray, dV: float) -> np.ndarray:
+        """Unit mass spread over particles or nodes at ``x`` with spacing dV: the point on
+        the one nearest x0, the Gaussian and box by their density (a box narrower than dV on the
+        one nearest its centre), normalised to sum 1."""
+        x = np.asarray(x, dtype=np.float64)
+        if self.kind == "gaussian":
+            z = (x - self.x0) / self.sd
+            m = np.exp(-0.5 * z * z)
+        elif self.kind == "box":
+            m = np.clip(np.minimum(x + 0.5 * dV, self.b) - np.maximum(x - 0.5 * dV, self.a), 0.0, None)
+        else:
+            m = np.zeros_like(x)
+        if not m.sum() > 0:  # a point, or a source narrower than the spacing
+            m = np.zeros_like(x)
+            m[np.argmin(np.abs(x - self.centre))] = 1.0
+        return m / m.sum()
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The exact concentration of ``source`` after time t under uniform velocity v and dispersion D."""
+
+    source: Source
+    D: float
+    v: float
+    t: float
+
+    @property
+    def shift(self) -> float:
+        """How far the plume has been carried, v t [L]."""
+        return self.v * self.t
+
+    @property
+    def spread(self) -> float:
+        """The variance added by dispersion, 2 D t [L^2]."""
+        return 2.0 * self.D * max(self.t, 0.0)
+
+    @property
+    def variance(self) -> float:
+        """The plume's variance: the source's plus 2 D t [L^2]."""
+        return self.source.variance + self.spread
+
+    @property
+    def centre(self) -> float:
+        """The plume's centre of mass, the source's plus v t [L]."""
+        return self.source.centre + self.shift
+
+    def density(self, x: np.ndarray) -> np.ndarray:
+        """c(x, t) [1/L] (a point source at t = 0 has none: ValueError)."""
+        x = np.asarray(x, dtype=np.float64)
+        s = self.source
+        if s.kind == "box":
+            if self.spread == 0.0:
+                return np.where((x >= s.a + self.shift) & (x <= s.b + self.shift), 1.0 / (s.b - s.a), 0.0)
+            from scipy.special import erf
+
+            w = math.sqrt(2.0 * self.spread)  # sqrt(4 D t)
+            lo, hi = (x - s.a - self.shift) / w, (x - s.b - self.shift) / w
+            return 0.5 * (erf(lo) - erf(hi)) / (s.b - s.a)
+        var = self.variance
+        if not var > 0:
+            raise ValueError("a point source has no density at t = 0 (a delta)")
+        if s.kind == "point":  # the paper's Gaussian (Eq. 2), moved: its very bits at x0 = v = 0
+            return M.gaussian_density(x - self.centre, self.D, self.t)
+        z = x - self.centre
+        return np.exp(-0.5 * z * z / var) / math.sqrt(2.0 * math.pi * var)
+
+    def entropy(self) -> float:
+        """H_I = -integral c ln c dx [nats, dV = 1] (Eq. 14 for a Gaussian; -inf for a point at t = 0)."""
+        s = self.source
+        if s.kind == "box":
+            return box_entropy(s.b - s.a, self.D * max(self.t, 0.0))
+        if s.kind == "point":
+            return M.analytic_h_i(self.D, self.t)
+        var = self.variance
+        return 0.5 * math.log(2.0 * math.pi * math.e * var) if var > 0 else -math.inf
+
+    def dilution(self) -> float:
+        """E = exp(H_I) (Eq. 8) [L]."""
+        if self.source.kind == "point":
+            return M.analytic_dilution(self.D, self.t)
+        h = self.entropy()
+        return math.exp(h) if h > -math.inf else 0.0
+
+    def h_c(self, dV: float) -> float:
+        """H_C = H_I - ln dV (Eqs. 6-7)."""
+        return self.entropy() - math.log(dV)
+
+    def sampled(self, x: np.ndarray, dV: float) -> np.ndarray:
+        """c sampled at sorted ``x`` and scaled to sum c dV = 1, as analytic_sampled does for the
+        paper's Gaussian; where the plume is narrower than the sampling (no sample sees it), all
+        its mass goes on the sample nearest its centre."""
+        x = np.asarray(x, dtype=np.float64)
+        if self.source.kind == "point":
+            return M.analytic_sampled(x - self.centre, self.D, self.t, dV)
+        if self.variance > 0:
+            if self.source.kind == "box":
+                g = self.density(x)
+            else:  # in log space: a plume narrower than the spacing keeps its peak
+                z = x - self.centre
+                logg = -0.5 * z * z / self.variance
+                g = np.exp(logg - logg.max())
+            if g.sum() > 0:
+                return g / (g.sum() * dV)
+        g = np.zeros_like(x)
+        g[np.argmin(np.abs(x - self.centre))] = 1.0
+        return g / dV
+
+    def points(self, length: float | None = None) -> np.ndarray:
+        """The measurement points common to every model (measures.measurement_points: 15 points on
+        [-L/2, L/2], L the paper's fd_length or ``length``, a scene's window), carried with the
+        plume by x0 + v t: sensors that follow the plume, so that a scene measures it where it is [L]."""
+        points = M.measurement_points() if length is None else M.measurement_points(length)
+        move = self.source.x0 + self.shift if self.source.kind != "box" else self.centre
+        return points if move == 0.0 else points + move
+
+    def sse_points(self, points: np.ndarray, x: np.ndarray, c: np.ndarray, dV: float) -> float:
+        """SSE at ``points`` of the model concentration c at sorted x against c(points, t), as
+        measures.sse_points (whose very bits a point source at rest gets); where the plume has no
+        density (a point at t = 0), against its delta on the model point nearest the centre."""
+        if self.source.kind == "point":
+            move = self.centre
+            if move == 0.0:
+                return M.sse_points(points, x, c, self.D, self.t, dV)
+            return M.sse_points(points - move, x - move, c, self.D, self.t, dV)
+        return M.sse(M.at_points(points, x, c), self.density(points))
+
+    def extent(self, widths: float = 6.0) -> tuple[float, float]:
+        """[lo, hi] around the plume: the source's extent carried by v t plus ``widths`` standard
+        deviations of the dispersion 2 D t [L]."""
+        reach = self.source.half_width + widths * math.sqrt(self.spread)
+        return self.centre - reach, self.centre + reach
+
+
+@functools.lru_cache(maxsize=256)
+def box_entropy(width: float, dt: float) -> float:
+    """H_I of a unit-mass box of ``width`` after dispersion D t = ``dt`` [nats]; ln(width) for dt = 0.
+
+    By symmetry only x >= the centre is summed. Farther than 12 s (s = sqrt(4 D t)) inside the
+    edge c is 1 / width to 1e-64, a term known exactly; from there to 12 s beyond the edge,
+    composite Gauss-Legendre quadrature of -c ln c on panels a quarter of s wide."""
+    if not width > 0:
+        raise ValueError(f"box width must be > 0, got {width!r}")
+    if dt <= 0:
+        return math.log(width)
+    from scipy.special import erf
+
+    s = math.sqrt(4.0 * dt)
+    half = 0.5 * width
+    start = max(0.0, half - _TAIL_WIDTHS * s)
+    flat = start * math.log(width) / width  # -c ln c = ln(width) / width on [0, start]
+    end = half + _TAIL_WIDTHS * s
+    panels = math.ceil(4.0 * (end - start) / s)
+    nodes, weights = np.polynomial.legendre.leggauss(_GL_NODES)
+    edges = np.linspace(start, end, panels + 1)
+    mid, rad = 0.5 * (edges[1:] + edges[:-1]), 0.5 * (edges[1:] - edges[:-1])
+    x = (mid[:, None] + rad[:, None] * nodes[None, :]).ravel()
+    w = (rad[:, None] * weights[None, :]).ravel()
+    c = 0.5 * (erf((x + half) / s) - erf((x - half) / s)) / width
+    safe = np.where(c > 0, c, 1.0)
+    return float(2.0 * (flat + np.dot(w, -c * np.log(safe))))

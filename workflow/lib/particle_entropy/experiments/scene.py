@@ -1,0 +1,258 @@
+"""A scene (config `scenes.<name>`, declared by settings.SCENE): a problem of the user's own (D, a
+uniform v, a source, the observation time, the domains) with the candidate models to compare and the
+accuracy they must reach. A scene knows each candidate's runs: their settings, their identity and
+the ladder of resolutions its search may visit (analysis/scene_search.py)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+from ..core.case import Case, SettingError
+from ..core.reference import Reference, Source
+from ..core.runconfig import ADVECTION_SCHEMES, RunConfig
+from ..core.settings import BY_KEY, PAPER, SCENE, defaults
+
+LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
+_DEFAULTS = defaults(SCENE)
+_TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
+
+
+def _key(name: str, key: str) -> str:
+    return f"scenes.{name}.{key}"
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One model a scene compares: a case without N, its resolution range, and FD's advection scheme
+    and time step."""
+
+    case: Case
+    n_lo: int
+    n_hi: int
+    advection: str = "upwind"
+    fd_dt: float = PAPER["fd_dt"]
+
+    @property
+    def label(self) -> str:
+        """The candidate's name in tables and legends."""
+        c = self.case
+        if c.method == "fd":
+            return f"fd {c.kernel} {self.advection} dt={self.fd_dt:g}"
+        words = [c.method, c.kernel]
+        if c.method == "mtpt":
+            words.append(f"eta={c.eta:g}")
+            if c.truncation is not None:
+                words.append(f"cut={c.truncation:g}")
+            if c.scheme != "symmetric":
+                words.append(c.scheme)
+        return " ".join(words)
+
+    def ladder(self) -> list[int]:
+        """The resolutions the search may visit: n_lo, n_lo r, n_lo r^2, ... up to n_hi (r = LADDER_RATIO,
+        rounded; FD: even numbers of intervals), each once."""
+        steps = max(1, math.ceil(math.log(self.n_hi / self.n_lo) / math.log(LADDER_RATIO) - 1e-9))
+        out = []
+        for k in range(steps + 1):
+            n = self.n_lo * (self.n_hi / self.n_lo) ** (k / steps)
+            n = 2 * round(n / 2) if self.case.method == "fd" else round(n)
+            if not out or n > out[-1]:
+                out.append(int(n))
+        return out
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A scene's physics, target and candidates (defaults: settings.SCENE)."""
+
+    name: str
+    D: float
+    v: float
+    t_final: float
+    source: Source
+    omega: float
+    fd_length: float
+    measure: str
+    value: float
+    realisations: int
+    candidates: tuple[Candidate, ...]
+    cost: tuple = ()  # ((method, (seconds a step, seconds a unit of work)), ...)
+
+    def cost_s(self, method: str, steps: float, work: float) -> float:
+        """A run's counted cost: steps and work times the scene's unit costs [s]."""
+        per_step, per_work = dict(self.cost)[method]
+        return per_step * steps + per_work * work
+
+    @property
+    def reference(self) -> Reference:
+        """The exact solution at the observation time."""
+        return Reference(self.source, self.D, self.v, self.t_final)
+
+    @property
+    def peclet(self) -> float:
+        """v L / D with L the FD window: how far advection outruns dispersion over the scene [-]."""
+        return abs(self.v) * self.fd_length / self.D
+
+    def settings(self, candidate: Candidate) -> dict:
+        """The run settings of a candidate's runs (RunConfig's fields besides case and seed)."""
+        out = {
+            "D": self.D,
+            "t_final": self.t_final,
+            "omega": self.omega,
+            "fd_length": self.fd_length,
+            "source": {k: v for k, v in vars(self.source).items()},
+            "v": self.v,
+        }
+        if candidate.case.method == "fd":
+            out["dt0"] = candidate.fd_dt
+            if self.v != 0.0:
+                out["advection"] = candidate.advection
+        return out
+
+    def identity(self, candidate: Candidate) -> str:
+        """What a run's file is keyed by besides its case and seeds: a digest of its settings, so that
+        two scenes share a run only when their physics (and FD's scheme and step) are equal."""
+        text = json.dumps(self.settings(candidate), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+    def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
+        """The checked run of a candidate at resolution n."""
+        settings = self.settings(candidate)
+        settings["source"] = self.source
+        return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
+
+    @classmethod
+    def from_config(cls, name: str, spec: Mapping, case_defaults: Mapping | None = None) -> Scene:
+        """The scene at config key scenes.<name>; SettingError naming the key path of a bad value."""
+        spec = dict(spec)
+        get = {k: spec.get(k, _DEFAULTS.get(k)) for k in ("D", "v", "t_final", "margin", "realisations")}
+        for key in ("D", "t_final", "margin"):
+            s = BY_KEY[f"scenes.<name>.{key}"]
+            value = get[key]
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            if not ok or (value <= s.low if s.open_low else value < s.low) or value > s.high:
+                raise SettingError(_key(name, key), value, s.allowed())
+        v = get["v"]
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
+            raise SettingError(_key(name, "v"), v, "a finite number [L/T]")
+        r = get["realisations"]
+        s = BY_KEY["scenes.<name>.realisations"]
+        if not (isinstance(r, int) and not isinstance(r, bool) and s.low <= r <= s.high):
+            raise SettingError(_key(name, "realisations"), r, s.allowed())
+        source = _source(name, spec.get("source", _DEFAULTS["source"]))
+        D, t_final, margin = float(get["D"]), float(get["t_final"]), float(get["margin"])
+        span = 2.0 * (source.half_width + margin * math.sqrt(2.0 * D * t_final))
+        omega = _length(name, "omega", spec.get("omega", span))
+        fd_length = _length(name, "fd_length", spec.get("fd_length", span))
+        target = {**_TARGET, **dict(spec.get("target") or {})}
+        if target.get("measure") not in BY_KEY["scenes.<name>.target.measure"].choices:
+            raise SettingError(_key(name, "target.measure"), target.get("measure"), "one of rmse, entropy, dilution")
+        value = target.get("value")
+        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < math.inf):
+            raise SettingError(_key(name, "target.value"), value, "a number > 0")
+        raw = spec.get("candidates")
+        if not isinstance(raw, list) or not raw:
+            raise SettingError(_key(name, "candidates"), raw, "a list of at least one model")
+        cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(raw))
+        labels = [c.label for c in cands]
+        if len(set(labels)) < len(labels):
+            raise SettingError(_key(name, "candidates"), labels, "models that differ (each once)")
+        cost = _cost(name, spec.get("cost"))
+        scene = cls(
+            name, D, float(v), t_final, source, omega, fd_length, target["measure"], float(value), r, cands, cost
+        )
+        for i, c in enumerate(cands):  # every candidate's runs must fit their domains
+            try:
+                scene.run_config(c, c.n_lo)
+            except SettingError as e:
+                raise SettingError(
+                    _key(name, f"candidates[{i}].{e.name}" if e.name in _CAND_KEYS else e.name), e.value, e.allowed
+                ) from None
+        return scene
+
+
+_CAND_KEYS = ("eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0")
+
+
+def _cost(name: str, spec) -> tuple:
+    out = dict(_DEFAULTS["cost"])
+    if spec is not None:
+        if not isinstance(spec, Mapping) or set(spec) - set(out):
+            raise SettingError(_key(name, "cost"), spec, BY_KEY["scenes.<name>.cost"].allowed())
+        out.update(spec)
+    for method, pair in out.items():
+        ok = isinstance(pair, (list, tuple)) and len(pair) == 2
+        ok = ok and all(isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x < math.inf for x in pair)
+        if not ok:
+            raise SettingError(_key(name, f"cost.{method}"), pair, "[seconds a step, seconds a unit of work], >= 0")
+    return tuple((m, (float(a), float(b))) for m, (a, b) in sorted(out.items()))
+
+
+def _length(name: str, key: str, value) -> float:
+    if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < math.inf):
+        raise SettingError(_key(name, key), value, "a number > 0 [L]")
+    return float(value)
+
+
+def _source(name: str, spec) -> Source:
+    if not isinstance(spec, Mapping):
+        raise SettingError(_key(name, "source"), spec, BY_KEY["scenes.<name>.source"].allowed())
+    spec = dict(spec)
+    kind = spec.get("kind")
+    needs = {"point": ("x0",), "gaussian": ("x0", "sd"), "box": ("a", "b")}
+    if kind not in needs:
+        raise SettingError(_key(name, "source.kind"), kind, "one of point, gaussian, box")
+    extra = set(spec) - {"kind", *needs[kind]}
+    if extra:
+        raise SettingError(
+            _key(name, f"source.{sorted(extra)[0]}"), spec[sorted(extra)[0]], f"not a key of a {kind} source"
+        )
+    values = {}
+    for key in needs[kind]:
+        value = spec.get(key, 0.0 if key == "x0" else None)
+        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)):
+            raise SettingError(_key(name, f"source.{key}"), value, "a finite number [L]")
+        values[key] = float(value)
+    try:
+        return Source(kind, **values)
+    except ValueError as e:
+        bad = "sd" if kind == "gaussian" else "b"
+        raise SettingError(_key(name, f"source.{bad}"), values.get(bad), str(e)) from None
+
+
+def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
+    where = f"candidates[{i}]"
+    if not isinstance(spec, Mapping):
+        raise SettingError(_key(name, where), spec, "a model: method, kernel, n_range and its dimensions")
+    spec = dict(spec)
+    n_range = spec.pop("n_range", None)
+    advection = spec.pop("advection", "upwind")
+    fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
+    ok = (
+        isinstance(n_range, list)
+        and len(n_range) == 2
+        and all(isinstance(n, int) and not isinstance(n, bool) for n in n_range)
+        and 2 <= n_range[0] < n_range[1]
+    )
+    if not ok:
+        raise SettingError(_key(name, f"{where}.n_range"), n_range, "[low, high], integers with 2 <= low < high")
+    if advection not in ADVECTION_SCHEMES:
+        raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
+    if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
+        raise SettingError(_key(name, f"{where}.fd_dt"), fd_dt, "a number > 0 [T]")
+    try:
+        case = Case.from_spec(spec, None, case_defaults)
+    except SettingError as e:
+        raise SettingError(_key(name, f"{where}.{e.name}"), e.value, e.allowed) from None
+    if case.method != "fd" and ("advection" in spec or fd_dt != PAPER["fd_dt"]):
+        raise SettingError(_key(name, f"{where}.advection"), advection, "fd candidates only")
+    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt))
+
+
+def scenes(config: Mapping) -> dict[str, Scene]:
+    """Every scene of a config, checked, by name."""
+    defaults_ = config.get("case_defaults", {})
+    return {name: Scene.from_config(name, spec, defaults_) for name, spec in (config.get("scenes") or {}).items()}

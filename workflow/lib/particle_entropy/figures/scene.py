@@ -1,0 +1,119 @@
+"""figures/scene_<name>.png: one scene's answer, drawn from its table (analysis/scene_search.py).
+
+(a) the error at t_final against the counted cost for every candidate (each visited resolution a
+point with its 95 % interval), the target as a line, the recommended candidate and resolution
+starred; (b) COMIC at the common measurement points against resolution for every candidate, the
+COMIC-best ringed. Unscored runs (negative concentrations) are drawn hollow and named below.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .style import AUTO_COLOURS, AUTO_MARKERS, BLACK, new_figure, style_axes
+
+MEASURE_LABEL = {
+    "rmse": "concentration RMSE at the points [1/L]",
+    "entropy": r"$|H_C - H_C^{exact}|$ [nats]",
+    "dilution": r"$|E / E^{exact} - 1|$",
+}
+
+
+def scene(table: pd.DataFrame):
+    """The figure of one scene's table."""
+    fig, (ax, bx) = new_figure(2, width=5.4, height=4.2)
+    name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
+    labels = list(dict.fromkeys(table["label"]))
+    for i, label in enumerate(labels):
+        rows = table[table["label"] == label].sort_values("n")
+        colour, marker = AUTO_COLOURS[i % len(AUTO_COLOURS)], AUTO_MARKERS[i % len(AUTO_MARKERS)]
+        scored = rows["unscored"] == ""
+        err = np.vstack([rows["error_mean"] - rows["error_lo"], rows["error_hi"] - rows["error_mean"]])
+        ax.errorbar(
+            rows["cost_s"],
+            rows["error_mean"],
+            yerr=np.clip(err, 0, None),
+            color=colour,
+            marker=marker,
+            ms=5,
+            lw=1.2,
+            capsize=2,
+            label=label,
+            mfc=colour,
+        )
+        if (~scored).any():
+            ax.plot(
+                rows.loc[~scored, "cost_s"],
+                rows.loc[~scored, "error_mean"],
+                ls="none",
+                marker=marker,
+                ms=9,
+                mfc="white",
+                mec=colour,
+            )
+        bx.plot(
+            rows.loc[scored, "n"],
+            rows.loc[scored, "COMIC_points"],
+            color=colour,
+            marker=marker,
+            ms=5,
+            lw=1.2,
+            label=label,
+        )
+    ax.axhline(target, color=BLACK, ls="--", lw=1.0, label=f"target {target:g}")
+    best = table[table["recommended"]]
+    if len(best):
+        r = best.iloc[0]
+        ax.plot(
+            [r["cost_s"]],
+            [r["error_mean"]],
+            marker="*",
+            ms=16,
+            color=BLACK,
+            ls="none",
+            label=f"cheapest meeting it: {r['label']}, n = {r['n']:,}",
+        )
+    comic = table[table["comic_best"]]
+    if len(comic):
+        r = comic.iloc[0]
+        bx.plot(
+            [r["n"]],
+            [r["COMIC_points"]],
+            marker="o",
+            ms=14,
+            mfc="none",
+            mec=BLACK,
+            ls="none",
+            label=f"COMIC-best: {r['label']}, n = {r['n']:,}",
+        )
+    style_axes(
+        ax, "a", f"scene {name}: error against cost", MEASURE_LABEL[measure], "counted cost of one run [s]", logx=True
+    )
+    ax.set_yscale("log")
+    style_axes(
+        bx,
+        "b",
+        "COMIC at the common measurement points",
+        "COMIC (Eq. 43) at the points",
+        "resolution n (particles; FD intervals)",
+        logx=True,
+    )
+    ax.legend(fontsize=7, loc="best")
+    bx.legend(fontsize=7, loc="best")
+    notes = sorted({f"{lab}: {why}" for lab, why in zip(table["label"], table["unscored"]) if why})
+    if not len(best):
+        closest = table[table["unscored"] == ""].sort_values("error_upper95").head(1)
+        if len(closest):
+            c = closest.iloc[0]
+            notes.insert(
+                0,
+                f"No candidate meets the target; closest: {c['label']} at n = {c['n']:,} "
+                f"(upper 95 % bound {c['error_upper95']:.3g})",
+            )
+    if notes:
+        text = "\n".join(notes[:4])
+        fig.text(0.01, 0.005, text, fontsize=8, ha="left", va="bottom", color="0.2")
+        bottom = 0.045 * (1 + text.count("\n"))  # room for the notes; rect is (left, bottom, width, height)
+        fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))
+    return fig

@@ -1,0 +1,93 @@
+# Scenes (config `scenes`, experiments/scene.py): for each, the cheapest candidate model that
+# reaches the stated accuracy, and the COMIC-best (analysis/scene_search.py). Each round of a scene's
+# search is a checkpoint whose plan names the runs to make next; every run is an ordinary job.
+# Their own target: `snakemake -j2 scenes`.
+
+
+rule simulate_scene:
+    input:
+        kernels=ancient(KERNELS),
+    output:
+        SCENE_RUN_PATTERN,
+    log:
+        f"logs/scenes/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.log",
+    benchmark:
+        f"results/benchmarks/simulate_scene/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
+    wildcard_constraints:
+        scene_id=r"[0-9a-f]{12}",
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        settings=lambda w: SCENE_SETTINGS[w.scene_id],
+        code=lambda w: SIM_CODE[w.method],
+    script:
+        "../scripts/simulate.py"
+
+
+checkpoint scene_round:
+    input:
+        unpack(scene_round_inputs),
+    output:
+        "results/scenes/{name}/round~{k}.parquet",
+    log:
+        "logs/scenes/{name}/round~{k}.log",
+    wildcard_constraints:
+        name=r"[A-Za-z0-9_]+",
+        k=r"\d+",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        spec=lambda w: config["scenes"][w.name],
+        case_defaults=config.get("case_defaults", {}),
+        base_seed=config["base_seed"],
+        code=SCENE_ROUND_CODE,
+    script:
+        "../scripts/scene_round.py"
+
+
+rule scene_table:
+    input:
+        unpack(scene_final_inputs),
+    output:
+        "results/scenes/{name}.parquet",
+    log:
+        "logs/scenes/{name}.log",
+    wildcard_constraints:
+        name=r"[A-Za-z0-9_]+",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        spec=lambda w: config["scenes"][w.name],
+        case_defaults=config.get("case_defaults", {}),
+        code=SCENE_TABLE_CODE,
+    script:
+        "../scripts/scene_table.py"
+
+
+rule plot_scene:
+    input:
+        "results/scenes/{name}.parquet",
+    output:
+        png=report("figures/scene_{name}.png", caption="../report/scene.rst", category=FIGURE["scene"].category),
+        pdf="figures/scene_{name}.pdf",
+    log:
+        "logs/plot/scene_{name}.log",
+    wildcard_constraints:
+        name=r"[A-Za-z0-9_]+",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    resources:
+        mem_mb=1000,
+    params:
+        code=SCENE_PLOT_CODE,
+    script:
+        "../scripts/plot_scene.py"
+
+
+# Every configured scene: `snakemake -j2 scenes` (not part of the default target).
+rule scenes:
+    input:
+        expand("figures/scene_{name}.png", name=SCENES),
