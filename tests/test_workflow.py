@@ -945,3 +945,66 @@ def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_r
     proc = run_snakemake(tiny_run, configfile=TINY)
     assert f"corrupt table results/{run.relative_to(tiny_run / 'results')}" in proc.stderr
     assert pd.read_parquet(run).shape[0] > 0 and (run.parent / (run.name + ".corrupt")).exists()
+
+
+SCENE_CONFIG = ROOT / "tests" / "data" / "scene_config.yaml"
+
+
+def _scene_overlay(tmp_path, name: str, **changes) -> Path:
+    """tests/data/scene_config.yaml with the scene `carried` changed, written to tmp_path / name."""
+    cfg = yaml.safe_load(SCENE_CONFIG.read_text())
+    for key, value in changes.items():
+        node = cfg["scenes"]["carried"]
+        *path, last = key.split(".")
+        for part in path:
+            node = node[part]
+        node[last] = value
+    out = tmp_path / name
+    out.write_text(yaml.safe_dump(cfg))
+    return out
+
+
+def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
+    from particle_entropy.analysis.scene_search import plan_paths
+    from particle_entropy.experiments.scene import Scene
+
+    work = tmp_path / "scenes"
+    run_snakemake(work, "scenes", "--configfile", TINY, SCENE_CONFIG)
+    table = pd.read_parquet(work / "results/scenes/carried.parquet")
+    assert table["recommended"].sum() == 1 and table["comic_best"].sum() == 1
+    best = table[table["recommended"]].iloc[0]
+    assert best["meets"] and best["unscored"] == "" and best["error_upper95"] <= 0.02
+    coarse = table[(table["label"].str.contains("central")) & (table["n"] == 16)].iloc[0]
+    assert coarse["unscored"].startswith("negative concentrations: grid Peclet") and coarse["unscored"].endswith("> 2")
+    assert not coarse["meets"] and np.isnan(coarse["COMIC_points"])
+    for label, rows in table.groupby("label"):  # each candidate bracketed or stopped at its range's top
+        assert rows["stopped"].iloc[0] in ("met: bracketed by neighbouring rungs", "not met within n_range"), label
+    assert (work / "figures/scene_carried.png").stat().st_size > 5000
+    plans = sorted((work / "results/scenes/carried").glob("round~*.parquet"), key=lambda p: int(p.stem.split("~")[1]))
+    last = pd.read_parquet(plans[-1])
+    assert last["done"].all() and len(plans) >= 3
+    spec = yaml.safe_load(SCENE_CONFIG.read_text())["scenes"]["carried"]
+    scene = Scene.from_config("carried", spec, yaml.safe_load(TINY.read_text()).get("case_defaults"))
+    assert all((work / p).exists() for p in plan_paths(scene, last))  # every run an ordinary table
+    # a new target reruns no simulation; a new velocity reruns the scene's runs
+    target = _scene_overlay(tmp_path, "target.yaml", **{"target.value": 0.05})
+    proc = run_snakemake(work, "scenes", "-n", "--configfile", TINY, target)
+    planned = _planned_rules(proc) | set(re.findall(r"^\s*(?:local)?checkpoint (\w+):", proc.stdout, flags=re.M))
+    assert "simulate_scene" not in planned and "scene_round" in planned
+    before = {p.name for p in (work / "results/scenes").iterdir() if p.is_dir() and p.name != "carried"}
+    faster = _scene_overlay(tmp_path, "v.yaml", v=0.02)
+    proc = run_snakemake(work, "scenes", "--configfile", TINY, faster)
+    after = {p.name for p in (work / "results/scenes").iterdir() if p.is_dir() and p.name != "carried"}
+    assert len(after - before) == 3 and before <= after  # FD upwind, FD central, particles: new identities
+    assert "simulate_scene" in _planned_rules(proc)
+
+
+def test_a_bad_scene_value_is_refused_before_any_job_naming_its_key(tmp_path):
+    bad = _scene_overlay(tmp_path, "bad.yaml", **{"source": {"kind": "gaussian", "x0": 0.0, "sd": -1.0}})
+    proc = run_snakemake(tmp_path / "w", "scenes", "-n", "--configfile", TINY, bad, check=False)
+    assert proc.returncode != 0
+    assert "scenes.carried.source.sd" in proc.stdout + proc.stderr
+    wide = _scene_overlay(tmp_path, "wide.yaml", omega=0.5, source={"kind": "box", "a": -1.0, "b": 1.0})
+    proc = run_snakemake(tmp_path / "w2", "scenes", "-n", "--configfile", TINY, wide, check=False)
+    assert proc.returncode != 0 and "scenes.carried.omega" in proc.stdout + proc.stderr
+    assert not (tmp_path / "w2" / "results").exists()

@@ -228,6 +228,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     if not isinstance(spec, Mapping):
         raise SettingError(_key(name, where), spec, "a model: method, kernel, n_range and its dimensions")
     spec = dict(spec)
+    fd_only = [k for k in ("advection", "fd_dt") if k in spec]
     n_range = spec.pop("n_range", None)
     advection = spec.pop("advection", "upwind")
     fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
@@ -247,8 +248,11 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         case = Case.from_spec(spec, None, case_defaults)
     except SettingError as e:
         raise SettingError(_key(name, f"{where}.{e.name}"), e.value, e.allowed) from None
-    if case.method != "fd" and ("advection" in spec or fd_dt != PAPER["fd_dt"]):
-        raise SettingError(_key(name, f"{where}.advection"), advection, "fd candidates only")
+    if case.method != "fd" and fd_only:
+        key = fd_only[0]
+        raise SettingError(
+            _key(name, f"{where}.{key}"), advection if key == "advection" else fd_dt, "fd candidates only"
+        )
     return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt))
 
 

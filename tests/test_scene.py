@@ -1,0 +1,99 @@
+"""A scene from config (experiments/scene.py): defaults, domains, identity, ladders and refusals."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from particle_entropy.core.case import SettingError
+from particle_entropy.experiments.scene import Scene, scenes
+
+FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 1000]}
+MTPT = {"method": "mtpt", "kernel": "collision", "n_range": [30, 3000]}
+
+
+def spec(**over):
+    out = {"v": 0.01, "t_final": 50.0, "target": {"value": 0.02}, "candidates": [FD, MTPT]}
+    out.update(over)
+    return out
+
+
+def test_defaults_and_domains_from_the_margin():
+    scene = Scene.from_config("s", spec(source={"kind": "box", "a": -0.5, "b": 0.5}))
+    spread = math.sqrt(2 * 1e-3 * 50.0)
+    assert scene.omega == pytest.approx(2 * (0.5 + 6 * spread))  # the box's half width + 6 sd either side
+    assert scene.fd_length == scene.omega
+    assert (scene.D, scene.measure, scene.realisations) == (1e-3, "rmse", 8)
+    cfg = scene.run_config(scene.candidates[0], 100)
+    lo, length = cfg.fd_span()
+    assert length == pytest.approx(scene.fd_length + 0.01 * 50.0)  # the window plus the path v t
+    assert lo == pytest.approx(-scene.fd_length / 2)
+    assert scene.peclet == pytest.approx(0.01 * scene.fd_length / 1e-3)
+
+
+def test_identity_is_the_physics_only():
+    base = Scene.from_config("a", spec())
+    other_target = Scene.from_config("b", spec(target={"value": 1e-4, "measure": "entropy"}))
+    other_v = Scene.from_config("c", spec(v=0.02))
+    fd, mtpt = base.candidates
+    assert base.identity(fd) == other_target.identity(other_target.candidates[0])  # a shared run
+    assert base.identity(fd) != other_v.identity(other_v.candidates[0])
+    assert base.identity(fd) != base.identity(mtpt)  # FD's step is part of its runs
+    central = Scene.from_config("d", spec(candidates=[{**FD, "advection": "central"}]))
+    assert central.identity(central.candidates[0]) != base.identity(fd)
+
+
+def test_ladders_rise_by_about_two_and_fd_takes_even_grids():
+    fd, mtpt = Scene.from_config("s", spec()).candidates
+    assert fd.ladder()[0] == 16 and fd.ladder()[-1] == 1000 and all(n % 2 == 0 for n in fd.ladder())
+    assert mtpt.ladder()[0] == 30 and mtpt.ladder()[-1] == 3000
+    for ladder in (fd.ladder(), mtpt.ladder()):
+        ratios = [b / a for a, b in zip(ladder, ladder[1:])]
+        assert all(1.6 < r <= 2.05 for r in ratios), ratios
+
+
+@pytest.mark.parametrize(
+    "over, key",
+    [
+        ({"v": math.inf}, "scenes.s.v"),
+        ({"D": 0.0}, "scenes.s.D"),
+        ({"t_final": -1.0}, "scenes.s.t_final"),
+        ({"realisations": 1}, "scenes.s.realisations"),
+        ({"source": {"kind": "gaussian", "x0": 0.0, "sd": 0.0}}, "scenes.s.source.sd"),
+        ({"source": {"kind": "box", "a": 1.0, "b": 1.0}}, "scenes.s.source.b"),
+        ({"source": {"kind": "line"}}, "scenes.s.source.kind"),
+        ({"source": {"kind": "point", "sd": 1.0}}, "scenes.s.source.sd"),
+        ({"target": {"value": 0.0}}, "scenes.s.target.value"),
+        ({"target": {"value": 1.0, "measure": "mae"}}, "scenes.s.target.measure"),
+        ({"candidates": []}, "scenes.s.candidates"),
+        ({"candidates": [{**FD, "n_range": [5, 5]}]}, "scenes.s.candidates[0].n_range"),
+        ({"candidates": [MTPT, {**MTPT, "advection": "upwind"}]}, "scenes.s.candidates[1].advection"),
+        ({"candidates": [{**FD, "advection": "lax"}]}, "scenes.s.candidates[0].advection"),
+        ({"candidates": [{**MTPT, "eta": 2.0}]}, "scenes.s.candidates[0].eta"),
+        ({"candidates": [FD, FD]}, "scenes.s.candidates"),
+        ({"omega": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.omega"),
+        ({"fd_length": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.fd_length"),
+        ({"cost": {"fd": [1.0]}}, "scenes.s.cost.fd"),
+    ],
+)
+def test_a_bad_value_is_refused_naming_its_key_path(over, key):
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("s", spec(**over))
+    assert err.value.name == key
+
+
+def test_a_plume_carried_100_windows_fits_the_fd_grid_and_moves_the_particles():
+    """v large enough for the plume to travel 100 window lengths: the grid holds the path."""
+    scene = Scene.from_config("far", spec(v=100 * 1.0 / 50.0, fd_length=1.0, omega=1.0, t_final=50.0))
+    cfg = scene.run_config(scene.candidates[0], 1000)
+    lo, length = cfg.fd_span()
+    assert length == pytest.approx(1.0 + 100.0) and lo == pytest.approx(-0.5)
+    assert scene.reference.centre == pytest.approx(100.0)
+    assert cfg.points(50.0).min() > 99.5  # the sensors moved with the plume
+
+
+def test_every_scene_of_a_config():
+    got = scenes({"scenes": {"one": spec(), "two": spec(v=0.0)}})
+    assert list(got) == ["one", "two"] and got["two"].v == 0.0
+    assert scenes({}) == {}

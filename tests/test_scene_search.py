@@ -1,0 +1,135 @@
+"""The cheapest-model search of a scene (analysis/scene_search.py) on synthetic runs whose errors are
+known: the path, the answer, the confidence bound and the recommendation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from particle_entropy.analysis import scene_search as S
+from particle_entropy.experiments.scene import Scene
+
+FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 4096]}
+MTPT = {"method": "mtpt", "kernel": "collision", "n_range": [32, 8192]}
+
+
+def _scene(value=0.01, candidates=(FD, MTPT)):
+    return Scene.from_config(
+        "s", {"v": 0.01, "t_final": 50.0, "target": {"value": value}, "candidates": list(candidates)}
+    )
+
+
+def _runs(plan: pd.DataFrame, law, negative=lambda ci, n: False) -> pd.DataFrame:
+    """The runs a plan would make, each with RMSE law(candidate, n, seed) (SSE_points = 15 rmse^2)."""
+    rows = []
+    for r in plan.itertuples():
+        for seed in range(int(r.first), int(r.last) + 1):
+            e = law(r.candidate, r.n, seed)
+            rows.append(
+                {
+                    "candidate": r.candidate,
+                    "n": r.n,
+                    "seed": seed,
+                    "SSE_points": 15 * e * e,
+                    "COMIC_points": math.log(e),
+                    "H_C": 0.0,
+                    "H_C_analytic": 0.0,
+                    "E": 1.0,
+                    "E_analytic": 1.0,
+                    "mass_min": -0.1 if negative(r.candidate, r.n) else 0.0,
+                    "dV": 0.1,
+                    "work": 100.0 * r.n,
+                    "steps": 100.0,
+                    "core_s": 0.01,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def _search(scene, law, negative=lambda ci, n: False):
+    """Every round until done -> (final plan, judged table, rounds)."""
+    plan = S.next_plan(scene, None, None, base_seed=0)
+    rounds = 1
+    while not plan["done"].all():
+        plan = S.next_plan(scene, plan, _runs(plan, law, negative), base_seed=0)
+        rounds += 1
+        assert rounds < 50
+    return plan, S.judged(scene, _runs(plan, law, negative)), rounds
+
+
+def test_the_search_finds_the_smallest_passing_rung_without_visiting_the_ladder():
+    scene = _scene(value=0.01)
+    law = lambda ci, n, seed: 1.0 / n  # noqa: E731  deterministic: passes from n >= 100
+    plan, table, rounds = _search(scene, law)
+    for ci, cand in enumerate(scene.candidates):
+        ladder = cand.ladder()
+        answer = min(n for n in ladder if 1.0 / n <= 0.01)
+        mine = table[(table["candidate"] == ci) & table["meets"]]["n"].min()
+        assert mine == answer
+        below = max(n for n in ladder if n < answer)
+        assert below in set(table[table["candidate"] == ci]["n"])  # bracketed by the rung below
+        assert len(table[table["candidate"] == ci]) < len(ladder)  # not a sweep
+    assert rounds <= 6
+
+
+def test_the_path_depends_on_the_errors_only():
+    scene = _scene(value=0.01)
+    law = lambda ci, n, seed: 1.0 / n * (1 + 0.05 * math.sin(seed + n))  # noqa: E731
+    a = _search(scene, law)[0]
+    b = _search(scene, law)[0]
+    assert a.equals(b)
+
+
+def test_the_upper_bound_is_students_one_sided_95_percent():
+    errors = np.array([1.0, 2.0, 3.0])  # mean 2, sd 1, t_0.95 with 2 degrees of freedom = 2.919986 (tables)
+    assert S.upper_bound(errors) == pytest.approx(2.0 + 2.919986 / math.sqrt(3), rel=1e-6)
+    assert S.upper_bound(np.array([0.5])) == 0.5  # FD: one deterministic run
+
+
+def test_noise_keeps_a_rung_from_passing_until_its_bound_does():
+    """Mean error below the target but the 95 % bound above it: not met."""
+    scene = _scene(value=0.01, candidates=(MTPT,))
+    noisy = lambda ci, n, seed: 0.009 + (0.004 if seed % 2 else -0.004) if n < 1000 else 0.001  # noqa: E731
+    _, table, _ = _search(scene, noisy)
+    low = table[table["n"] < 1000]
+    assert (low["error_mean"] < 0.01).all() and not low["meets"].any()
+    assert table[table["meets"]]["n"].min() >= 1000
+
+
+def test_the_recommendation_is_the_cheapest_first_passing_rung_and_unscored_runs_never_win():
+    scene = _scene(value=0.01)
+    law = lambda ci, n, seed: 1.0 / n  # noqa: E731
+    negative = lambda ci, n: ci == 0  # noqa: E731  every FD run has negative concentrations
+    _, table, _ = _search(scene, law, negative)
+    out = S.result(scene, table)
+    assert out["recommended"].sum() == 1
+    best = out[out["recommended"]].iloc[0]
+    assert best["method"] == "mtpt"
+    assert (out[out["candidate"] == 0]["unscored"].str.startswith("negative concentrations: grid Peclet")).all()
+    assert not out[out["candidate"] == 0]["meets"].any()
+    assert out[out["comic_best"]].iloc[0]["method"] == "mtpt"
+    assert out.loc[out["candidate"] == 0, "stopped"].iloc[0] == "not met within n_range"
+
+
+def test_the_cheaper_candidate_is_recommended_by_counted_cost():
+    scene = _scene(value=0.01)
+    law = lambda ci, n, seed: 1.0 / n  # noqa: E731
+    _, table, _ = _search(scene, law)
+    out = S.result(scene, table)
+    firsts = out[out["meets"]].sort_values("n").groupby("candidate").head(1)
+    cheapest = firsts.loc[firsts["cost_s"].idxmin()]
+    assert out[out["recommended"]].index.tolist() == [cheapest.name]
+    fd = scene.cost_s("fd", 100.0, 100.0 * 100)
+    assert fd == pytest.approx(3.5e-5 * 100 + 1.5e-8 * 1e4)  # the shipped cost model: a step, a unit of work
+
+
+def test_nothing_recommended_when_no_candidate_meets_the_target():
+    scene = _scene(value=1e-9)
+    _, table, _ = _search(scene, lambda ci, n, seed: 1.0 / n)
+    out = S.result(scene, table)
+    assert not out["recommended"].any()
+    assert set(out["stopped"]) == {"not met within n_range"}
+    assert out.groupby("candidate")["n"].max().tolist() == [c.n_hi for c in scene.candidates]
