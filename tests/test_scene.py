@@ -94,6 +94,24 @@ def test_a_plume_carried_100_windows_fits_the_fd_grid_and_moves_the_particles():
 
 
 def test_every_scene_of_a_config():
-    got = scenes({"scenes": {"one": spec(), "two": spec(v=0.0)}})
-    assert list(got) == ["one", "two"] and got["two"].v == 0.0
-    assert scenes({}) == {}
+    got = scenes({"scenes": {"one": spec(), "two": spec(v=0.0), "bad": spec(v=math.nan)}})
+    assert list(got) == ["one", "two", "bad"] and got["two"].v == 0.0
+    fd = got["one"].candidates[0]
+    assert got.settings(got["one"].identity(fd)) == got["one"].settings(fd)
+    with pytest.raises(SettingError, match="scenes.bad.v"):  # checked when used
+        got["bad"]
+    assert len(scenes({})) == 0
+
+
+def test_check_config_refuses_a_bad_scene_and_accepts_the_shipped_ones():
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import check_config, load_yaml
+
+    config = dict(load_yaml(ROOT / "config.yaml"))
+    check_config(config)  # the shipped scenes are valid
+    assert set(config["scenes"]) == {"paper", "carried", "spill", "narrow"}
+    config["scenes"] = {**config["scenes"], "carried": {**config["scenes"]["carried"], "margin": 0.5}}
+    with pytest.raises(SettingError) as err:
+        check_config(config)
+    assert err.value.name == "scenes.carried.margin"

@@ -58,10 +58,9 @@ if AVAILABLE is not None:
 # The adaptive COMIC searches (workflow/rules/optimum.smk), by name; each is checked when a
 # requested target first needs it, so a config layered over config.yaml's searches runs.
 OPTIMUM = optimum_searches(config, AVAILABLE)
-# The scenes (workflow/rules/scenes.smk), by name, every one checked here, before any job; the run
-# settings of each candidate by its identity (a digest of its physics: scenes share equal runs).
+# The scenes (workflow/rules/scenes.smk), by name, each checked when a requested target first needs
+# it; their runs are keyed by a digest of their physics (scenes share equal runs: SCENES.settings).
 SCENES = scenes(config)
-SCENE_SETTINGS = {sc.identity(c): sc.settings(c) for sc in SCENES.values() for c in sc.candidates}
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):
@@ -298,6 +297,7 @@ def scene_round_inputs(wildcards):
 
     if wildcards.name not in SCENES:
         raise WorkflowError(f"no scene {wildcards.name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
+    SCENES[wildcards.name]  # builds and checks the scene before its first job
     k = int(wildcards.k)
     if k == 0:
         return {}

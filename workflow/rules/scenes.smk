@@ -18,7 +18,7 @@ rule simulate_scene:
     conda:
         "../../envs/particle-entropy.yaml"
     params:
-        settings=lambda w: SCENE_SETTINGS[w.scene_id],
+        settings=lambda w: SCENES.settings(w.scene_id),
         code=lambda w: SIM_CODE[w.method],
     script:
         "../scripts/simulate.py"

@@ -160,12 +160,17 @@ def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
 def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     """The scene's table: every visited (candidate, n) with its error, interval, counted cost, measured
     core-seconds and COMIC at the common points; ``recommended`` on the cheapest row that meets the
-    target (at most one row), ``comic_best`` on the lowest COMIC_points of each candidate's passing
+    target (at most one row), ``n_below`` the highest failing rung visited below each row (the answer
+    of a passing row lies in (n_below, n]), ``comic_best`` on the lowest COMIC_points of each candidate's passing
     or, if none passes, highest visited resolution; ``stopped`` says why each candidate stopped."""
     out = table.copy()
     out["scene"] = scene.name
     reasons = stop_reasons(scene, table)
     out["stopped"] = [reasons[c] for c in out["candidate"]]
+    out["n_below"] = [
+        out[(out["candidate"] == c) & (out["n"] < n) & ~out["meets"]]["n"].max()
+        for c, n in zip(out["candidate"], out["n"])
+    ]  # the highest visited rung below that fails: the answer lies in (n_below, n]
     out["recommended"] = False
     meets = out[out["meets"]]
     if len(meets):

@@ -33,7 +33,7 @@ class Candidate:
     case: Case
     n_lo: int
     n_hi: int
-    advection: str = "upwind"
+    advection: str = "upwind"  # "none" in a scene without flow
     fd_dt: float = PAPER["fd_dt"]
 
     @property
@@ -41,7 +41,8 @@ class Candidate:
         """The candidate's name in tables and legends."""
         c = self.case
         if c.method == "fd":
-            return f"fd {c.kernel} {self.advection} dt={self.fd_dt:g}"
+            scheme = "" if self.advection == "none" else f" {self.advection}"
+            return f"fd {c.kernel}{scheme} dt={self.fd_dt:g}"
         words = [c.method, c.kernel]
         if c.method == "mtpt":
             words.append(f"eta={c.eta:g}")
@@ -160,6 +161,8 @@ class Scene:
         labels = [c.label for c in cands]
         if len(set(labels)) < len(labels):
             raise SettingError(_key(name, "candidates"), labels, "models that differ (each once)")
+        if v == 0:  # nothing to advect: FD's scheme is no part of the runs
+            cands = tuple(replace(c, advection="none") for c in cands)
         cost = _cost(name, spec.get("cost"))
         scene = cls(
             name, D, float(v), t_final, source, omega, fd_length, target["measure"], float(value), r, cands, cost
@@ -256,7 +259,36 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt))
 
 
-def scenes(config: Mapping) -> dict[str, Scene]:
-    """Every scene of a config, checked, by name."""
-    defaults_ = config.get("case_defaults", {})
-    return {name: Scene.from_config(name, spec, defaults_) for name, spec in (config.get("scenes") or {}).items()}
+class Scenes(Mapping):
+    """The scenes of config `scenes` by name, each built and checked when a requested target first
+    needs it (as the optimum searches are), so that a run that draws no scene is never blocked by
+    one; a bad value is still refused before any of its jobs, naming its key path."""
+
+    def __init__(self, config: Mapping):
+        self._specs = dict(config.get("scenes") or {})
+        self._defaults = config.get("case_defaults", {})
+        self._built: dict[str, Scene] = {}
+
+    def __getitem__(self, name: str) -> Scene:
+        if name not in self._built:
+            self._built[name] = Scene.from_config(name, self._specs[name], self._defaults)
+        return self._built[name]
+
+    def __iter__(self):
+        return iter(self._specs)
+
+    def __len__(self) -> int:
+        return len(self._specs)
+
+    def settings(self, identity: str) -> dict:
+        """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
+        for scene in self.values():
+            for candidate in scene.candidates:
+                if scene.identity(candidate) == identity:
+                    return scene.settings(candidate)
+        raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+
+
+def scenes(config: Mapping) -> Scenes:
+    """Every scene of a config by name, each checked when first used (Scenes)."""
+    return Scenes(config)

@@ -196,8 +196,9 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
 def check_config(config: Mapping, schema: Mapping | None = None, available: float | None = None) -> None:
     """Everything a dry run checks: the schema, then every rule between fields (crosschecks.check_sweeps),
     with ``available`` bytes (the machine's, for the check-config command) that every job fits
-    (crosschecks.check_memory), and every adaptive search, which a dry run checks only when a target
-    needs it."""
+    (crosschecks.check_memory), and every adaptive search and scene, which a dry run checks only when
+    a target needs it."""
+    from ..experiments.scene import scenes
     from .crosschecks import check_memory, check_optimum, check_sweeps
 
     check_schema(config, load_schema() if schema is None else schema)
@@ -205,3 +206,6 @@ def check_config(config: Mapping, schema: Mapping | None = None, available: floa
     if available is not None:
         check_memory(config, available)
     check_optimum(config, available)
+    every = scenes(config)
+    for name in every:  # builds and checks each scene
+        every[name]
