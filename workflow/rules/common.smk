@@ -45,8 +45,7 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
-from particle_entropy.experiments.scene import scenes
-from particle_entropy.analysis.scene_search import SCENE_RUN_PATTERN
+from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 

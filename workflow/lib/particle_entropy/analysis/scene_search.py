@@ -20,10 +20,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..core.case import CASE_DIR
-from ..experiments.scene import Candidate, Scene
+from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 
-SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 MAX_ROUNDS = 40  # a search's rounds at most: a ladder has at most ~40 rungs (ratio 2)
 CLIMB = 2  # rungs climbed a round while no rung passes
 PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]

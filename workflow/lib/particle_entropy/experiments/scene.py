@@ -11,11 +11,12 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
-from ..core.case import Case, SettingError
+from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
 from ..core.runconfig import ADVECTION_SCHEMES, RunConfig
 from ..core.settings import BY_KEY, PAPER, SCENE, defaults
 
+SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
 _DEFAULTS = defaults(SCENE)
 _TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}

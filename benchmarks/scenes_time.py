@@ -1,0 +1,53 @@
+"""How long `snakemake -j2 scenes` takes, and what each scene answers (the README's scene table).
+
+    python benchmarks/scenes_time.py WORKDIR        # runs the scenes in WORKDIR (a finished paper run or empty)
+
+Runs `snakemake -j2 scenes` with this checkout's Snakefile in WORKDIR (config.yaml of this
+checkout unless WORKDIR has its own), times it, and prints per scene its Peclet number, the
+recommendation with its interval of resolutions and counted cost, the COMIC-best, and the
+simulation jobs it ran with their summed seconds (Snakemake's benchmark files).
+"""
+
+from __future__ import annotations
+
+import csv
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main(workdir: Path) -> None:
+    workdir.mkdir(parents=True, exist_ok=True)
+    if not (workdir / "config.yaml").exists():
+        shutil.copy(ROOT / "config.yaml", workdir / "config.yaml")
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir), "-j2", "scenes"]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        sys.exit(proc.stderr[-3000:])
+    bench = list((workdir / "results/benchmarks/simulate_scene").rglob("*.tsv"))
+    seconds = sum(float(next(csv.DictReader(p.open(), delimiter="\t"))["s"]) for p in bench)
+    print(f"snakemake -j2 scenes: {wall:.1f} s wall; {len(bench)} simulation jobs on record, {seconds:.1f} job-s")
+    for table in sorted((workdir / "results/scenes").glob("*.parquet")):
+        t = pd.read_parquet(table)
+        best, comic = t[t["recommended"]], t[t["comic_best"]]
+        head = f"{table.stem}: Peclet {t['peclet'].iloc[0]:,.0f}, {t['measure'].iloc[0]} <= {t['target'].iloc[0]:g}"
+        if len(best):
+            r = best.iloc[0]
+            answer = f"{r['label']}, n in ({r['n_below']:g}, {r['n']}], {r['cost_s']:.3g} s a run"
+        else:
+            answer = "none meets it"
+        c = comic.iloc[0] if len(comic) else None
+        tail = f"; COMIC-best {c['label']}, n = {c['n']}" if c is not None else ""
+        print(f"  {head}: {answer}{tail}")
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("scenes_run"))
