@@ -19,6 +19,9 @@ from pathlib import Path
 
 import pandas as pd
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow" / "lib"))
+from particle_entropy.analysis.scene_search import crossover  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -37,6 +40,10 @@ def main(workdir: Path) -> None:
     print(f"snakemake -j2 scenes: {wall:.1f} s wall; {len(bench)} simulation jobs on record, {seconds:.1f} job-s")
     for table in sorted((workdir / "results/scenes").glob("*.parquet")):
         t = pd.read_parquet(table)
+        if table.stem == "peclet":  # the sweep's table (scene_search.peclet_table)
+            cross = crossover(t)
+            print(f"  Peclet sweep: particles overtake the grid at Pe in {cross}" if cross else "  no crossover")
+            continue
         best, comic = t[t["recommended"]], t[t["comic_best"]]
         head = f"{table.stem}: Peclet {t['peclet'].iloc[0]:,.0f}, {t['measure'].iloc[0]} <= {t['target'].iloc[0]:g}"
         if len(best):

@@ -115,3 +115,24 @@ def test_check_config_refuses_a_bad_scene_and_accepts_the_shipped_ones():
     with pytest.raises(SettingError) as err:
         check_config(config)
     assert err.value.name == "scenes.carried.margin"
+
+
+def test_the_peclet_sweep_makes_one_scene_a_velocity():
+    base = spec()
+    del base["v"]
+    got = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01, 0.1]}})
+    assert list(got) == ["peclet_0", "peclet_1", "peclet_2"]
+    assert [got[n].v for n in got] == [0.0, 0.01, 0.1]
+    assert got["peclet_2"].peclet == pytest.approx(0.1 * got["peclet_2"].fd_length / 1e-3)
+    for bad, key in (
+        ({"base": spec(), "v": [0.0, 1.0]}, "scenes_peclet.base.v"),
+        ({"base": base, "v": [1.0, 0.5]}, "scenes_peclet.v"),
+    ):
+        with pytest.raises(SettingError) as err:
+            scenes({"scenes_peclet": bad})
+        assert err.value.name == key
+
+
+def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
+    at_rest = Scene.from_config("s", spec(v=0.0, candidates=[FD, {**FD, "advection": "central"}, MTPT]))
+    assert [c.label for c in at_rest.candidates] == ["fd implicit dt=0.05", "mtpt collision eta=1"]

@@ -133,3 +133,43 @@ def test_nothing_recommended_when_no_candidate_meets_the_target():
     assert not out["recommended"].any()
     assert set(out["stopped"]) == {"not met within n_range"}
     assert out.groupby("candidate")["n"].max().tolist() == [c.n_hi for c in scene.candidates]
+
+
+def _answer(scene: str, peclet: float, fd_cost: float | None, particle_cost: float | None) -> pd.DataFrame:
+    """A scene table holding one FD and one PT candidate, each meeting at n = 200 (below it 100) or never."""
+    rows = []
+    for ci, (method, label, cost) in enumerate(
+        [("fd", "fd implicit upwind dt=1", fd_cost), ("pt", "pt adaptive", particle_cost)]
+    ):
+        for n, meets in ((100, False), (200, cost is not None)):
+            rows.append(
+                {
+                    "scene": scene,
+                    "peclet": peclet,
+                    "candidate": ci,
+                    "method": method,
+                    "label": label,
+                    "n": n,
+                    "meets": meets,
+                    "cost_s": (cost or 1.0) * n / 200,
+                    "n_below": 100.0 if n == 200 else np.nan,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def test_the_peclet_table_and_its_crossover():
+    tables = [
+        _answer("peclet_0", 0.0, 0.01, 0.5),
+        _answer("peclet_1", 50.0, 0.1, 0.4),
+        _answer("peclet_2", 500.0, 1.0, 0.3),  # particles cheaper from here
+        _answer("peclet_3", 5000.0, None, 0.3),  # the grid never meets it
+    ]
+    table = S.peclet_table(tables)
+    grid = table[table["family"] == S.FAMILIES["fd"]].set_index("peclet")
+    assert (
+        grid.loc[0.0, "cost_s"] == 0.01 and grid.loc[0.0, "cost_lo"] == 0.005 and np.isnan(grid.loc[5000.0, "cost_s"])
+    )
+    assert table.drop_duplicates("peclet")["particles_cheaper"].tolist() == [False, False, True, True]
+    assert S.crossover(table) == (50.0, 500.0)
+    assert S.crossover(S.peclet_table(tables[:2])) is None  # the grid wins throughout

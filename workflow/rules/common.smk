@@ -45,7 +45,7 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
-from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, scenes
+from particle_entropy.experiments.scene import PECLET_PREFIX, SCENE_RUN_PATTERN, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 
@@ -368,4 +368,6 @@ OPTIMUM_TABLE_CODE = code_version("analysis.optimum", "core.io", files=[SCRIPTS 
 OPTIMUM_PLOT_CODE = code_version("figures.optimum", "core.io", files=[SCRIPTS / "plot_optimum.py"])
 SCENE_ROUND_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_round.py"])
 SCENE_TABLE_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_table.py"])
-SCENE_PLOT_CODE = code_version("figures.scene", "core.io", files=[SCRIPTS / "plot_scene.py"])
+SCENE_PLOT_CODE = code_version(
+    "figures.scene", "analysis.scene_search", "core.io", files=[SCRIPTS / "plot_scene.py", SCRIPTS / "plot_scenes_peclet.py"]
+)

@@ -38,7 +38,7 @@ checkpoint scene_round:
     conda:
         "../../envs/particle-entropy.yaml"
     params:
-        spec=lambda w: config["scenes"][w.name],
+        spec=lambda w: SCENES.spec(w.name),
         case_defaults=config.get("case_defaults", {}),
         base_seed=config["base_seed"],
         code=SCENE_ROUND_CODE,
@@ -59,7 +59,7 @@ rule scene_table:
     conda:
         "../../envs/particle-entropy.yaml"
     params:
-        spec=lambda w: config["scenes"][w.name],
+        spec=lambda w: SCENES.spec(w.name),
         case_defaults=config.get("case_defaults", {}),
         code=SCENE_TABLE_CODE,
     script:
@@ -87,7 +87,31 @@ rule plot_scene:
         "../scripts/plot_scene.py"
 
 
+# Where particles overtake grids: the Peclet sweep's scenes side by side (config `scenes_peclet`).
+rule plot_scenes_peclet:
+    input:
+        [f"results/scenes/{name}.parquet" for name in SCENES if name.startswith(PECLET_PREFIX)],
+    output:
+        png=report(
+            "figures/scenes_peclet.png", caption="../report/scenes_peclet.rst", category=FIGURE["scene"].category
+        ),
+        pdf="figures/scenes_peclet.pdf",
+        data="results/scenes/peclet.parquet",
+    log:
+        "logs/plot/scenes_peclet.log",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    resources:
+        mem_mb=1000,
+    params:
+        code=SCENE_PLOT_CODE,
+    script:
+        "../scripts/plot_scenes_peclet.py"
+
+
 # Every configured scene: `snakemake -j2 scenes` (not part of the default target).
 rule scenes:
     input:
         expand("figures/scene_{name}.png", name=SCENES),
+        ["figures/scenes_peclet.png"] if config.get("scenes_peclet") else [],

@@ -222,3 +222,47 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+FAMILIES = {"fd": "grid (best FD)", "pt": "particles (best PT or MTPT)", "mtpt": "particles (best PT or MTPT)"}
+
+
+def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
+    """The Peclet sweep's answer: per scene and family (the grid: FD candidates; particles: PT and
+    MTPT), the cheapest candidate's smallest rung that meets the target, its counted cost and the
+    cost at the failing rung below it (the answer's cost lies in (cost_lo, cost_s]); NaN where
+    no candidate of the family meets it. ``particles_cheaper`` marks the scenes where particles win."""
+    rows = []
+    for t in tables:
+        peclet, name = float(t["peclet"].iloc[0]), str(t["scene"].iloc[0])
+        t = t.assign(family=t["method"].map(FAMILIES))
+        for family in dict.fromkeys(FAMILIES.values()):
+            meets = t[(t["family"] == family) & t["meets"]]
+            row = {"scene": name, "peclet": peclet, "family": family, "label": "", "n": np.nan, "cost_s": np.nan}
+            row["cost_lo"] = np.nan
+            if len(meets):
+                first = meets.sort_values("n").groupby("candidate").head(1)
+                best = first.loc[first["cost_s"].idxmin()]
+                below = t[(t["candidate"] == best["candidate"]) & (t["n"] == best["n_below"])]
+                row.update(label=best["label"], n=float(best["n"]), cost_s=float(best["cost_s"]))
+                row["cost_lo"] = float(below["cost_s"].iloc[0]) if len(below) else np.nan
+            rows.append(row)
+    out = pd.DataFrame(rows).sort_values(["peclet", "family"]).reset_index(drop=True)
+    wide = out.pivot(index="peclet", columns="family", values="cost_s")
+    grid, particles = wide.get(FAMILIES["fd"]), wide.get(FAMILIES["pt"])
+    cheaper = {
+        p: bool(np.isfinite(q) and (not np.isfinite(g) or q < g)) for p, g, q in zip(wide.index, grid, particles)
+    }
+    out["particles_cheaper"] = out["peclet"].map(cheaper)
+    return out
+
+
+def crossover(table: pd.DataFrame) -> tuple[float, float] | None:
+    """(Pe_lo, Pe_hi]: the particles first win at Pe_hi and did not at Pe_lo, the sweep's previous
+    point (the crossover's uncertainty: the sweep's spacing); None if they never win or always do."""
+    by = table.drop_duplicates("peclet").sort_values("peclet")
+    pe, win = by["peclet"].to_numpy(), by["particles_cheaper"].to_numpy()
+    for k in range(1, len(pe)):
+        if win[k] and not win[k - 1]:
+            return float(pe[k - 1]), float(pe[k])
+    return None

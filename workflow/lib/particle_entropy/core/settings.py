@@ -372,6 +372,8 @@ SECTION_DOCS = {
     "scenes.<name>": "One scene: D, v, a source, the observation time, the domains, the candidate models and "
     "the accuracy to reach.",
     "scenes.<name>.target": "The accuracy every candidate is held to at t_final.",
+    "scenes_peclet": "Where particles overtake grids: one scene (`base`) at each velocity of `v`, searched as "
+    "scenes peclet_0, peclet_1, ... and drawn as figures/scenes_peclet.png (its own target).",
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }
@@ -822,6 +824,30 @@ SCENE = (
 )
 
 
+SCENES_PECLET = (
+    Setting(
+        "base",
+        "scenes_peclet.base",
+        NO_DEFAULT,
+        "a scene without its v (the keys of scenes.<name>); each velocity of `v` makes one scene of it",
+        kind="shape",
+        shape={"type": "object"},
+        range_text="a scene (scenes.<name>) without v",
+        required=True,
+    ),
+    Setting(
+        "v",
+        "scenes_peclet.v",
+        NO_DEFAULT,
+        "the velocities, ascending; the Peclet number of each is v L / D (L: the base's FD window)",
+        "L/T",
+        kind="shape",
+        shape={"type": "array", "minItems": 2, "items": {"type": "number", "minimum": 0}},
+        range_text="at least two numbers >= 0, ascending",
+        required=True,
+    ),
+)
+
 DECLARED = (
     *SETTINGS,
     *SEEDS,
@@ -832,6 +858,7 @@ DECLARED = (
     *FIGURE_OPTIONS,
     *TRADEOFF,
     *SCENE,
+    *SCENES_PECLET,
     *MECHANISM,
     *SHEAR,
     *SEARCH,

@@ -162,8 +162,8 @@ class Scene:
         labels = [c.label for c in cands]
         if len(set(labels)) < len(labels):
             raise SettingError(_key(name, "candidates"), labels, "models that differ (each once)")
-        if v == 0:  # nothing to advect: FD's scheme is no part of the runs
-            cands = tuple(replace(c, advection="none") for c in cands)
+        if v == 0:  # nothing to advect: FD's scheme is no part of the runs (nor of its candidates: one each)
+            cands = tuple({replace(c, advection="none").label: replace(c, advection="none") for c in cands}.values())
         cost = _cost(name, spec.get("cost"))
         scene = cls(
             name, D, float(v), t_final, source, omega, fd_length, target["measure"], float(value), r, cands, cost
@@ -266,7 +266,7 @@ class Scenes(Mapping):
     one; a bad value is still refused before any of its jobs, naming its key path."""
 
     def __init__(self, config: Mapping):
-        self._specs = dict(config.get("scenes") or {})
+        self._specs = {**dict(config.get("scenes") or {}), **peclet_scenes(config)}
         self._defaults = config.get("case_defaults", {})
         self._built: dict[str, Scene] = {}
 
@@ -281,6 +281,10 @@ class Scenes(Mapping):
     def __len__(self) -> int:
         return len(self._specs)
 
+    def spec(self, name: str) -> dict:
+        """The config of scene ``name`` as written (a Peclet scene: its base with its v)."""
+        return self._specs[name]
+
     def settings(self, identity: str) -> dict:
         """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
         for scene in self.values():
@@ -288,6 +292,25 @@ class Scenes(Mapping):
                 if scene.identity(candidate) == identity:
                     return scene.settings(candidate)
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+
+
+PECLET_PREFIX = "peclet_"  # the scenes of the Peclet sweep: peclet_0, peclet_1, ...
+
+
+def peclet_scenes(config: Mapping) -> dict[str, dict]:
+    """The scenes of config `scenes_peclet`: its base at each velocity, named peclet_<k>; SettingError
+    naming the key when the velocities are not ascending numbers >= 0 or the base sets v."""
+    sweep = config.get("scenes_peclet")
+    if not sweep:
+        return {}
+    base, vs = dict(sweep.get("base") or {}), sweep.get("v")
+    if "v" in base:
+        raise SettingError("scenes_peclet.base.v", base["v"], "no v: the sweep sets it (scenes_peclet.v)")
+    ok = isinstance(vs, list) and len(vs) >= 2
+    ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < math.inf for v in vs)
+    if not ok or any(b <= a for a, b in zip(vs, vs[1:])):
+        raise SettingError("scenes_peclet.v", vs, "at least two numbers >= 0, ascending")
+    return {f"{PECLET_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
 
 
 def scenes(config: Mapping) -> Scenes:

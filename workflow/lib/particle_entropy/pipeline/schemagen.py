@@ -36,6 +36,7 @@ from ..core.settings import (
     REALISATIONS_DOC,
     REALISATIONS_ENTRY,
     SCENE,
+    SCENES_PECLET,
     SEARCH,
     SECTION_DOCS,
     SEEDS,
@@ -218,6 +219,7 @@ def blocks() -> dict[str, Block]:
     generated["shear"] = object_body("shear", SHEAR)
     generated["search"] = object_body("optimum.<name>", SEARCH)
     generated["scene"] = object_body("scenes.<name>", SCENE)
+    generated["scenes_peclet"] = object_body("scenes_peclet", SCENES_PECLET)
     generated["realisations_entry"] = Block(items=object_body("realisations[]", REALISATIONS_ENTRY))
     return generated
 
