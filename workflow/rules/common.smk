@@ -369,5 +369,8 @@ OPTIMUM_PLOT_CODE = code_version("figures.optimum", "core.io", files=[SCRIPTS / 
 SCENE_ROUND_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_round.py"])
 SCENE_TABLE_CODE = code_version("analysis.scene_search", "core.io", files=[SCRIPTS / "scene_table.py"])
 SCENE_PLOT_CODE = code_version(
-    "figures.scene", "analysis.scene_search", "core.io", files=[SCRIPTS / "plot_scene.py", SCRIPTS / "plot_scenes_peclet.py"]
+    "figures.scene",
+    "analysis.scene_search",
+    "core.io",
+    files=[SCRIPTS / "plot_scene.py", SCRIPTS / "plot_scenes_peclet.py"],
 )
