@@ -136,3 +136,15 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
 def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
     at_rest = Scene.from_config("s", spec(v=0.0, candidates=[FD, {**FD, "advection": "central"}, MTPT]))
     assert [c.label for c in at_rest.candidates] == ["fd implicit dt=0.05", "mtpt collision eta=1"]
+
+
+def test_a_scene_at_rest_measures_over_its_own_window_and_the_paper_over_its_own():
+    """A point at 0 with no flow is the paper's physics, but a scene's points span its FD window."""
+    from particle_entropy.core import measures as M
+
+    scene = Scene.from_config("s", spec(v=0.0))
+    cfg = scene.run_config(scene.candidates[1], 300)
+    assert cfg.at_rest and abs(cfg.points(50.0)).max() <= scene.fd_length / 2
+    paper = Scene.from_config("p", spec(v=0.0, fd_length=12.0, omega=10.0, t_final=1000.0))
+    pts = paper.run_config(paper.candidates[1], 300).points(1000.0)
+    assert pts.tobytes() == M.measurement_points().tobytes()  # the paper's window: the paper's points

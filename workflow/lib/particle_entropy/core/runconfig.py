@@ -70,6 +70,7 @@ class RunConfig:
     source: Source = PAPER_SOURCE
     v: float = 0.0
     advection: str = "upwind"
+    window: float | None = None  # the measurement points' window: None = the paper's (at rest) or fd_length
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
@@ -131,6 +132,8 @@ class RunConfig:
     def points(self, t: float) -> np.ndarray:
         """The measurement points at time t: the paper's 15 (measures.measurement_points), or a
         scene's over its FD window, carried with the plume (Reference.points) [L]."""
+        if self.window is not None:  # a scene's: its FD window, whatever its source and v
+            return self.reference(t).points(self.window)
         return self.reference(t).points(None if self.at_rest else self.fd_length)
 
     def fd_span(self) -> tuple[float, float]:

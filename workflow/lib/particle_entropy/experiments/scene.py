@@ -107,6 +107,7 @@ class Scene:
             "fd_length": self.fd_length,
             "source": {k: v for k, v in vars(self.source).items()},
             "v": self.v,
+            "window": self.fd_length,  # the measurement points span the FD window, at rest too
         }
         if candidate.case.method == "fd":
             out["dt0"] = candidate.fd_dt
