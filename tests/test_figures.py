@@ -14,7 +14,7 @@ from particle_entropy.figures import BY_NAME, CASE_FIGURES, FIGURES, PAPER_FIGUR
 def test_the_list_names_the_papers_figures_and_ours():
     names = [f.name for f in FIGURES]
     assert names[:10] == [f"fig{k}" for k in range(1, 11)]  # Figs. 1-10 of the paper
-    assert set(names[10:]) == {"tradeoff", "fig9_mechanism", "optimum", "scene"}  # ours
+    assert set(names[10:]) == {"tradeoff", "fig9_mechanism", "optimum", "scene", "scenes_peclet"}  # ours
     assert len(set(names)) == len(names) and set(BY_NAME) == set(names)
     assert PAPER_FIGURES == tuple(f"fig{k}" for k in range(1, 10))  # drawn from sections of cases
     assert set(CASE_FIGURES) == {*PAPER_FIGURES, "tradeoff"}

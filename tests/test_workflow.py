@@ -32,7 +32,9 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 # figures.FIGURES, the one list: the default target draws every figure but the mechanism figure
 # and the searches, which are their own targets (fig1 ... fig10 and tradeoff: test_settings holds the names)
-DEFAULT_FIGURES = [f.name for f in FIGURES if f.name not in ("fig9_mechanism", "optimum", "scene")]  # own targets
+DEFAULT_FIGURES = [
+    f.name for f in FIGURES if f.name not in ("fig9_mechanism", "optimum", "scene", "scenes_peclet")
+]  # own targets
 
 
 def load(path):

@@ -12,7 +12,7 @@ import pandas as pd
 
 from particle_entropy.analysis.scene_search import peclet_table
 from particle_entropy.core.io import write_parquet
-from particle_entropy.figures.scene import scenes_peclet
+from particle_entropy.figures.scenes_peclet import scenes_peclet
 from particle_entropy.figures.style import save_figure
 
 table = peclet_table([pd.read_parquet(p) for p in snakemake.input])

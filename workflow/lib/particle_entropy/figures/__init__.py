@@ -49,6 +49,7 @@ FIGURES = (
     Figure("fig9_mechanism", "mechanism", "mechanism", "Mechanism"),
     Figure("optimum", "optimum", "search", "Optimum search"),
     Figure("scene", "scenes", "scene", "Scenes"),
+    Figure("scenes_peclet", "scenes_peclet", "scene", "Scenes"),
 )
 BY_NAME = {f.name: f for f in FIGURES}
 PAPER_FIGURES = tuple(f.name for f in FIGURES if f.section.startswith("figures."))  # fig1 ... fig9

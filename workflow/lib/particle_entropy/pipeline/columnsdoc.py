@@ -272,6 +272,13 @@ FIGURE_CONTENTS = (
         "a: `cost_s` → `error_mean` with `error_lo`, `error_hi` per candidate, the `target`, the `recommended` row "
         "starred; b: `n` → `COMIC_points` per candidate, the `comic_best` row ringed",
     ),
+    (
+        "scenes_peclet",
+        "`results/scenes/peclet_<k>.parquet`, its source data `results/scenes/peclet.parquet`",
+        "one",
+        "`peclet` → `cost_s` per `family` (grid, particles), bars down to `cost_lo`; the crossover shaded where "
+        "`particles_cheaper` turns true",
+    ),
 )
 FIGURE_NOTES = "\n".join(
     [

@@ -1,0 +1,76 @@
+"""figures/scenes_peclet.png: where particles overtake grids, drawn from the Peclet sweep's table
+(analysis/scene_search.peclet_table): the counted cost of one run of the cheapest FD candidate and
+of the cheapest particle candidate that meet the target, against v L / D; bars from the cost of the
+failing resolution below each answer, hollow markers where a family never meets it, the crossover
+shaded over the sweep's spacing."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from ..analysis.scene_search import crossover
+from .style import AUTO_COLOURS, AUTO_MARKERS, new_figure, style_axes
+
+
+def scenes_peclet(table: pd.DataFrame):
+    """figures/scenes_peclet.png: the cost to reach the sweep's accuracy for the best grid and the
+    best particle model against the Peclet number, the crossover shaded (scene_search.peclet_table)."""
+    fig, (ax,) = new_figure(1, width=6.4, height=4.4)
+    pe = sorted(table["peclet"].unique())
+    positive = [p for p in pe if p > 0]
+    zero_at = min(positive) / 10 if positive else 1.0  # Pe = 0 drawn a decade left of the first
+    x_of = {p: (p if p > 0 else zero_at) for p in pe}
+    finite = table["cost_s"].dropna()
+    top = finite.max() * 3 if len(finite) else 1.0
+    for i, (family, rows) in enumerate(table.groupby("family", sort=False)):
+        colour, marker = AUTO_COLOURS[i], AUTO_MARKERS[i]
+        rows = rows.sort_values("peclet")
+        x = rows["peclet"].map(x_of)
+        met = rows["cost_s"].notna()
+        lo = (rows["cost_s"] - rows["cost_lo"]).where(rows["cost_lo"].notna(), 0.0)
+        ax.errorbar(
+            x[met],
+            rows.loc[met, "cost_s"],
+            yerr=[lo[met].clip(lower=0), 0 * lo[met]],
+            color=colour,
+            marker=marker,
+            ms=6,
+            lw=1.4,
+            capsize=2,
+            label=family,
+        )
+        if (~met).any():
+            ax.plot(
+                x[~met],
+                [top] * int((~met).sum()),
+                ls="none",
+                marker=marker,
+                ms=9,
+                mfc="white",
+                mec=colour,
+                label=f"{family}: not met within its range",
+            )
+    cross = crossover(table)
+    if cross is not None:
+        ax.axvspan(
+            x_of[cross[0]],
+            x_of[cross[1]],
+            color="0.88",
+            zorder=0,
+            label=f"particles overtake the grid: Pe in ({cross[0]:,.3g}, {cross[1]:,.3g}]",
+        )
+    style_axes(
+        ax,
+        None,
+        "Where particles overtake grids",
+        "counted cost of one run that meets the target [s]",
+        "Péclet number v L / D",
+        logx=True,
+        logy=True,
+        legend=None,
+    )
+    ticks = [x_of[p] for p in pe]
+    ax.set_xticks(ticks, [f"{p:,.3g}" for p in pe], rotation=30)
+    ax.minorticks_off()
+    ax.legend(fontsize=7, loc="best")
+    return fig
