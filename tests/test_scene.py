@@ -148,3 +148,16 @@ def test_a_scene_at_rest_measures_over_its_own_window_and_the_paper_over_its_own
     paper = Scene.from_config("p", spec(v=0.0, fd_length=12.0, omega=10.0, t_final=1000.0))
     pts = paper.run_config(paper.candidates[1], 300).points(1000.0)
     assert pts.tobytes() == M.measurement_points().tobytes()  # the paper's window: the paper's points
+
+
+def test_a_scene_whose_top_job_cannot_fit_in_memory_is_refused():
+    from particle_entropy.pipeline.crosschecks import check_scene_memory
+
+    scene = Scene.from_config("s", spec())
+    check_scene_memory(scene, available=24e9)  # fits
+    with pytest.raises(SettingError) as err:
+        check_scene_memory(scene, available=1e6)  # 1 MB: no job fits
+    assert err.value.name == "scenes.s.candidates[0].n_range" and "GB" in err.value.allowed
+    guarded = scenes({"scenes": {"s": spec()}}, check=lambda sc: check_scene_memory(sc, available=1e6))
+    with pytest.raises(SettingError, match="scenes.s.candidates"):
+        guarded["s"]

@@ -2,6 +2,7 @@
 import re
 import sys
 from pathlib import Path
+from functools import partial
 
 from snakemake.exceptions import WorkflowError
 from snakemake.io import regex_from_filepattern
@@ -44,7 +45,7 @@ from particle_entropy.pipeline.sweeps import (
     spec_ensembles,
 )
 
-from particle_entropy.pipeline.crosschecks import check_memory, check_sweeps, optimum_searches
+from particle_entropy.pipeline.crosschecks import check_memory, check_scene_memory, check_sweeps, optimum_searches
 from particle_entropy.experiments.scene import PECLET_PREFIX, SCENE_RUN_PATTERN, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
@@ -59,7 +60,7 @@ if AVAILABLE is not None:
 OPTIMUM = optimum_searches(config, AVAILABLE)
 # The scenes (workflow/rules/scenes.smk), by name, each checked when a requested target first needs
 # it; their runs are keyed by a digest of their physics (scenes share equal runs: SCENES.settings).
-SCENES = scenes(config)
+SCENES = scenes(config, None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE))
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):

@@ -266,14 +266,18 @@ class Scenes(Mapping):
     needs it (as the optimum searches are), so that a run that draws no scene is never blocked by
     one; a bad value is still refused before any of its jobs, naming its key path."""
 
-    def __init__(self, config: Mapping):
+    def __init__(self, config: Mapping, check=None):
         self._specs = {**dict(config.get("scenes") or {}), **peclet_scenes(config)}
         self._defaults = config.get("case_defaults", {})
+        self._check = check  # a further check of each built scene (the workflow's memory check)
         self._built: dict[str, Scene] = {}
 
     def __getitem__(self, name: str) -> Scene:
         if name not in self._built:
-            self._built[name] = Scene.from_config(name, self._specs[name], self._defaults)
+            scene = Scene.from_config(name, self._specs[name], self._defaults)
+            if self._check is not None:
+                self._check(scene)
+            self._built[name] = scene
         return self._built[name]
 
     def __iter__(self):
@@ -314,6 +318,7 @@ def peclet_scenes(config: Mapping) -> dict[str, dict]:
     return {f"{PECLET_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
 
 
-def scenes(config: Mapping) -> Scenes:
-    """Every scene of a config by name, each checked when first used (Scenes)."""
-    return Scenes(config)
+def scenes(config: Mapping, check=None) -> Scenes:
+    """Every scene of a config by name, each checked when first used (Scenes; ``check``: a further
+    check of each, given the Scene)."""
+    return Scenes(config, check)

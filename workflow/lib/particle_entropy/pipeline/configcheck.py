@@ -199,13 +199,13 @@ def check_config(config: Mapping, schema: Mapping | None = None, available: floa
     (crosschecks.check_memory), and every adaptive search and scene, which a dry run checks only when
     a target needs it."""
     from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_optimum, check_sweeps
+    from .crosschecks import check_memory, check_optimum, check_scene_memory, check_sweeps
 
     check_schema(config, load_schema() if schema is None else schema)
     check_sweeps(config)
     if available is not None:
         check_memory(config, available)
     check_optimum(config, available)
-    every = scenes(config)
+    every = scenes(config, None if available is None else lambda scene: check_scene_memory(scene, available))
     for name in every:  # builds and checks each scene
         every[name]

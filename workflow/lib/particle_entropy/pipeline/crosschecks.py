@@ -192,6 +192,21 @@ def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
             )
 
 
+def check_scene_memory(scene, available: float) -> None:
+    """Every job a scene may run must fit in ``available`` bytes: each candidate's top resolution
+    with its realisations in one process (memory.estimate_mb); SettingError naming its n_range."""
+    for i, c in enumerate(scene.candidates):
+        runs = 1 if c.case.method == "fd" else scene.realisations
+        need = estimate_mb(scene.run_config(c, c.n_hi), runs) * 2**20
+        if need > available:
+            raise SettingError(
+                f"scenes.{scene.name}.candidates[{i}].n_range",
+                [c.n_lo, c.n_hi],
+                f"a range whose top job fits in this machine's memory: {c.label} at n = {c.n_hi:,} with "
+                f"{runs} realisations needs about {need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available",
+            )
+
+
 def _case_error(e: SettingError, where: str, case: Case) -> SettingError:
     """A SettingError of one case's run, named by its config key: a shared setting (time.dt0, ...)
     names that key and the case, any other the case's own key under ``where``."""
