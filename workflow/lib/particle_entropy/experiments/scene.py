@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
-from ..core.runconfig import ADVECTION_SCHEMES, RunConfig
+from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_setting
 from ..core.settings import BY_KEY, PAPER, SCENE, defaults
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
@@ -131,31 +131,16 @@ class Scene:
     def from_config(cls, name: str, spec: Mapping, case_defaults: Mapping | None = None) -> Scene:
         """The scene at config key scenes.<name>; SettingError naming the key path of a bad value."""
         spec = dict(spec)
-        get = {k: spec.get(k, _DEFAULTS.get(k)) for k in ("D", "v", "t_final", "margin", "realisations")}
-        for key in ("D", "t_final", "margin"):
-            s = BY_KEY[f"scenes.<name>.{key}"]
-            value = get[key]
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-            if not ok or (value <= s.low if s.open_low else value < s.low) or value > s.high:
-                raise SettingError(_key(name, key), value, s.allowed())
-        v = get["v"]
-        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)):
-            raise SettingError(_key(name, "v"), v, "a finite number [L/T]")
-        r = get["realisations"]
-        s = BY_KEY["scenes.<name>.realisations"]
-        if not (isinstance(r, int) and not isinstance(r, bool) and s.low <= r <= s.high):
-            raise SettingError(_key(name, "realisations"), r, s.allowed())
+        D, v, t_final, margin, r = (
+            _checked(name, k, spec.get(k, _DEFAULTS[k])) for k in ("D", "v", "t_final", "margin", "realisations")
+        )
         source = _source(name, spec.get("source", _DEFAULTS["source"]))
-        D, t_final, margin = float(get["D"]), float(get["t_final"]), float(get["margin"])
         span = 2.0 * (source.half_width + margin * math.sqrt(2.0 * D * t_final))
-        omega = _length(name, "omega", spec.get("omega", span))
-        fd_length = _length(name, "fd_length", spec.get("fd_length", span))
+        omega = _checked(name, "omega", spec.get("omega", span))
+        fd_length = _checked(name, "fd_length", spec.get("fd_length", span))
         target = {**_TARGET, **dict(spec.get("target") or {})}
-        if target.get("measure") not in BY_KEY["scenes.<name>.target.measure"].choices:
-            raise SettingError(_key(name, "target.measure"), target.get("measure"), "one of rmse, entropy, dilution")
-        value = target.get("value")
-        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < math.inf):
-            raise SettingError(_key(name, "target.value"), value, "a number > 0")
+        measure = _checked(name, "target.measure", target.get("measure"))
+        value = _checked(name, "target.value", target.get("value"))
         raw = spec.get("candidates")
         if not isinstance(raw, list) or not raw:
             raise SettingError(_key(name, "candidates"), raw, "a list of at least one model")
@@ -166,9 +151,7 @@ class Scene:
         if v == 0:  # nothing to advect: FD's scheme is no part of the runs (nor of its candidates: one each)
             cands = tuple({replace(c, advection="none").label: replace(c, advection="none") for c in cands}.values())
         cost = _cost(name, spec.get("cost"))
-        scene = cls(
-            name, D, float(v), t_final, source, omega, fd_length, target["measure"], float(value), r, cands, cost
-        )
+        scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains
             try:
                 scene.run_config(c, c.n_lo)
@@ -196,10 +179,13 @@ def _cost(name: str, spec) -> tuple:
     return tuple((m, (float(a), float(b))) for m, (a, b) in sorted(out.items()))
 
 
-def _length(name: str, key: str, value) -> float:
-    if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 < value < math.inf):
-        raise SettingError(_key(name, key), value, "a number > 0 [L]")
-    return float(value)
+def _checked(name: str, key: str, value):
+    """``value`` of scenes.<name>.<key> as its declaration (settings.SCENE) allows it (check_setting: a
+    number as a float), else SettingError naming the key path."""
+    try:
+        return check_setting(BY_KEY[f"scenes.<name>.{key}"], value)
+    except SettingError as e:
+        raise SettingError(_key(name, key), value, e.allowed) from None
 
 
 def _source(name: str, spec) -> Source:
