@@ -37,7 +37,7 @@ def error(scene: Scene, row: pd.Series | dict) -> float:
     return abs(row["E"] / row["E_analytic"] - 1.0)
 
 
-def unscored(scene: Scene, candidate: Candidate, row) -> str:
+def unscored(scene: Scene, row) -> str:
     """Why a run cannot be judged ('' if it can): negative concentrations (an FD central scheme past
     grid Peclet 2) have no entropy and are never chosen."""
     if row["mass_min"] < -NEGATIVE_TOLERANCE:
@@ -50,14 +50,19 @@ def unscored(scene: Scene, candidate: Candidate, row) -> str:
     return ""
 
 
+def _t_margin(errors: np.ndarray, quantile: float) -> float:
+    """Student t's ``quantile`` times the mean's standard error; 0 for a single value."""
+    if errors.size == 1:
+        return 0.0
+    from scipy.stats import t
+
+    return float(t.ppf(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
+
+
 def upper_bound(errors: np.ndarray) -> float:
     """The mean's one-sided 95 % upper bound (Student t); one value: itself."""
     errors = np.asarray(errors, dtype=float)
-    if errors.size == 1:
-        return float(errors[0])
-    from scipy.stats import t
-
-    return float(errors.mean() + t.ppf(0.95, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
+    return float(errors.mean() + _t_margin(errors, 0.95))
 
 
 def seeds(scene: Scene, candidate: Candidate, base_seed: int) -> tuple[int, int]:
@@ -72,16 +77,11 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for (ci, n), g in runs.groupby(["candidate", "n"], sort=True):
         cand = scene.candidates[ci]
-        reasons = [unscored(scene, cand, r) for _, r in g.iterrows()]
-        errs = np.array([error(scene, r) for _, r in g.iterrows()])
-        reason = next((r for r in reasons if r), "")
+        records = g.to_dict("records")
+        reason = next((why for why in (unscored(scene, r) for r in records) if why), "")
+        errs = np.array([error(scene, r) for r in records])
         k = errs.size
-        if k > 1:
-            from scipy.stats import t
-
-            half = t.ppf(0.975, k - 1) * errs.std(ddof=1) / math.sqrt(k)
-        else:
-            half = 0.0
+        half = _t_margin(errs, 0.975)
         up = upper_bound(errs)
         rows.append(
             {
