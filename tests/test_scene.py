@@ -11,6 +11,7 @@ from particle_entropy.experiments.scene import Scene, scenes
 
 FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 1000]}
 MTPT = {"method": "mtpt", "kernel": "collision", "n_range": [30, 3000]}
+PT = {"method": "pt", "kernel": "adaptive"}
 
 
 def spec(**over):
@@ -75,6 +76,12 @@ def test_ladders_rise_by_about_two_and_fd_takes_even_grids():
         ({"omega": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.omega"),
         ({"fd_length": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.fd_length"),
         ({"cost": {"fd": [1.0]}}, "scenes.s.cost.fd"),
+        ({"budget": 0.0}, "scenes.s.budget"),
+        ({"budget": "cheap"}, "scenes.s.budget"),
+        ({"candidates": [{**MTPT, "ladder": [30, 100]}]}, "scenes.s.candidates[0].ladder"),  # and n_range
+        ({"candidates": [{**PT, "ladder": [100, 30]}]}, "scenes.s.candidates[0].ladder"),
+        ({"candidates": [{**PT, "ladder": [30]}]}, "scenes.s.candidates[0].ladder"),
+        ({"candidates": [{"method": "fd", "kernel": "implicit", "ladder": [16, 33]}]}, "scenes.s.candidates[0].ladder"),
     ],
 )
 def test_a_bad_value_is_refused_naming_its_key_path(over, key):
@@ -161,3 +168,73 @@ def test_a_scene_whose_top_job_cannot_fit_in_memory_is_refused():
     guarded = scenes({"scenes": {"s": spec()}}, check=lambda sc: check_scene_memory(sc, available=1e6))
     with pytest.raises(SettingError, match="scenes.s.candidates"):
         guarded["s"]
+
+
+def test_a_ladder_written_out_is_the_search_s_rungs():
+    pt = {"method": "pt", "kernel": "adaptive", "ladder": [30, 100, 300, 1000]}
+    (cand,) = Scene.from_config("s", spec(candidates=[pt])).candidates
+    assert cand.ladder() == [30, 100, 300, 1000] and (cand.n_lo, cand.n_hi) == (30, 1000)
+
+
+PAPER = {  # the paper's problem, as config.yaml's scene `paper` writes it
+    "D": 1.0e-3,
+    "t_final": 1000.0,
+    "omega": 10.0,
+    "fd_length": 12.0,
+    "target": {"value": 1e-3},
+    "candidates": [
+        {"method": "fd", "kernel": "implicit", "fd_dt": 0.05, "ladder": [8, 16, 30]},
+        {"method": "mtpt", "kernel": "collision", "ladder": [30, 100]},
+        {"method": "pt", "kernel": "adaptive", "ladder": [30, 100]},
+    ],
+}
+
+
+def _with_paper(spec_, config=None):
+    from functools import partial
+
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import load_yaml
+    from particle_entropy.pipeline.sweeps import RUN_PATTERN, run_config
+
+    config = config or dict(load_yaml(ROOT / "config.yaml"))
+    return scenes({"scenes": {"p": spec_}}, paper=(RUN_PATTERN, partial(run_config, config=config)))["p"], config
+
+
+def test_the_paper_scene_runs_are_the_paper_run_s_own_files():
+    from particle_entropy.analysis.scene_search import run_path
+
+    scene, _ = _with_paper(PAPER)
+    assert scene.paper_runs == {0, 1, 2}
+    fd, mtpt, _pt = scene.candidates
+    assert run_path(scene, mtpt, 100, 0, 19) == (
+        "results/runs/mtpt/collision/n~100/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact/seeds~0-19.parquet"
+    )
+    assert run_path(scene, fd, 30, 0, 0).startswith("results/runs/fd/implicit/n~30/")
+    # any difference of physics, step or points keeps a scene's runs its own
+    for over in ({"D": 2e-3}, {"v": 1e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
+        other, _ = _with_paper({**PAPER, **over})
+        assert other.paper_runs == frozenset(), over
+        assert run_path(other, other.candidates[1], 100, 0, 19).startswith("results/scenes/")
+    other, _ = _with_paper({**PAPER, "candidates": [{**PAPER["candidates"][0], "fd_dt": 0.1}, PAPER["candidates"][1]]})
+    assert other.paper_runs == {1}  # FD at another step is not the paper's FD
+
+
+@pytest.mark.parametrize("which", [0, 1, 2])
+def test_a_shared_run_is_the_paper_run_to_the_bit(which):
+    """The claim that lets the paper scene read the paper's files: its RunConfig's table equals the
+    paper's own (measured wall times aside), so no answer depends on which job made the file."""
+    from particle_entropy.models.simulate import run_seeds_arrow
+    from particle_entropy.pipeline.sweeps import run_config
+
+    scene, config = _with_paper(PAPER)
+    cand = scene.candidates[which]
+    n = cand.ladder()[0]
+    mine = run_seeds_arrow(scene.run_config(cand, n, seed=3), [3]).to_pandas()
+    from dataclasses import replace as _replace
+
+    theirs = run_seeds_arrow(run_config(_replace(cand.case, n=n), config, seed=3), [3]).to_pandas()
+    timing = [c for c in mine.columns if c.startswith(("wall_", "peak_rss", "core_s"))]
+    assert list(mine.columns) == list(theirs.columns)
+    assert mine.drop(columns=timing).equals(theirs.drop(columns=timing))

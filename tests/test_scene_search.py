@@ -123,7 +123,7 @@ def test_the_cheaper_candidate_is_recommended_by_counted_cost():
     cheapest = firsts.loc[firsts["cost_s"].idxmin()]
     assert out[out["recommended"]].index.tolist() == [cheapest.name]
     fd = scene.cost_s("fd", 100.0, 100.0 * 100)
-    assert fd == pytest.approx(3.5e-5 * 100 + 1.5e-8 * 1e4)  # the shipped cost model: a step, a unit of work
+    assert fd == pytest.approx(3.85e-5 * 100 + 1.72e-8 * 1e4)  # the shipped cost model: a step, a unit of work
 
 
 def test_nothing_recommended_when_no_candidate_meets_the_target():
@@ -173,3 +173,54 @@ def test_the_peclet_table_and_its_crossover():
     assert table.drop_duplicates("peclet")["particles_cheaper"].tolist() == [False, False, True, True]
     assert S.crossover(table) == (50.0, 500.0)
     assert S.crossover(S.peclet_table(tables[:2])) is None  # the grid wins throughout
+
+
+def test_the_counted_cost_of_a_run_is_known_before_it_runs():
+    """Scene.run_cost from the time grid alone equals the cost counted from the run's own table
+    (steps, particle- or node-steps) for PT and FD, which have no substeps."""
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    scene = _scene(
+        candidates=(
+            {"method": "fd", "kernel": "implicit", "fd_dt": 1.0, "n_range": [16, 64]},
+            {"method": "pt", "kernel": "adaptive", "n_range": [30, 300]},
+        )
+    )
+    for cand, n in zip(scene.candidates, (16, 30)):
+        table = run_seeds_arrow(scene.run_config(cand, n), [0]).to_pandas()
+        last = table.loc[table["step"].idxmax()]
+        counted = scene.cost_s(cand.case.method, float(last["step"]), float(last["work"]))
+        assert scene.run_cost(cand, n) == pytest.approx(counted, rel=1e-12)
+        size = n + 1 if cand.case.method == "fd" else n
+        assert last["work"] == last["step"] * size
+
+
+def test_a_budget_stops_the_climb_and_says_so():
+    scene = _scene(value=1e-9)  # never met
+    dear = scene.candidates[1]
+    ladder = dear.ladder()
+    budget = scene.run_cost(dear, ladder[3]) * 1.0001  # rungs 0..3 of MTPT are affordable
+    capped = Scene.from_config(
+        "s", {"v": 0.01, "t_final": 50.0, "budget": budget, "target": {"value": 1e-9}, "candidates": [FD, MTPT]}
+    )
+    assert S.affordable(capped, capped.candidates[1]) == ladder[:4]
+    plan, table, _ = _search(capped, lambda ci, n, seed: 1.0 / n)
+    mtpt = table[table["candidate"] == 1]
+    assert mtpt["n"].max() == ladder[3] and mtpt["cost_s"].max() <= budget
+    reasons = S.stop_reasons(capped, table)
+    assert reasons[1] == f"not met within the budget (n <= {ladder[3]:,})"
+    out = S.result(capped, table)
+    assert (out["budget"] == budget).all() and not out["recommended"].any()
+    # a budget below the cheapest rung: nothing run, and the reason names the rung's cost
+    tiny = Scene.from_config(
+        "s", {"v": 0.01, "t_final": 50.0, "budget": 1e-9, "target": {"value": 0.1}, "candidates": [MTPT]}
+    )
+    assert S.next_plan(tiny, None, None, 0)["done"].all()
+    nothing = pd.DataFrame({"candidate": [], "n": [], "meets": []})
+    assert S.stop_reasons(tiny, nothing)[0].startswith("over budget: n = 32 costs")
+
+
+def test_the_result_columns_are_the_documented_ones():
+    scene = _scene(value=0.01)
+    _, table, _ = _search(scene, lambda ci, n, seed: 1.0 / n)
+    assert list(S.result(scene, table).columns) == list(S.RESULT_COLUMN_DOCS)

@@ -60,7 +60,11 @@ if AVAILABLE is not None:
 OPTIMUM = optimum_searches(config, AVAILABLE)
 # The scenes (workflow/rules/scenes.smk), by name, each checked when a requested target first needs
 # it; their runs are keyed by a digest of their physics (scenes share equal runs: SCENES.settings).
-SCENES = scenes(config, None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE))
+SCENES = scenes(
+    config,
+    None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE),
+    paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
+)
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):

@@ -28,6 +28,35 @@ PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
 NEGATIVE_TOLERANCE = 1e-12  # a node mass below -this (of unit total) is a negative concentration
 
 
+RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a finished scene
+    "candidate": "the candidate's index in `scenes.<name>.candidates` (a Peclet scene: in its base's)",
+    "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
+    "method": "fd, pt or mtpt",
+    "n": "the resolution: particles, or FD intervals",
+    "realisations": "runs averaged (FD: 1, deterministic)",
+    "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
+    "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
+    "error_hi": "upper end of that interval",
+    "error_upper95": "the mean's one-sided 95 % upper bound: the rung meets the target when it is <= `target`",
+    "meets": "the rung is scored and `error_upper95` <= `target`",
+    "unscored": "why the rung cannot be judged (negative concentrations past grid Peclet 2), else empty",
+    "steps": "time steps of a run",
+    "work": "particle-steps (FD node-steps) of a run, MTPT substeps counted",
+    "cost_s": "the counted cost of one run: `steps` and `work` times the scene's `cost` [s]",
+    "core_s": "the measured core-seconds of one run (the sum of its steps' wall time) [s]",
+    "COMIC_points": "mean COMIC (Eq. 43) at the common measurement points (NaN if unscored)",
+    "scene": "the scene's name",
+    "stopped": "why the candidate's search stopped",
+    "n_below": "the highest failing rung visited below `n` (NaN if none): a passing row's answer lies in (n_below, n]",
+    "recommended": "the cheapest candidate's smallest rung that meets the target (at most one row)",
+    "comic_best": "the lowest `COMIC_points` of the scene (one row)",
+    "target": "the scene's `target.value`",
+    "budget": "the scene's `budget`, the most counted cost of a run (inf: none) [s]",
+    "measure": "the scene's `target.measure`: rmse, entropy or dilution",
+    "peclet": "v L / D, L the scene's FD window",
+}
+
+
 def error(scene: Scene, row: pd.Series | dict) -> float:
     """The scene's error measure of one run at t_final (its last row)."""
     if scene.measure == "rmse":
@@ -106,9 +135,20 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def affordable(scene: Scene, candidate: Candidate) -> list[int]:
+    """The rungs of a candidate's ladder whose run costs at most the scene's budget (Scene.run_cost)."""
+    ladder = candidate.ladder()
+    if not math.isfinite(scene.budget):
+        return ladder
+    return [n for n in ladder if scene.run_cost(candidate, n) <= scene.budget]
+
+
 def _next_rung(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tuple[int | None, str]:
     """The next resolution of one candidate's search, or (None, why it stops)."""
-    ladder = candidate.ladder()
+    whole = candidate.ladder()
+    ladder = affordable(scene, candidate)
+    if not ladder:
+        return None, f"over budget: n = {whole[0]:,} costs {scene.run_cost(candidate, whole[0]):.3g} s a run"
     if visited.empty:
         return ladder[0], ""
     idx = {n: i for i, n in enumerate(ladder)}
@@ -117,6 +157,8 @@ def _next_rung(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tup
     if not passing:
         top = seen[-1]
         if top == len(ladder) - 1:
+            if len(ladder) < len(whole):
+                return None, f"not met within the budget (n <= {ladder[-1]:,})"
             return None, "not met within n_range"
         return ladder[min(top + CLIMB, len(ladder) - 1)], ""
     best = passing[0]
@@ -180,16 +222,20 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     if len(scored):
         out.loc[scored["COMIC_points"].idxmin(), "comic_best"] = True
     out["target"] = scene.value
+    out["budget"] = scene.budget
     out["measure"] = scene.measure
     out["peclet"] = scene.peclet
     return out.reset_index(drop=True)
 
 
 def run_path(scene: Scene, candidate: Candidate, n: int, first: int, last: int) -> str:
-    """The table of a candidate's runs at resolution n, seeds first..last (SCENE_RUN_PATTERN)."""
+    """The table of a candidate's runs at resolution n, seeds first..last (SCENE_RUN_PATTERN; the
+    paper run's own table where the scene shares its runs: Scene.paper_runs)."""
     from dataclasses import replace
 
     case = replace(candidate.case, n=int(n))
+    if scene.candidates.index(candidate) in scene.paper_runs:  # the paper run's own table
+        return scene.paper_pattern.format(kind="runs", first=first, last=last, **case.wildcards())
     return SCENE_RUN_PATTERN.format(
         scene_id=scene.identity(candidate), kind="runs", first=first, last=last, **case.wildcards()
     )

@@ -718,7 +718,7 @@ CANDIDATE_SHAPE = {
     "items": {
         "type": "object",
         "additionalProperties": False,
-        "required": ["method", "kernel", "n_range"],
+        "required": ["method", "kernel"],
         "properties": {
             "method": _ref("method"),
             "kernel": _ref("kernel"),
@@ -729,7 +729,9 @@ CANDIDATE_SHAPE = {
             "advection": {"type": "string", "enum": ["upwind", "central"]},
             "fd_dt": {"type": "number", "exclusiveMinimum": 0},
             "n_range": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2, "maxItems": 2},
+            "ladder": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2},
         },
+        "oneOf": [{"required": ["n_range"]}, {"required": ["ladder"]}],
     },
 }
 SCENE = (
@@ -794,10 +796,10 @@ SCENE = (
     Setting(
         "cost",
         "scenes.<name>.cost",
-        {"fd": [3.5e-5, 1.5e-8], "pt": [6.0e-5, 3.5e-8], "mtpt": [8.0e-5, 2.5e-7]},
+        {"fd": [3.85e-5, 1.72e-8], "pt": [7.99e-5, 3.71e-8], "mtpt": [8.37e-5, 2.02e-7]},
         "the cost model of a run, by method: [seconds a time step, seconds a unit of work] (work = node- or "
-        "particle-steps); counted, never timed, so the answer is the same on every machine (measured on "
-        "the paper run of 2026-12-03, Intel Xeon)",
+        "particle-steps); counted, never timed, so the answer is the same on every machine (fitted by "
+        "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03)",
         "s",
         kind="shape",
         shape={
@@ -811,14 +813,25 @@ SCENE = (
         range_text="per method fd, pt, mtpt: [seconds a step, seconds a unit of work], numbers >= 0",
     ),
     Setting(
+        "budget",
+        "scenes.<name>.budget",
+        NO_DEFAULT,
+        "the most a run may cost, counted by `cost` before it runs: rungs above it are not run, and a "
+        "candidate that meets the target only above it does not meet it (none: no limit)",
+        "s",
+        0.0,
+        open_low=True,
+    ),
+    Setting(
         "candidates",
         "scenes.<name>.candidates",
         NO_DEFAULT,
         "the models to compare: method, kernel and case dimensions, n_range [low, high] (particles or FD "
-        "intervals); FD candidates may set advection (upwind, central) and fd_dt",
+        "intervals) or a ladder of its own [n1, n2, ...]; FD candidates may set advection (upwind, central) "
+        "and fd_dt",
         kind="shape",
         shape=CANDIDATE_SHAPE,
-        range_text="a list of models, each with 2 <= n_range low < high",
+        range_text="a list of models, each with 2 <= n_range low < high, or a ladder of ascending integers >= 2",
         required=True,
     ),
 )

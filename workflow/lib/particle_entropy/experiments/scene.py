@@ -15,6 +15,7 @@ from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
 from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_setting
 from ..core.settings import BY_KEY, PAPER, SCENE, defaults
+from ..core.timegrid import time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -36,6 +37,7 @@ class Candidate:
     n_hi: int
     advection: str = "upwind"  # "none" in a scene without flow
     fd_dt: float = PAPER["fd_dt"]
+    rungs: tuple[int, ...] = ()  # a ladder written out (config `ladder`) instead of n_range's
 
     @property
     def label(self) -> str:
@@ -55,7 +57,9 @@ class Candidate:
 
     def ladder(self) -> list[int]:
         """The resolutions the search may visit: n_lo, n_lo r, n_lo r^2, ... up to n_hi (r = LADDER_RATIO,
-        rounded; FD: even numbers of intervals), each once."""
+        rounded; FD: even numbers of intervals), each once; or the candidate's own ``rungs``."""
+        if self.rungs:
+            return list(self.rungs)
         steps = max(1, math.ceil(math.log(self.n_hi / self.n_lo) / math.log(LADDER_RATIO) - 1e-9))
         out = []
         for k in range(steps + 1):
@@ -82,11 +86,24 @@ class Scene:
     realisations: int
     candidates: tuple[Candidate, ...]
     cost: tuple = ()  # ((method, (seconds a step, seconds a unit of work)), ...)
+    budget: float = math.inf  # the most counted cost of one run [s]
+    paper_runs: frozenset = frozenset()  # candidates whose runs are the paper run's own (Scenes)
+    paper_pattern: str = ""  # the paper run's table pattern, for those
 
     def cost_s(self, method: str, steps: float, work: float) -> float:
         """A run's counted cost: steps and work times the scene's unit costs [s]."""
         per_step, per_work = dict(self.cost)[method]
         return per_step * steps + per_work * work
+
+    def run_cost(self, candidate: Candidate, n: int) -> float:
+        """The counted cost of one run of ``candidate`` at resolution n, known before it runs: its time
+        steps and work (particles, or FD's n + 1 nodes, times steps; MTPT's substeps, if any, come on
+        top in the run's own count) times the scene's unit costs [s]."""
+        cfg = self.run_config(candidate, n)
+        grid = cfg.time_grid if cfg.method != "fd" else "exact"
+        steps = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid).size
+        size = n + 1 if cfg.method == "fd" else n
+        return self.cost_s(cfg.method, steps, steps * size)
 
     @property
     def reference(self) -> Reference:
@@ -134,6 +151,7 @@ class Scene:
         D, v, t_final, margin, r = (
             _checked(name, k, spec.get(k, _DEFAULTS[k])) for k in ("D", "v", "t_final", "margin", "realisations")
         )
+        budget = _checked(name, "budget", spec["budget"]) if spec.get("budget") is not None else math.inf
         source = _source(name, spec.get("source", _DEFAULTS["source"]))
         span = 2.0 * (source.half_width + margin * math.sqrt(2.0 * D * t_final))
         omega = _checked(name, "omega", spec.get("omega", span))
@@ -151,7 +169,7 @@ class Scene:
         if v == 0:  # nothing to advect: FD's scheme is no part of the runs (nor of its candidates: one each)
             cands = tuple({replace(c, advection="none").label: replace(c, advection="none") for c in cands}.values())
         cost = _cost(name, spec.get("cost"))
-        scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost)
+        scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost, budget)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains
             try:
                 scene.run_config(c, c.n_lo)
@@ -162,7 +180,7 @@ class Scene:
         return scene
 
 
-_CAND_KEYS = ("eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0")
+_CAND_KEYS = ("eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0", "ladder")
 
 
 def _cost(name: str, spec) -> tuple:
@@ -220,6 +238,17 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(_key(name, where), spec, "a model: method, kernel, n_range and its dimensions")
     spec = dict(spec)
     fd_only = [k for k in ("advection", "fd_dt") if k in spec]
+    if "ladder" in spec:
+        rungs = spec.pop("ladder")
+        ok = isinstance(rungs, list) and len(rungs) >= 2 and "n_range" not in spec
+        ok = ok and all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in rungs)
+        if not ok or any(b <= a for a, b in zip(rungs, rungs[1:])):
+            raise SettingError(
+                _key(name, f"{where}.ladder"), rungs, "at least two integers >= 2, ascending (instead of n_range)"
+            )
+        spec["n_range"] = [rungs[0], rungs[-1]]
+    else:
+        rungs = []
     n_range = spec.pop("n_range", None)
     advection = spec.pop("advection", "upwind")
     fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
@@ -244,7 +273,9 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(
             _key(name, f"{where}.{key}"), advection if key == "advection" else fd_dt, "fd candidates only"
         )
-    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt))
+    if case.method == "fd" and any(n % 2 for n in rungs):
+        raise SettingError(_key(name, f"{where}.ladder"), rungs, "for fd even numbers of intervals")
+    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt), tuple(rungs))
 
 
 class Scenes(Mapping):
@@ -252,10 +283,11 @@ class Scenes(Mapping):
     needs it (as the optimum searches are), so that a run that draws no scene is never blocked by
     one; a bad value is still refused before any of its jobs, naming its key path."""
 
-    def __init__(self, config: Mapping, check=None):
+    def __init__(self, config: Mapping, check=None, paper=None):
         self._specs = {**dict(config.get("scenes") or {}), **peclet_scenes(config)}
         self._defaults = config.get("case_defaults", {})
         self._check = check  # a further check of each built scene (the workflow's memory check)
+        self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
         self._built: dict[str, Scene] = {}
 
     def __getitem__(self, name: str) -> Scene:
@@ -263,6 +295,8 @@ class Scenes(Mapping):
             scene = Scene.from_config(name, self._specs[name], self._defaults)
             if self._check is not None:
                 self._check(scene)
+            if self._paper is not None:
+                scene = shares_paper_runs(scene, *self._paper)
             self._built[name] = scene
         return self._built[name]
 
@@ -285,6 +319,26 @@ class Scenes(Mapping):
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
 
 
+def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
+    """``scene`` with its candidates whose runs are the paper run's own marked (``paper_runs``): the
+    same RunConfig as ``paper_run(case)`` gives (the paper's physics, first step and numerics) and
+    the same measurement points. Their tables are the paper's (``pattern``): the paper scene
+    recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
+    shared = set()
+    for ci, cand in enumerate(scene.candidates):
+        mine = scene.run_config(cand, cand.n_lo)
+        try:
+            theirs = paper_run(replace(cand.case, n=cand.n_lo))
+        except (SettingError, ValueError):
+            continue
+        same_points = all(
+            mine.points(t).tobytes() == theirs.points(t).tobytes() for t in (0.0, scene.t_final)
+        )  # at rest the points do not move; a carried plume's would, and then v differs anyway
+        if replace(mine, window=None) == theirs and same_points:
+            shared.add(ci)
+    return replace(scene, paper_runs=frozenset(shared), paper_pattern=pattern)
+
+
 PECLET_PREFIX = "peclet_"  # the scenes of the Peclet sweep: peclet_0, peclet_1, ...
 
 
@@ -304,7 +358,8 @@ def peclet_scenes(config: Mapping) -> dict[str, dict]:
     return {f"{PECLET_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
 
 
-def scenes(config: Mapping, check=None) -> Scenes:
+def scenes(config: Mapping, check=None, paper=None) -> Scenes:
     """Every scene of a config by name, each checked when first used (Scenes; ``check``: a further
-    check of each, given the Scene)."""
-    return Scenes(config, check)
+    check of each, given the Scene; ``paper``: the paper run's table pattern and RunConfig of a case,
+    whose runs the scenes of the paper's physics share: shares_paper_runs)."""
+    return Scenes(config, check, paper)

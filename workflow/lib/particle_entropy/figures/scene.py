@@ -1,8 +1,8 @@
 """figures/scene_<name>.png: one scene's answer, drawn from its table (analysis/scene_search.py).
 
 (a) the error at t_final against the counted cost for every candidate (each visited resolution a
-point with its 95 % interval), the target as a line, the recommended candidate and resolution
-starred; (b) COMIC at the common measurement points against resolution for every candidate, the
+point with its 95 % interval), the target as a line (the budget, if any, dotted), the recommended
+candidate and resolution starred; (b) COMIC at the common measurement points against resolution for every candidate, the
 COMIC-best ringed. Unscored runs (negative concentrations) are drawn hollow and named below.
 """
 
@@ -62,6 +62,9 @@ def scene(table: pd.DataFrame):
             label=label,
         )
     ax.axhline(target, color=BLACK, ls="--", lw=1.0, label=f"target {target:g}")
+    budget = float(table["budget"].iloc[0]) if "budget" in table else np.inf
+    if np.isfinite(budget):
+        ax.axvline(budget, color=BLACK, ls=":", lw=1.0, label=f"budget {budget:g} s a run")
     best = table[table["recommended"]]
     if len(best):
         r = best.iloc[0]

@@ -21,7 +21,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..analysis import claims, optimum
+from ..analysis import claims, optimum, scene_search
 from ..analysis.aggregate import ARGMIN_COLUMN_DOCS, MINIMA_COLUMN_DOCS, REALISATION_COLUMN_DOCS, SUMMARY_COLUMNS
 from ..analysis.resampling import CONFIDENCE, N_RESAMPLES
 from ..core import records
@@ -496,6 +496,14 @@ def sections() -> list[Section]:
             "`optimum.<name>`; the search-level columns repeat on every row, and the optimum's columns hold values "
             "of the searched dimension (`over`). Written by rule `optimum_table` (`optimum.result_table`).",
             (("optimum.RESULT_COLUMN_DOCS", optimum.RESULT_COLUMN_DOCS),),
+        ),
+        Section(
+            "Scene results",
+            ("results/scenes/<name>.parquet",),
+            "One row per visited (candidate, resolution) of a finished scene `scenes.<name>` (or a scene of the "
+            "Peclet sweep, `peclet_<k>`); the scene-level columns repeat on every row. Written by rule "
+            "`scene_table` (`scene_search.result`); docs/scenes.md explains the search.",
+            (("scene_search.RESULT_COLUMN_DOCS", scene_search.RESULT_COLUMN_DOCS),),
         ),
     ]
 
