@@ -32,6 +32,7 @@ include: "workflow/rules/shear.smk"
 include: "workflow/rules/mechanism.smk"
 include: "workflow/rules/optimum.smk"
 include: "workflow/rules/scenes.smk"
+include: "workflow/rules/crate.smk"
 
 
 rule all:

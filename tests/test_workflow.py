@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import re
 import shutil
 import subprocess
@@ -378,6 +379,58 @@ def test_report_holds_every_figure_with_its_caption(tiny_run):
     for fig in DEFAULT_FIGURES:
         assert f"{fig}.png" in html, fig
     assert "Reproduces" in html
+    # each figure says where it came from: commit, config digest, rule, module, source table and digest
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True).stdout
+    for fig in DEFAULT_FIGURES:
+        data = f"results/figures/{fig}.parquet"
+        recorded = (tiny_run / (data + ".sha256")).read_text().split()[0]
+        entry = re.search(r'"labels": \{"figure": "' + fig + r'"[^}]*\}', html)
+        assert entry, fig
+        labels = json.loads(entry.group(0)[len('"labels": ') :])
+        assert labels["commit"].startswith(commit[:12]) and labels["rule"] == f"plot_{fig}", labels
+        assert labels["module"] == f"workflow/lib/particle_entropy/figures/{fig}.py"
+        assert (ROOT / labels["module"]).is_file()
+        assert labels["source data"] == data and labels["source sha256"] == recorded[:16]
+        assert re.fullmatch(r"[0-9a-f]{16}", labels["config sha256"])
+
+
+def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_copy):
+    """`snakemake crate` writes a Provenance Run Crate that the RO-Crate validator accepts (its
+    REQUIRED checks), whose every file has the digest it records, and whose actions trace each figure
+    to its rule and inputs; a crate with a missing file or a wrong digest is caught."""
+    from crate_validation import validate_crate
+
+    from particle_entropy.pipeline.crate import METADATA, verify_crate
+    from particle_entropy.pipeline.verify import corrupt_tables, file_sha256
+
+    work = tiny_run_copy
+    run_snakemake(work, "crate", configfile=TINY)
+    crate = work / "results/ro-crate"
+    graph = {e["@id"]: e for e in json.loads((crate / METADATA).read_text())["@graph"]}
+    assert validate_crate(crate) == []
+    assert verify_crate(crate) == []
+    for fig in DEFAULT_FIGURES:
+        png = f"figures/{fig}.png"
+        assert graph[png]["sha256"] == file_sha256(work / png)
+        made = [e for e in graph.values() if e.get("@type") == "CreateAction" and {"@id": png} in e.get("result", [])]
+        (action,) = [e for e in made if e["@id"] != "#run"]  # the job; the run's action lists every figure
+        assert graph[action["instrument"]["@id"]]["name"] == f"rule plot_{fig}"
+        assert {"@id": f"results/figures/{fig}.parquet"} in action["result"]
+        assert re.fullmatch(r"code hash [0-9a-f]{16}", action["description"])
+    assert graph["config-as-run.yaml"]["sha256"] == file_sha256(crate / "config-as-run.yaml")
+    assert graph["https://doi.org/10.1016/j.advwatres.2020.103509"]["@type"] == "ScholarlyArticle"
+    assert (crate / "requirements.lock").read_bytes() == (ROOT / "requirements.lock").read_bytes()
+    assert "commit " in graph["#git"]["value"]
+    # the table check does not read the crate's links again
+    assert not [p for p in corrupt_tables(work / "results") if "ro-crate" in str(p)]
+    # a wrong digest, then a missing file
+    table = crate / "results/figures/fig1.parquet"
+    table.unlink()
+    table.write_bytes(b"PAR1 not the table PAR1")
+    assert verify_crate(crate) == ["results/figures/fig1.parquet: its SHA-256 differs from the crate's record"]
+    table.unlink()
+    assert verify_crate(crate) == ["results/figures/fig1.parquet: missing"]
+    assert validate_crate(crate) != []  # the validator too: a data entity that is not there
 
 
 # --- every case a section lists is drawn and tabulated, and cases stay apart -------------------

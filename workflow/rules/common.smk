@@ -23,7 +23,8 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
 from particle_entropy.numerics.compiled import kernels_folder
-from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
+from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, CRATE_DIR, TableError, set_aside_corrupt
+from particle_entropy.pipeline.crate import provenance
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
@@ -379,3 +380,18 @@ SCENE_PLOT_CODE = code_version(
     "core.io",
     files=[SCRIPTS / "plot_scene.py", SCRIPTS / "plot_scenes_peclet.py"],
 )
+CRATE_CODE = code_version("pipeline.crate", files=[SCRIPTS / "crate.py"])
+
+
+def coded_rules(rules):
+    """The rules with a `code` parameter (their code hash, pipeline/codeversion.py): the crate
+    reads each job's from Snakemake's record of its params (pipeline/crate.py)."""
+    return sorted(r.name for r in rules if "code" in r.params.keys())
+
+
+def figure_labels(figure, rule, data, drawn_by=None):
+    """The report's labels of a figure: where it came from (pipeline/crate.provenance), worked out
+    when the report is built; ``data`` is its source-data table's path pattern, ``drawn_by`` the
+    figures module that draws it (default: the one named for it)."""
+    path = f"workflow/lib/particle_entropy/figures/{drawn_by or figure}.py"
+    return lambda w: provenance(figure.format(**w), rule, path, data.format(**w), config, workflow.basedir)

@@ -13,6 +13,7 @@ for _fig in PLOTTED:
                 f"figures/{_fig}.png",
                 caption=f"../report/{_fig}.rst",
                 category=FIGURE[_fig].category,
+                labels=figure_labels(_fig, f"plot_{_fig}", FIGURE_DATA_PATTERN.format(fig=_fig)),
             ),
             pdf=f"figures/{_fig}.pdf",
             data=FIGURE_DATA_PATTERN.format(fig=_fig),

@@ -36,6 +36,9 @@ if "mechanism" in config:
                 "figures/fig9_mechanism.png",
                 caption="../report/fig9_mechanism.rst",
                 category=FIGURE["fig9_mechanism"].category,
+                labels=figure_labels(
+                    "fig9_mechanism", "plot_fig9_mechanism", FIGURE_DATA_PATTERN.format(fig="fig9_mechanism")
+                ),
             ),
             pdf="figures/fig9_mechanism.pdf",
             data=FIGURE_DATA_PATTERN.format(fig="fig9_mechanism"),

@@ -55,7 +55,12 @@ rule plot_optimum:
     input:
         "results/optimum/{name}.parquet",
     output:
-        png=report("figures/optimum_{name}.png", caption="../report/optimum.rst", category=FIGURE["optimum"].category),
+        png=report(
+            "figures/optimum_{name}.png",
+            caption="../report/optimum.rst",
+            category=FIGURE["optimum"].category,
+            labels=figure_labels("optimum_{name}", "plot_optimum", "results/optimum/{name}.parquet", "optimum"),
+        ),
         pdf="figures/optimum_{name}.pdf",
     log:
         "logs/plot/optimum_{name}.log",

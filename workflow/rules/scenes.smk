@@ -70,7 +70,12 @@ rule plot_scene:
     input:
         "results/scenes/{name}.parquet",
     output:
-        png=report("figures/scene_{name}.png", caption="../report/scene.rst", category=FIGURE["scene"].category),
+        png=report(
+            "figures/scene_{name}.png",
+            caption="../report/scene.rst",
+            category=FIGURE["scene"].category,
+            labels=figure_labels("scene_{name}", "plot_scene", "results/scenes/{name}.parquet", "scene"),
+        ),
         pdf="figures/scene_{name}.pdf",
     log:
         "logs/plot/scene_{name}.log",
@@ -93,7 +98,10 @@ rule plot_scenes_peclet:
         [f"results/scenes/{name}.parquet" for name in SCENES if name.startswith(PECLET_PREFIX)],
     output:
         png=report(
-            "figures/scenes_peclet.png", caption="../report/scenes_peclet.rst", category=FIGURE["scene"].category
+            "figures/scenes_peclet.png",
+            caption="../report/scenes_peclet.rst",
+            category=FIGURE["scene"].category,
+            labels=figure_labels("scenes_peclet", "plot_scenes_peclet", "results/scenes/peclet.parquet"),
         ),
         pdf="figures/scenes_peclet.pdf",
         data="results/scenes/peclet.parquet",

@@ -31,7 +31,12 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
         input:
             [f"results/shear/{case}/seed~{config['shear']['seed']}/state.parquet" for case in config["shear"]["cases"]],
         output:
-            png=report("figures/fig10.png", caption="../report/fig10.rst", category=FIGURE["fig10"].category),
+            png=report(
+                "figures/fig10.png",
+                caption="../report/fig10.rst",
+                category=FIGURE["fig10"].category,
+                labels=figure_labels("fig10", "plot_fig10", FIGURE_DATA_PATTERN.format(fig="fig10")),
+            ),
             pdf="figures/fig10.pdf",
             data=FIGURE_DATA_PATTERN.format(fig="fig10"),
         log:

@@ -21,6 +21,7 @@ from pathlib import Path
 from ..core.io import checksum_path, write_bytes_atomically
 
 CORRUPT_SUFFIX = ".corrupt"
+CRATE_DIR = "results/ro-crate"  # a run's RO-Crate (pipeline/crate.py): links to tables checked where they were made
 MAGIC = b"PAR1"
 
 
@@ -124,8 +125,11 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
         return {}
     known = _read_digests(digests) if digests is not None else {}
     kept, out = {}, {}
+    crate = Path(CRATE_DIR).relative_to("results").as_posix() + "/"
     for path in sorted(root.rglob("*.parquet")):
         key = path.relative_to(root).as_posix()
+        if key.startswith(crate):  # hard links of tables checked at their own paths
+            continue
         stamp = digest = None
         remembered = False
         if path.is_file() and recorded_digest(path) is not None:
@@ -175,6 +179,13 @@ def _read_digests(path: str | os.PathLike) -> dict[str, list]:
         }
     except (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError):
         return {}
+
+
+def cached_digests(path: str | os.PathLike) -> dict[str, list]:
+    """The digest cache at ``path`` as the table check left it: {table below results/: [size,
+    mtime_ns, inode, sha256]} (empty when missing or unreadable); entries vouch for a table only
+    while its size, mtime and inode match."""
+    return _read_digests(path)
 
 
 def _write_digests(path: Path, tables: dict[str, list]) -> None:

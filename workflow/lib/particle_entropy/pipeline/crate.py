@@ -1,0 +1,503 @@
+"""A finished run as a Workflow Run RO-Crate (results/ro-crate/), for a repository to ingest.
+
+The crate (https://w3id.org/ro/wfrun/provenance/0.5, built with the ``rocrate`` library) holds:
+
+- the workflow: the Snakefile as the crate's main entity, with its rule files and scripts, the git
+  commit it ran at and whether the tree was dirty;
+- the config as run (``config.yaml`` merged with every ``--configfile`` and ``--config``), with its
+  SHA-256;
+- the software: requirements.lock, Python and the versions of the key packages;
+- one action per recorded job (Snakemake's own metadata, ``.snakemake/metadata``): its rule, inputs
+  and outputs with SHA-256, start and end time, and the code hash the rule's ``code`` parameter
+  carries (pipeline/codeversion.py), grouped per rule as the Provenance Run Crate asks (a HowToStep
+  and a tool per rule, a ControlAction per job, one OrganizeAction for the run);
+- the paper the run reproduces (its DOI) and CITATION.cff.
+
+Every data file is hard-linked into the crate (copied where a link cannot be made), so a crate of a
+paper run costs no space; tables are hashed from the run's digest cache where it vouches for them
+(pipeline/verify.py), so building a crate reads no table twice. ``verify_crate`` checks a crate's
+files against the digests it records.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import os
+import platform
+import re
+import shutil
+import subprocess
+import warnings
+from collections import defaultdict
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+import yaml
+
+from .verify import CRATE_DIR, cached_digests, file_sha256, recorded_digest
+
+RO_CRATE_VERSION = "1.1"  # the version the Workflow Run Crate profiles 0.5 build on
+SHA256_TERM = "https://w3id.org/ro/terms/workflow-run#sha256"  # the profiles' digest property
+METADATA = "ro-crate-metadata.json"
+CONFIG_AS_RUN = "config-as-run.yaml"
+PROFILES = {  # the profiles the crate conforms to (versioned permalinks)
+    "process": "https://w3id.org/ro/wfrun/process/0.5",
+    "workflow": "https://w3id.org/ro/wfrun/workflow/0.5",
+    "provenance": "https://w3id.org/ro/wfrun/provenance/0.5",
+    "workflow-ro-crate": "https://w3id.org/workflowhub/workflow-ro-crate/1.0",
+}
+KEY_PACKAGES = ("numpy", "scipy", "pandas", "pyarrow", "numba", "matplotlib", "snakemake", "rocrate")
+SNAKEMAKE_URL = "https://snakemake.github.io"
+DESCRIBED = ("figures/", "results/")  # the folders whose job outputs the crate holds
+
+
+@dataclass(frozen=True)
+class Job:
+    """One recorded rule execution (Snakemake's metadata of its outputs)."""
+
+    rule: str
+    start: float
+    end: float
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    code: str  # the code hash of the rule's ``code`` parameter ('' if it has none)
+    script: str = ""  # the rule's script below workflow/scripts ('' if it runs none)
+
+
+CODE_HASH = re.compile(r"'([0-9a-f]{16})'")  # a code_version hash as Snakemake records a param
+
+
+def recorded_jobs(workdir: Path, coded: Iterable[str]) -> list[Job]:
+    """Every job Snakemake recorded in ``workdir`` whose outputs still exist, once, in start order.
+    ``coded``: the rules with a ``code`` parameter; Snakemake records a job's params as sorted
+    text, without names, so the code hash is the one param of its form (codeversion.code_version:
+    16 hex digits), and '' where there is not exactly one."""
+    coded = set(coded)
+    folder = workdir / ".snakemake" / "metadata"
+    grouped: dict[tuple, dict] = {}
+    for entry in sorted(folder.iterdir()) if folder.is_dir() else []:
+        name = entry.name
+        output = base64.urlsafe_b64decode(name + "=" * (-len(name) % 4)).decode()
+        try:
+            record = json.loads(entry.read_bytes())
+        except (OSError, ValueError):
+            continue
+        if record.get("incomplete") or not (workdir / output).is_file():
+            continue
+        rule = record.get("rule", "")
+        params = record.get("params") or []
+        hashes = [m.group(1) for p in params if (m := CODE_HASH.fullmatch(str(p)))] if rule in coded else []
+        code = hashes[0] if len(hashes) == 1 else ""
+        key = (rule, record.get("endtime"), record.get("job_hash"))  # a job's outputs differ in start time
+        script = re.search(r"scripts/([\w.-]+\.py)", record.get("code") or "")
+        job = grouped.setdefault(
+            key,
+            {
+                "inputs": tuple(record.get("input") or ()),
+                "outputs": [],
+                "code": code,
+                "script": script.group(1) if script else "",
+                "start": float(record.get("starttime") or 0.0),
+            },
+        )
+        job["outputs"].append(output)
+        job["start"] = min(job["start"], float(record.get("starttime") or 0.0))
+    jobs = [
+        Job(rule, j["start"], float(end or 0.0), j["inputs"], tuple(sorted(j["outputs"])), j["code"], j["script"])
+        for (rule, end, _), j in grouped.items()
+    ]
+    return sorted(jobs, key=lambda j: (j.start, j.rule, j.outputs))
+
+
+class Digests:
+    """SHA-256 of files below a run folder: a table from the run's digest cache where its size,
+    mtime and inode still match (the table check has read it), anything else read once."""
+
+    def __init__(self, workdir: Path):
+        self.workdir = workdir
+        self.cache = cached_digests(workdir / ".snakemake" / "particle_entropy" / "table_digests.json")
+        self.reads = 0  # files read to hash them
+        self._known: dict[str, str] = {}
+
+    def __call__(self, rel: str) -> str:
+        if rel not in self._known:
+            path = self.workdir / rel
+            st = path.stat()
+            remembered = (
+                self.cache.get(Path(rel).relative_to("results").as_posix()) if rel.startswith("results/") else None
+            )
+            if remembered and remembered[:3] == [st.st_size, st.st_mtime_ns, st.st_ino]:
+                digest = remembered[3]
+            else:
+                digest = file_sha256(path)
+                self.reads += 1
+                want = recorded_digest(path) if rel.endswith(".parquet") else None
+                if want is not None and want != digest:
+                    raise ValueError(f"{rel}: its SHA-256 differs from the one recorded beside it; rerun the workflow")
+            self._known[rel] = digest
+        return self._known[rel]
+
+
+def git_state(folder: Path) -> tuple[str, bool | None]:
+    """(commit, dirty) of the checkout holding ``folder``: ('', None) outside git. Dirty: a tracked
+    file differs from the commit (untracked files such as results do not count)."""
+    try:
+        commit = subprocess.run(
+            ["git", "-C", str(folder), "rev-parse", "HEAD"], capture_output=True, text=True, check=True, timeout=30
+        ).stdout.strip()
+        status = subprocess.run(
+            ["git", "-C", str(folder), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=True,
+            timeout=60,
+        ).stdout
+    except (OSError, subprocess.SubprocessError):
+        return "", None
+    return commit, bool(status.strip())
+
+
+def config_text(config: Mapping) -> str:
+    """The config as run, as YAML with sorted keys: the text whose digest names it."""
+    return yaml.safe_dump(json.loads(json.dumps(config, default=str)), sort_keys=True)
+
+
+def config_digest(config: Mapping) -> str:
+    """SHA-256 of config_text(config)."""
+    return hashlib.sha256(config_text(config).encode()).hexdigest()
+
+
+def _place(source: Path, target: Path) -> None:
+    """Put ``source`` at ``target``: a hard link, else a copy (another file system)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if target.exists() or target.is_symlink():
+        target.unlink()
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+def _when(seconds: float) -> str:
+    return datetime.fromtimestamp(seconds, UTC).isoformat(timespec="seconds")
+
+
+def _paper(citation: Mapping) -> dict | None:
+    """The article CITATION.cff cites (its DOI) as a ScholarlyArticle."""
+    for ref in citation.get("references") or []:
+        if ref.get("doi"):
+            authors = ", ".join(
+                f"{a.get('given-names', '')} {a.get('family-names', '')}".strip() for a in ref["authors"]
+            )
+            return {
+                "@id": f"https://doi.org/{ref['doi']}",
+                "@type": "ScholarlyArticle",
+                "name": ref.get("title", ""),
+                "author": authors,
+                "datePublished": str(ref.get("year", "")),
+                "publisher": ref.get("journal", ""),
+                "identifier": f"https://doi.org/{ref['doi']}",
+            }
+    return None
+
+
+def build_crate(
+    workdir: str | os.PathLike,
+    checkout: str | os.PathLike,
+    config: Mapping,
+    coded: Iterable[str],
+    out: str | os.PathLike = CRATE_DIR,
+    progress=lambda line: None,
+) -> dict:
+    """Write the crate of the finished run in ``workdir`` (code from ``checkout``, the config as run,
+    ``coded``: the rules with a ``code`` parameter) into ``out``; returns a summary (files, jobs,
+    files read to hash them)."""
+    from rocrate.model.contextentity import ContextEntity
+    from rocrate.rocrate import ROCrate
+
+    workdir, checkout = Path(workdir).resolve(), Path(checkout).resolve()
+    out = (workdir / out).resolve()
+    if out.exists():
+        shutil.rmtree(out)
+    out.mkdir(parents=True)
+    digests = Digests(workdir)
+    jobs = [j for j in recorded_jobs(workdir, coded) if any(o.startswith(DESCRIBED) for o in j.outputs)]
+    progress(f"crate: {len(jobs)} recorded jobs")
+
+    crate = ROCrate(version=RO_CRATE_VERSION)
+    crate.metadata.extra_terms["sha256"] = SHA256_TERM
+    crate.name = "particle-entropy: a run of the workflow"
+    crate.description = (
+        "Every figure and table of a run of the particle-entropy workflow, with the jobs that made them."
+    )
+    crate.license = "https://spdx.org/licenses/MIT"
+    crate.root_dataset["datePublished"] = _when(max((j.end for j in jobs), default=0.0))
+    profiles = [
+        crate.add(ContextEntity(crate, uri, {"@type": "CreativeWork", "name": key, "version": uri.rsplit("/", 1)[-1]}))
+        for key, uri in PROFILES.items()
+    ]
+    crate.root_dataset["conformsTo"] = profiles
+
+    files: dict[str, object] = {}
+
+    def data(rel: str, source: Path | None = None, kind: str | list = "File", **props):
+        """The crate's File entity for ``rel`` (a path below the run), placed in the crate once."""
+        if rel not in files:
+            src = source if source is not None else workdir / rel
+            _place(src, out / rel)
+            props.setdefault("sha256", digests(rel) if source is None else file_sha256(src))
+            props.setdefault("contentSize", str(src.stat().st_size))
+            with warnings.catch_warnings():  # the file is placed here, not copied by the library
+                warnings.simplefilter("ignore", UserWarning)
+                files[rel] = crate.add_file(None, dest_path=rel, properties={"@type": kind, **props})
+        return files[rel]
+
+    # the workflow, its rules and scripts, as they were in the checkout
+    commit, dirty = git_state(checkout)
+    rules = sorted((checkout / "workflow" / "rules").glob("*.smk"))
+    scripts = sorted((checkout / "workflow" / "scripts").glob("*.py"))
+    for p in rules + scripts:  # the rule files and scripts, as they were in the checkout
+        data(p.relative_to(checkout).as_posix(), p, kind=["File", "SoftwareSourceCode"])
+    snakefile = checkout / "Snakefile"
+    _place(snakefile, out / "Snakefile")
+    workflow = crate.add_workflow(
+        None,
+        dest_path="Snakefile",
+        main=True,
+        lang="snakemake",
+        properties={
+            "@type": ["File", "SoftwareSourceCode", "ComputationalWorkflow", "HowTo"],  # HowTo: it has steps
+            "name": "particle-entropy workflow",
+            "sha256": file_sha256(snakefile),
+            "version": commit or "unknown",
+        },
+    )
+    state = crate.add(
+        ContextEntity(
+            crate,
+            "#git",
+            {
+                "@type": "PropertyValue",
+                "name": "git checkout of the workflow",
+                "propertyID": "git",
+                "value": f"commit {commit or 'unknown'}; "
+                + {True: "dirty (tracked files differ from the commit)", False: "clean", None: "not a git checkout"}[
+                    dirty
+                ],
+            },
+        )
+    )
+    workflow["identifier"] = state
+
+    # the config as run, the lock file, the citation
+    (out / CONFIG_AS_RUN).write_text(config_text(config))
+    config_file = crate.add_file(
+        None,
+        dest_path=CONFIG_AS_RUN,
+        properties={"name": "the config as run", "sha256": config_digest(config), "encodingFormat": "application/yaml"},
+    )
+    lock = data("requirements.lock", checkout / "requirements.lock", name="the pinned environment")
+    citation_path = checkout / "CITATION.cff"
+    citation = data("CITATION.cff", citation_path, name="how to cite")
+    paper = _paper(yaml.safe_load(citation_path.read_text()) or {})
+    if paper:
+        article = crate.add(ContextEntity(crate, paper.pop("@id"), paper))
+        crate.root_dataset["citation"] = article
+        workflow["citation"] = article
+
+    software = [
+        crate.add(
+            ContextEntity(
+                crate,
+                f"#software-{name}",
+                {"@type": "SoftwareApplication", "name": name, "softwareVersion": _version(name)},
+            )
+        )
+        for name in KEY_PACKAGES
+    ]
+    python = crate.add(
+        ContextEntity(
+            crate,
+            "#python",
+            {"@type": "SoftwareApplication", "name": "Python", "softwareVersion": platform.python_version()},
+        )
+    )
+    engine = crate.add(
+        ContextEntity(
+            crate,
+            "#snakemake",
+            {
+                "@type": "SoftwareApplication",
+                "name": "Snakemake",
+                "url": SNAKEMAKE_URL,
+                "softwareVersion": _version("snakemake"),
+            },
+        )
+    )
+    workflow["softwareRequirements"] = [python, *software]
+
+    # formal parameters: the config in, each figure out
+    config_param = crate.add(
+        ContextEntity(
+            crate,
+            "#param-config",
+            {"@type": "FormalParameter", "name": "config", "additionalType": "File", "workExample": config_file},
+        )
+    )
+    config_file["exampleOfWork"] = config_param
+    figures = sorted({o for j in jobs for o in j.outputs if o.startswith("figures/")})
+    out_params = []
+    for rel in figures:
+        entity = data(rel, name=Path(rel).name)
+        param = crate.add(
+            ContextEntity(
+                crate,
+                f"#param-{rel}",
+                {"@type": "FormalParameter", "name": rel, "additionalType": "File", "workExample": entity},
+            )
+        )
+        entity["exampleOfWork"] = param
+        out_params.append(param)
+    workflow["input"] = [config_param]
+    workflow["output"] = out_params
+
+    # per rule a tool and a step; per job a CreateAction and a ControlAction
+    tools, steps = {}, {}
+    script_of = {j.rule: j.script for j in jobs}
+    for position, rule in enumerate(sorted(script_of)):
+        tool = {"@type": "SoftwareApplication", "name": f"rule {rule}"}
+        script = f"workflow/scripts/{script_of[rule]}"
+        if script_of[rule] and script in files:
+            tool["hasPart"] = files[script]  # the rule's script, as it was in the checkout
+        tools[rule] = crate.add(ContextEntity(crate, f"#rule-{rule}", tool))
+        steps[rule] = crate.add(
+            ContextEntity(
+                crate,
+                f"#step-{rule}",
+                {"@type": "HowToStep", "name": rule, "position": str(position), "workExample": tools[rule]},
+            )
+        )
+    workflow["hasPart"] = list(tools.values())  # the tools it orchestrates: one per rule that ran
+    workflow["step"] = list(steps.values())
+
+    controls = []
+    by_rule: dict[str, int] = defaultdict(int)
+    for k, job in enumerate(jobs):
+        by_rule[job.rule] += 1
+        inputs = [data(i) for i in job.inputs if (workdir / i).is_file() and not i.startswith(CRATE_DIR)]
+        outputs = [data(o) for o in job.outputs]
+        props = {
+            "name": f"{job.rule} #{by_rule[job.rule]}",
+            "startTime": _when(job.start),
+            "endTime": _when(job.end),
+            "actionStatus": "http://schema.org/CompletedActionStatus",
+        }
+        if job.code:
+            props["description"] = f"code hash {job.code}"
+        action = crate.add_action(
+            tools[job.rule], identifier=f"#job-{k}", object=inputs, result=outputs, properties=props
+        )
+        controls.append(
+            crate.add(
+                ContextEntity(
+                    crate,
+                    f"#control-{k}",
+                    {"@type": "ControlAction", "name": props["name"], "instrument": steps[job.rule], "object": action},
+                )
+            )
+        )
+        if (k + 1) % 200 == 0:
+            progress(f"crate: {k + 1} of {len(jobs)} jobs described")
+
+    run = crate.add_action(
+        workflow,
+        identifier="#run",
+        object=[config_file, lock],
+        result=[files[r] for r in figures],
+        properties={
+            "name": "the workflow run",
+            "startTime": _when(min((j.start for j in jobs), default=0.0)),
+            "endTime": _when(max((j.end for j in jobs), default=0.0)),
+            "actionStatus": "http://schema.org/CompletedActionStatus",
+        },
+    )
+    crate.add(
+        ContextEntity(
+            crate,
+            "#organize",
+            {
+                "@type": "OrganizeAction",
+                "name": "Snakemake's run",
+                "instrument": engine,
+                "object": controls,
+                "result": run,
+            },
+        )
+    )
+    crate.root_dataset["mentions"] = [run]
+    crate.root_dataset["about"] = citation
+    with warnings.catch_warnings():  # the files are placed already: nothing for the library to copy
+        warnings.simplefilter("ignore", UserWarning)
+        crate.write(out)
+    return {"files": len(files) + 2, "jobs": len(jobs), "hashed": digests.reads, "path": str(out)}
+
+
+def _version(name: str) -> str:
+    try:
+        return version(name)
+    except PackageNotFoundError:
+        return "not installed"
+
+
+def verify_crate(folder: str | os.PathLike) -> list[str]:
+    """What is wrong with the crate in ``folder``: each file it describes with a SHA-256 must exist
+    there and have that digest. [] when all hold."""
+    folder = Path(folder)
+    graph = json.loads((folder / METADATA).read_text())["@graph"]
+    problems = []
+    for entity in graph:
+        digest = entity.get("sha256")
+        if not digest:
+            continue
+        path = folder / entity["@id"]
+        if not path.is_file():
+            problems.append(f"{entity['@id']}: missing")
+        elif file_sha256(path) != digest:
+            problems.append(f"{entity['@id']}: its SHA-256 differs from the crate's record")
+    return problems
+
+
+def described(folder: str | os.PathLike) -> Iterable[str]:
+    """The ids of every File the crate in ``folder`` describes."""
+    graph = json.loads((Path(folder) / METADATA).read_text())["@graph"]
+    return [e["@id"] for e in graph if "File" in (e["@type"] if isinstance(e["@type"], list) else [e["@type"]])]
+
+
+_GIT: dict[str, tuple[str, bool | None]] = {}
+
+
+def provenance(figure: str, rule: str, module: str, data: str, config: Mapping, checkout) -> dict[str, str]:
+    """Where a figure came from, for its entry in the report (as showyourwork's margins): the
+    commit (and whether the tree was dirty), the config's digest, its rule and module, its source
+    data table and that table's SHA-256 as recorded beside it."""
+    key = str(checkout)
+    if key not in _GIT:
+        _GIT[key] = git_state(Path(checkout))
+    commit, dirty = _GIT[key]
+    recorded = recorded_digest(data) if data.endswith(".parquet") else None
+    if recorded is None:
+        recorded = file_sha256(data) if Path(data).is_file() else "not made yet"
+    return {
+        "figure": figure,
+        "commit": (commit[:12] or "not a git checkout") + (" (dirty)" if dirty else ""),
+        "config sha256": config_digest(config)[:16],
+        "rule": rule,
+        "module": module,
+        "source data": data,
+        "source sha256": recorded[:16],
+    }

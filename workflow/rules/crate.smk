@@ -1,0 +1,21 @@
+# A finished run as a Workflow Run RO-Crate (pipeline/crate.py), for a repository to ingest:
+# `snakemake -j2 crate` completes the default target, then writes results/ro-crate/. Not part of
+# the default target.
+
+
+rule crate:
+    input:
+        all_targets(),
+    output:
+        directory(CRATE_DIR),
+    log:
+        "logs/crate.log",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        checkout=workflow.basedir,
+        coded=lambda w: coded_rules(workflow.rules),
+        code=CRATE_CODE,
+    script:
+        "../scripts/crate.py"
