@@ -4,8 +4,8 @@ Beside each table a ``<name>.sha256`` file records the SHA-256 of its bytes (io.
 ``corrupt_tables`` finds every table whose bytes no longer match (a truncation, a flipped bit,
 an empty file) so that the workflow can set it aside and rebuild it. Given a digests file, it
 remembers each table's SHA-256 against the table's size, mtime and inode (as DVC does) and reads
-a table again only when one of them changed. Only the workflow's main process imports this
-module, never a job, so editing it reruns no rule.
+a table again only when one of them changed. Only the workflow's main process and the crate
+job (pipeline/crate.py) import this module, so editing it reruns no rule but `crate`.
 """
 
 from __future__ import annotations
