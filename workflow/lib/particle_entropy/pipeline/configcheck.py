@@ -36,7 +36,8 @@ class ConfigFileError(ValueError):
 MAX_CONFIG_BYTES = 1_000_000  # a config file is read only up to this size: config.yaml is ~20 kB
 MAX_VALUES = 100_000  # values a file may hold once its aliases are expanded: config.yaml has ~2,000
 MAX_DEPTH = 40  # nesting levels of mappings and lists: config.yaml has 6
-MESSAGE_CHARS = 300  # a value or an allowed text longer than this is abbreviated in a message
+MESSAGE_CHARS = 300  # a value (or a quoted schema message) longer than this is abbreviated in a message
+ALLOWED_CHARS = 1000  # the allowed text: a schema description (the longest ~400) and a hint
 _MERGE_TAG = "tag:yaml.org,2002:merge"
 _OCTAL_1_1 = re.compile(r"[-+]?0[0-7]+")  # YAML 1.1 octal (0-prefixed); 1.2's 0o17 is text to YAML 1.1
 
@@ -60,8 +61,8 @@ def _clip(text: str, limit: int = MESSAGE_CHARS) -> str:
 
 
 def bounded(error: SettingError) -> SettingError:
-    """``error`` with its value and allowed text abbreviated: a message of at most ~2 x MESSAGE_CHARS."""
-    value, allowed = _short(error.value, MESSAGE_CHARS), _clip(error.allowed)
+    """``error`` with its name, value and allowed text abbreviated: at most ~1,600 characters."""
+    value, allowed = _short(error.value, MESSAGE_CHARS), _clip(error.allowed, ALLOWED_CHARS)
     if value is error.value and allowed == error.allowed and len(error.name) <= MESSAGE_CHARS:
         return error
     return SettingError(_clip(error.name), value, allowed)
@@ -371,9 +372,10 @@ def _schema_error_to_setting(error) -> SettingError:
             key_path([*path, key]), "(missing)", "a required key" + (f": {described}" if described else "")
         )
     described = schema.get("description", "")
-    allowed = f"{described} ({error.message})" if described else error.message
+    message = _clip(error.message)  # it quotes the value
+    allowed = f"{described} ({message})" if described else message
     if error.validator in ("type", "oneOf"):
-        allowed = _clip(allowed) + _number_hint(error.instance, schema)
+        allowed += _number_hint(error.instance, schema)
     return SettingError(key_path(path), _short(error.instance), allowed)
 
 
