@@ -100,28 +100,35 @@ def build_parser() -> argparse.ArgumentParser:
         help="check workflow config files as a dry run would, with YAML line numbers",
         description="Check one or more workflow config files, merged in order as Snakemake merges "
         "config.yaml and --configfile: YAML syntax (line and column), the schema and every rule "
-        "between fields. Exit 0 when the workflow would accept them, 2 otherwise.",
+        "between fields. Exit 0 when the workflow would accept them, 2 otherwise. An adaptive "
+        "search or a scene is judged, as by the run, only for its own targets: one that they would "
+        "refuse is named on a line of its own, not judged against the rest. Only regular files of "
+        "at most 1 MB are read.",
     )
     c.add_argument("files", nargs="+", help="YAML config files, later ones overriding earlier ones")
     return p
 
 
 def check_config_files(files: list[str]) -> int:
-    """The check-config command: merge the files, check them, print one line."""
+    """The check-config command: merge the files, check them as the run would, print one line (and
+    one line for each search or scene that only its own targets would refuse)."""
     from snakemake.utils import update_config
 
     from .pipeline.configcheck import ConfigFileError, check_config, load_yaml
     from .pipeline.memory import available_bytes
 
     config: dict = {}
+    not_judged: list[str] = []
     try:
         for f in files:
             update_config(config, dict(load_yaml(f)))
-        check_config(config, available=available_bytes())  # the dry run's checks, memory on this machine too
+        check_config(config, available=available_bytes(), not_judged=not_judged)  # the dry run's checks
     except (ConfigFileError, SettingError, OSError) as e:
         print(f"check-config: {e}", file=sys.stderr)
         return 2
     print(f"check-config: {' + '.join(files)}: accepted")
+    for line in not_judged:
+        print(f"check-config: {line}")
     return 0
 
 
