@@ -17,7 +17,9 @@ from particle_entropy.pipeline.configcheck import check_schema, load_schema, ret
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 retype_overrides(config, workflow.config_settings.config)  # --config physics={D: 0.002}: a number
-check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
+# the merged config (config.yaml, --configfile, --config): one short message naming the key path; an
+# integer is an int, so --config base_seed=1e3 (1000.0 to Snakemake) is refused, not run as seeds~1000.0
+check_schema(config, load_schema(SCHEMA))
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
