@@ -134,3 +134,33 @@ def test_the_lattice_size_is_bounded_by_the_schema_and_memory(n, available, expe
         check_config(cfg, available=available)
     assert str(err.value).startswith(f"mechanism.lattice.n={n} is not allowed: ") and expected in str(err.value)
     check_config(BASE, available=8e9)  # the shipped lattice (3,001) fits
+
+
+def test_fig9_titles_lie_inside_the_figure_with_seven_models():
+    """Before: with seven models, panel (e)'s title ran past the figure's right edge. Every
+    title's drawn extent (and its wrapped lines) now lies inside its panel and the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from test_plots import draw
+
+    from particle_entropy.core.case import Case
+
+    families = [
+        ("collision", 1.0, 1.05),
+        ("sph", 1.0, 1.05),
+        ("collision", 0.333333333, 1.0123456789),  # panel (e): the longest label, in the right column
+        ("collision", 0.25, 1.0123),
+        ("sph", 0.75, 1.0125),
+        ("collision", 0.125, 1.001),
+        ("sph", 0.5, 1.2),
+    ]
+    cases = [Case("mtpt", k, n, eta=e, dt_growth=g) for k, e, g in families for n in (30, 100, 300)]
+    figure, _ = draw("fig9", cases)
+    FigureCanvasAgg(figure).draw()
+    renderer, page = figure.canvas.get_renderer(), figure.bbox
+    titles = [(ax, t) for ax in figure.axes if ax.get_visible() for t in (ax.title, ax._left_title) if t.get_text()]
+    assert len(titles) == 14  # a COMIC panel and a share panel per model
+    for ax, title in titles:
+        box, room = title.get_window_extent(renderer), ax.get_window_extent(renderer)
+        inside = page.x0 - 0.5 <= box.x0 and box.x1 <= page.x1 + 0.5 and page.y0 <= box.y0 and box.y1 <= page.y1
+        assert inside and box.x1 <= room.x1 + 0.5, (title.get_text(), box, room, page)
+    assert any("\n" in t.get_text() for _, t in titles)  # the long ones were wrapped, not dropped

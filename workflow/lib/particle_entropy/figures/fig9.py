@@ -21,6 +21,7 @@ from .style import (
     SPH,
     Series,
     distinct_models,
+    fit_titles,
     draw,
     mark_missing,
     mark_no_data,
@@ -245,4 +246,5 @@ def fig9(tables, cases, *, D: float, t_final: float, bars: str = "eq43"):
     for ax, bar_ax in list(zip(tops, bottoms, strict=True))[len(families) :]:
         ax.set_visible(False)
         bar_ax.set_visible(False)
+    fit_titles(fig)  # seven families' titles with their time ran past the panel's edge
     return fig, source_table("fig9", out)
