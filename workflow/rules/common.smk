@@ -17,9 +17,7 @@ from particle_entropy.pipeline.configcheck import check_schema, load_schema, ret
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 retype_overrides(config, workflow.config_settings.config)  # --config physics={D: 0.002}: a number
-# the merged config (config.yaml, --configfile, --config): one short message naming the key path; an
-# integer is an int, so --config base_seed=1e3 (1000.0 to Snakemake) is refused, not run as seeds~1000.0
-check_schema(config, load_schema(SCHEMA))
+check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
