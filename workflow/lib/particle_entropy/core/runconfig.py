@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -13,7 +14,7 @@ from .case import DEFAULT, Case, SettingError, check_range
 from .reference import Reference, Source
 from .registry import DEFAULT_KERNEL
 from .settings import BY_NAME, MAX_SEED, PAPER, Setting
-from .timegrid import MAX_STEPS, max_first_step, step_count
+from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
 PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
 ADVECTION_SCHEMES = ("upwind", "central")  # FD's advection term (models/fd.py)
@@ -33,6 +34,80 @@ def check_setting(setting: Setting, value):
             raise SettingError(setting.name, value, setting.allowed())
         return value
     return check_range(setting.name, value, setting.low, setting.high, open_low=setting.open_low)
+
+
+# The widest reconstruction grid a run may build (models/pt.kernel_grid: spacing min(0.1, spread / 4,
+# h / 2), the bins Omega / N), as MAX_STEPS bounds the steps: 800 MB an array; the plume a grid
+# must hold is the source and PLUME_SIGMAS standard deviations either side of it.
+MAX_GRID_POINTS = 100_000_000
+GRID_SPACING = 0.1
+PLUME_SIGMAS = 8.0
+
+
+def plume_span(cfg: RunConfig) -> float:
+    """The width a run's particles spread over by t_final: the source's extent plus PLUME_SIGMAS
+    sqrt(2 D t_final) either side [L]."""
+    return 2.0 * (cfg.source.half_width + PLUME_SIGMAS * math.sqrt(2.0 * cfg.D * cfg.t_final))
+
+
+def check_arithmetic(cfg: RunConfig) -> None:
+    """Refuse finite settings whose derived widths, variances or grids overflow or underflow, by
+    name with the range allowed at the other settings: each variance 2 D t (t_final, dt0, and
+    the fixed kernel's time) a normal float, the plume within a grid of MAX_GRID_POINTS at
+    spacing GRID_SPACING (t_final), and the fixed kernel's grid within MAX_GRID_POINTS too."""
+    tiny = sys.float_info.min
+    times = ["t_final", "dt0"] + (["fixed_kernel_time"] if (cfg.method, cfg.kernel) == ("pt", "fixed") else [])
+    for name in times:
+        t = getattr(cfg, name)
+        variance = 2.0 * cfg.D * t
+        if not math.isfinite(4.0 * math.pi * math.e * variance):  # E = sqrt(2 pi e variance)
+            raise SettingError("D", cfg.D, f"a number with 2 D {name} finite ({name} = {t:g})")
+        if variance < tiny:  # a subnormal (or zero) variance: 1 / sqrt(variance) overflows
+            raise SettingError(
+                name,
+                t,
+                f"a number with 2 D {name} a normal float (>= {tiny:.3g}): >= {tiny / (2 * cfg.D):.3g} "
+                f"for D = {cfg.D:g}",
+            )
+    widest = MAX_GRID_POINTS * GRID_SPACING
+    span = plume_span(cfg)
+    if span > widest:
+        room = (widest / 2.0 - cfg.source.half_width) / PLUME_SIGMAS
+        raise SettingError(
+            "t_final",
+            cfg.t_final,
+            f"a number in (0, {room * room / (2.0 * cfg.D):.6g}] for D = {cfg.D:g}: a plume 2 x {PLUME_SIGMAS:g} "
+            f"sqrt(2 D t_final) wide at most {widest:g}, the {MAX_GRID_POINTS:,} points of a grid at spacing "
+            f"{GRID_SPACING:g} (this one {span:.3g})",
+        )
+    if (cfg.method, cfg.kernel) == ("pt", "fixed"):
+        _check_kernel_grid(cfg, span)
+
+
+def _check_kernel_grid(cfg: RunConfig, span: float) -> None:
+    """The fixed kernel's grid (models/pt.kernel_grid: the plume plus 6 h either side, at spacing
+    at least min(0.1, h / 4)) within MAX_GRID_POINTS: h = sqrt(2 D fixed_kernel_time) neither so
+    narrow that the spacing h / 4 needs more, nor so wide that its 12 h at spacing 0.1 do."""
+    h = math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
+    points = (span + 12.0 * h) / min(GRID_SPACING, h / 4.0)
+    if points > MAX_GRID_POINTS:
+        h_lo = 4.0 * span / (MAX_GRID_POINTS - 48.0)  # (span + 12 h) / (h / 4) = MAX_GRID_POINTS
+        h_hi = (MAX_GRID_POINTS * GRID_SPACING - span) / 12.0  # (span + 12 h) / 0.1 = MAX_GRID_POINTS
+        if h_lo > h_hi:  # no kernel fits: the plume itself is too wide for the grid
+            raise SettingError(
+                "t_final",
+                cfg.t_final,
+                f"a plume 2 x {PLUME_SIGMAS:g} sqrt(2 D t_final) = {span:.3g} that a fixed kernel's grid of at most "
+                f"{MAX_GRID_POINTS:,} points holds at spacing h / 4 <= {GRID_SPACING:g} (D = {cfg.D:g})",
+            )
+        lo, hi = h_lo * h_lo / (2.0 * cfg.D), h_hi * h_hi / (2.0 * cfg.D)
+        raise SettingError(
+            "fixed_kernel_time",
+            cfg.fixed_kernel_time,
+            f"a number in [{lo:.3g}, {hi:.3g}] for D = {cfg.D:g}, t_final = {cfg.t_final:g}: a kernel "
+            f"sqrt(2 D fixed_kernel_time) whose grid has at most {MAX_GRID_POINTS:,} points "
+            f"(this one about {points:.3g})",
+        )
 
 
 def first_step_key(method: str, dt_growth: float) -> str:
@@ -176,8 +251,10 @@ class RunConfig:
                 "dt0",
                 self.dt0,
                 f"a first step reaching t_final = {self.t_final:g} in at most {MAX_STEPS:,} steps with dt_growth = "
-                f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
+                f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} "
+                f"(this one needs {count_text(steps)})",
             )
+        check_arithmetic(self)
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
         check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
         if not isinstance(self.source, Source):

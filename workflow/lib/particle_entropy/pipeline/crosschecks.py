@@ -161,12 +161,15 @@ def optimum_largest_jobs(search) -> list[Ensemble]:
 
 def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
-    of its seed block; the shear jobs: shear_memory_mb; an adaptive search's jobs: check_search)."""
+    of its seed block; each run of the lattice floors; the shear jobs: shear_memory_mb; an adaptive
+    search's jobs: check_search)."""
     jobs = [
         (f"{name}.n", ens, block_size(ens, config))
         for name, spec in case_sections(config).items()
         for ens in spec_ensembles(spec, config)
     ]
+    # the floors job runs its lattice cases one after another in one process: each must fit
+    jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(config)]
     _check_jobs_fit(jobs, config, available)
     if "shear" in config:
         need = shear_memory_mb(config) * 2**20
