@@ -25,7 +25,15 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
 from particle_entropy.numerics.compiled import kernels_folder
-from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, TableError, set_aside_corrupt
+from particle_entropy.pipeline.verify import (
+    CORRUPT_SUFFIX,
+    TableError,
+    folder_problems,
+    numba_cache_folders,
+    numba_cache_problem,
+    set_aside_corrupt,
+    tables_below,
+)
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
@@ -74,15 +82,16 @@ def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemak
     moved to <name>.corrupt before the DAG is built. The default target rebuilds every table set
     aside and not yet rebuilt, so a dry run in between loses nothing. ``look_only`` (a dry run):
     read no table and move none, only name those set aside before. ``digests``: each table's
-    SHA-256 against its size, mtime and inode (verify.corrupt_tables), so a table is reread only when
-    it changed; beside Snakemake's own state, not in results/, which may be copied elsewhere.
-    Deleting it makes the next run read every table."""
+    SHA-256 against its size, mtime, inode and ctime (verify.corrupt_tables), so a table is reread
+    only when it changed; beside Snakemake's own state, not in results/, which may be copied
+    elsewhere. Deleting it makes the next run read every table. Folders linked under ``root`` are
+    followed (results/runs on another disk), each once (verify.tables_below)."""
     if not look_only:
         try:
             set_aside_corrupt(root, digests, named_columns, report=lambda line: print(line, file=sys.stderr))
         except TableError as e:  # a read-only results/: one line, and stop
             raise WorkflowError(str(e)) from None
-    aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
+    aside = tables_below(root, f".parquet{CORRUPT_SUFFIX}")
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     return sorted(m for m in missing if not Path(m).exists())
 
@@ -129,6 +138,20 @@ def looks_only():
     return DRY_RUN or runs_no_job(snakemake_options(sys.argv)) or (locks.is_dir() and any(locks.iterdir()))
 
 
+def check_writable(look_only):
+    """Stop in one line, before any job, where this run cannot write what it must: .snakemake/
+    (every invocation: Snakemake keeps its state there), and for a run of jobs results/ and, run
+    here, numba's cache of compiled kernels (verify.numba_cache_folders; a cluster node has its
+    own). Else every job fails on a traceback or an empty log."""
+    problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
+    if not look_only and workflow.local_exec:
+        problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
+    if problems:
+        raise WorkflowError("\n".join(problems))
+
+
+if workflow.is_main_process:
+    check_writable(looks_only())
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
 
 

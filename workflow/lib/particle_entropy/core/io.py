@@ -5,6 +5,8 @@ renamed over the target, and the folder is flushed too, so a crash or power cut 
 file or the new one, never part of one. Beside each table a ``<name>.sha256`` file records the
 SHA-256 of its bytes (verify.py checks them before a run). Only regular files are ever replaced:
 an existing directory, device or pipe at the target is refused.
+
+Tables are read back with ``read_parquet``, which checks every page it reads against its CRC.
 """
 
 from __future__ import annotations
@@ -127,3 +129,57 @@ def write_parquet(df: pd.DataFrame | pa.Table, path: str | os.PathLike) -> None:
 def checksum_path(path: str | os.PathLike) -> Path:
     path = Path(path)
     return path.with_name(path.name + CHECKSUM_SUFFIX)
+
+
+# --------------------------------------------------------------------------- reading
+class TableReadError(ValueError):
+    """A table a job cannot use (a page that fails its checksum, a truncated file, an unreadable
+    disk block); the one-line message names it and what happens next."""
+
+
+def read_parquet(path: str | os.PathLike, columns: list[str] | None = None) -> pd.DataFrame:
+    """The table at ``path`` as pd.read_parquet gives it, every page read checked against the CRC32
+    in its header (write_parquet writes one per page): a table changed on the disk after it was
+    written fails here instead of giving other numbers. A table that fails raises TableReadError
+    naming it; its change time (ctime) is moved, its other times kept (``_mark_changed``), so that
+    the workflow's digest cache (verify.corrupt_tables), which vouches for a table only while its
+    ctime holds, hashes it again at the next run and sets it aside."""
+    import pandas as pd
+
+    try:
+        return pd.read_parquet(path, columns=columns, page_checksum_verification=True)
+    except (OSError, pa.ArrowException) as e:
+        if isinstance(e, OSError) and (e.errno is not None or type(e) is not OSError):  # missing, no access, EIO
+            why = e.strerror or {FileNotFoundError: "No such file", PermissionError: "Permission denied"}.get(type(e))
+            raise TableReadError(f"cannot read table {path}: {why or type(e).__name__}") from None
+        reason = " ".join(str(e).split())[:200]
+        if not _mark_changed(path):
+            raise TableReadError(f"corrupt table {path}: {reason}; delete it and rerun to rebuild it") from None
+        raise TableReadError(f"corrupt table {path}: {reason}; the next run sets it aside and rebuilds it") from None
+
+
+def _mark_changed(path: str | os.PathLike) -> bool:
+    """Set the times of ``path`` to what they are: its content and mtime stay (Snakemake sees no
+    change), its ctime moves to now. -> whether that could be done (the file's owner)."""
+    try:
+        st = os.stat(path)
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+    except OSError:
+        return False
+    return True
+
+
+def exit_on_table_errors() -> None:
+    """Make an uncaught TableReadError end this process (a Snakemake job's script) with its one-line
+    message on stderr and exit status 1, not a traceback; every other error is shown as before."""
+    import sys
+
+    previous = sys.excepthook
+
+    def hook(kind, value, tb):
+        if issubclass(kind, TableReadError):
+            print(value, file=sys.stderr)
+        else:
+            previous(kind, value, tb)
+
+    sys.excepthook = hook
