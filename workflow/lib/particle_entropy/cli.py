@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
 
 from .core.case import NONE, from_text
@@ -148,11 +149,45 @@ def _same_file(a: str, b: str) -> bool:
         return False
 
 
+class Stopped(Exception):
+    """SIGTERM, raised where the run is (as SIGINT raises KeyboardInterrupt), so that it ends as SIGINT does."""
+
+
+def _stop(signum, frame):
+    raise Stopped(signum)
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     a = parser.parse_args(argv)
     if a.command == "check-config":
         return check_config_files(a.files)
+    before = _identity(a.out)
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        return simulate(parser, a)
+    except (KeyboardInterrupt, Stopped) as e:
+        # one line, no traceback; exit 128 + the signal's number, as a shell reports a process it ended
+        signum = e.args[0] if isinstance(e, Stopped) else signal.SIGINT
+        outputs = " and ".join(flag for flag, target in (("--out", a.out), ("--state-out", a.state_out)) if target)
+        written = _identity(a.out) != before  # a new table is a new file (io: renamed into place)
+        what = f"{outputs} written" if written else f"nothing written ({outputs} as they were)"
+        print(f"simulate: stopped by {signal.Signals(signum).name}; {what}", file=sys.stderr)
+        return 128 + signum
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _identity(path: str) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_mtime_ns
+
+
+def simulate(parser: argparse.ArgumentParser, a: argparse.Namespace) -> int:
+    """The simulate command, after its arguments are parsed."""
     try:
         cfg = config_from_args(a)
     except SettingError as e:
@@ -179,15 +214,16 @@ def main(argv=None) -> int:
             "lower --n or take fewer, longer steps (--dt0, --dt-growth)"
         )
     from .core.heap import keep_freed_pages
-    from .core.io import write_parquet
+    from .core.io import write_parquet, write_run
     from .models.simulate import run
 
     keep_freed_pages()  # steps reuse the pages of the last step's arrays
     progress = None if a.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))
     table, state = run(cfg, progress=progress, want_state=a.state_out is not None)
-    write_parquet(table, a.out)
-    if state is not None:
-        write_parquet(state, a.state_out)
+    if state is None:
+        write_parquet(table, a.out)
+    else:  # one run's pair: named by a run id in each, so tables of two runs are never taken for one
+        write_run({a.out: table, a.state_out: state})
     last = table.iloc[-1]
     if progress:
         progress(

@@ -245,6 +245,38 @@ def set_aside_corrupt(root, digests=None, expected=None, report=print) -> list[P
             ) from None
         report(f"corrupt table {path}: {problem}; moved to {target.name}; the default target rebuilds it")
         moved.append(path)
+    return moved + set_aside_mixed_runs(root, report)
+
+
+def set_aside_mixed_runs(root, report=print) -> list[Path]:
+    """Set aside (as ``set_aside``) every table below ``root`` that names a run (io.write_run)
+    whose other tables are there from another run, or from none: a run stopped between the
+    renames of its tables (SIGKILL, a power cut) left tables of two runs side by side, each
+    whole and under its own checksum. Both sides are moved, so the job writing them runs again.
+    A table whose partner is missing is left (the job reruns for the missing one); a table that
+    cannot be read is corrupt_tables' to judge. Reads each table's footer (its key-value metadata)
+    only. Returns the tables moved; one that cannot be moved raises TableError."""
+    from ..core.io import run_of
+
+    root = Path(root)
+    mixed = {}
+    for path in sorted(root.rglob("*.parquet")) if root.exists() else []:
+        run = run_of(path) if path.is_file() else None
+        for name in (run or {}).get("tables", []):
+            other = path.parent / str(name)
+            if other.is_file() and (run_of(other) or {}).get("id") != run["id"]:
+                mixed[path] = f"it is from run {run['id'][:12]}, its {name} from another run"
+    moved = []
+    for path, problem in mixed.items():
+        try:
+            target = set_aside(path)
+        except OSError as e:
+            raise TableError(
+                f"table {path}: {problem}; it cannot be moved aside ({e.strerror or e}): "
+                "make its folder writable, or delete it, and rerun"
+            ) from None
+        report(f"table {path}: {problem}; moved to {target.name}; the default target rebuilds it")
+        moved.append(path)
     return moved
 
 
