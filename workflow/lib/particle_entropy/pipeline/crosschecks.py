@@ -60,17 +60,14 @@ def check_fd_domain(config: Mapping) -> None:
     physics, fd_dt = config["physics"], float(config["time"]["fd_dt"])
     ref = float(physics.get("fd_length", PAPER["fd_length"]))
     settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
-    for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
-        try:
-            RunConfig.of(method="fd", kernel="implicit", n=2, fd_length=float(length), **settings).check()
-        except SettingError as e:
-            raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
-    for n in spec["n"]:
+    for n in spec["n"]:  # each grid as it runs: a domain the plume fits, a dx that resolves it
         for length in spec["lengths"]:
             try:
-                grid_intervals(int(n), float(length), ref)
+                n_int = grid_intervals(int(n), float(length), ref)
+                RunConfig.of(method="fd", kernel="implicit", n=n_int, fd_length=float(length), **settings).check()
             except SettingError as e:
-                raise SettingError("mechanism.fd_domain.n", n, e.allowed) from None
+                key, value = ("lengths", length) if e.name == "fd_length" else ("n", n)
+                raise SettingError(f"mechanism.fd_domain.{key}", value, e.allowed) from None
 
 
 def check_finite(value, where: str = "") -> None:
