@@ -241,36 +241,35 @@ class RunConfig:
                     + ("grid" if name == "fd_length" else "particles"),
                 )
 
+    def check_domain(self) -> None:
+        """The domain checks alone (_check_reference), whatever the grid: a config's FD domain
+        lengths before any of its grids (crosschecks.check_fd_domain)."""
+        self._check_reference()
+
     def _check_resolution(self) -> None:
-        """Refuse a run whose sampling volume dV (FD's dx, MTPT's particle spacing Omega / N, the bins
-        of binned PT) is wider than the plume it measures at t_final: dV > E(t_final), the exact
-        dilution index (sqrt(4 pi e D t_final) for the paper's point), i.e. t_final before the
-        settling time dV^2 / (4 pi e D) of Section 3. The plume then sits on one node or particle:
-        model and sampled reference (Eq. 44, normalised on the same points) are both that spike, the
-        SSE tends to 0 and COMIC (Eq. 43) to -inf, an extreme score that measures nothing. Kernel PT
-        reconstructs at its own width (dV only labels its H_C), and an FD grid with an advection
-        term (a scene's v != 0) spreads the plume over v dx / 2 of numerical dispersion: neither
-        collapses, a coarse grid scores badly instead."""
-        if self.method == "fd":
-            if self.v != 0.0:
-                return
-            name, length, what = "fd_length", self.fd_span()[1], "grid"
-        elif self.method == "mtpt" or self.kernel == "bins":
-            name, length, what = "omega", self.omega, "particle" if self.method == "mtpt" else "bin"
-        else:
+        """Refuse an FD grid whose dx is wider than the plume it measures at t_final: dx > E(t_final),
+        the exact dilution index (sqrt(4 pi e D t_final) for the paper's point), i.e. t_final before
+        the settling time dx^2 / (4 pi e D) of Section 3. The plume then sits on one node: the
+        implicit solution and the sampled reference (Eq. 44, normalised on the same nodes) are both
+        that spike, the SSE tends to 0 and COMIC (Eq. 43) to -inf, an extreme score that measures
+        nothing. A grid with an advection term (a scene's v != 0) spreads the plume over v dx / 2 of
+        numerical dispersion: it does not collapse, a coarse grid scores badly instead. Particles
+        (MTPT's Omega / N, binned PT) are not bounded here: runs before their settling time are
+        valid and flagged (the `settled` column)."""
+        if self.method != "fd" or self.v != 0.0:
             return
+        dx = self.fd_span()[1] / self.n
         spread = self.reference(self.t_final).dilution()
-        if length / self.n <= spread:
+        if dx <= spread:
             return
         low = 2.0 * (self.source.half_width + math.sqrt(2.0 * self.D * self.t_final))
-        low_text = f"{low:.6g}, " if self.method != "pt" or not self.at_rest else "0, "
         raise SettingError(
-            name,
-            getattr(self, name),
-            f"a length in [{low_text}{self.n * spread:.6g}] for n = {self.n}, D = {self.D:g}, t_final = "
-            f"{self.t_final:g}: its {what} spacing {name} / n = {length / self.n:.6g} must not exceed the plume's "
-            f"dilution index E = {spread:.6g} at t_final (t_final past the settling time dV^2 / (4 pi e D) = "
-            f"{settling_time(length / self.n, self.D):.6g}), else the plume sits on one point and COMIC tends to -inf",
+            "fd_length",
+            self.fd_length,
+            f"a length in [{low:.6g}, {self.n * spread:.6g}] for n = {self.n}, D = {self.D:g}, t_final = "
+            f"{self.t_final:g}: its grid spacing dx = fd_length / n = {dx:.6g} must not exceed the plume's dilution "
+            f"index E = {spread:.6g} at t_final (t_final past the settling time dx^2 / (4 pi e D) = "
+            f"{settling_time(dx, self.D):.6g}), else the plume sits on one node and COMIC tends to -inf",
         )
 
     def rng(self, stream: int = 0) -> np.random.Generator:

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 
 from ..core.case import Case, SettingError
 from ..core.labels import case_label
-from ..core.runconfig import MAX_SEED, RunConfig, first_step_key
+from ..core.runconfig import FD_MIN_INTERVALS, MAX_SEED, RunConfig, first_step_key
 from ..core.settings import PAPER, SETTINGS
 from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
@@ -60,7 +60,13 @@ def check_fd_domain(config: Mapping) -> None:
     physics, fd_dt = config["physics"], float(config["time"]["fd_dt"])
     ref = float(physics.get("fd_length", PAPER["fd_length"]))
     settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
-    for n in spec["n"]:  # each grid as it runs: a domain the plume fits, a dx that resolves it
+    for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
+        try:
+            cfg = RunConfig.of(method="fd", kernel="implicit", n=FD_MIN_INTERVALS, fd_length=float(length), **settings)
+            cfg.check_domain()
+        except SettingError as e:
+            raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
+    for n in spec["n"]:  # each grid as it runs: a dx that resolves the plume
         for length in spec["lengths"]:
             try:
                 n_int = grid_intervals(int(n), float(length), ref)
