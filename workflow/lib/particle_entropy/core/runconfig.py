@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
+from .measures import settling_time
 from .reference import Reference, Source
 from .registry import DEFAULT_KERNEL
 from .settings import BY_NAME, MAX_SEED, PAPER, Setting
@@ -18,6 +19,10 @@ from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
 PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
 ADVECTION_SCHEMES = ("upwind", "central")  # FD's advection term (models/fd.py)
+# FD's fewest intervals: a node at the source's x = 0 (an even number) whose 3-point stencil reaches
+# an interior node on either side. With 2 the one interior node's neighbours are both zero ends: its
+# mass only drains into them (5 % by t = 1000 at the paper's settings) and never spreads (H_C stays 0).
+FD_MIN_INTERVALS = 4
 
 
 def check_setting(setting: Setting, value):
@@ -122,6 +127,12 @@ def first_step(method: str, dt_growth: float, time: Mapping | None = None) -> fl
     """The first time step of a run from a config's `time` section (the paper's where it has none)."""
     key = first_step_key(method, dt_growth)
     return float((time or {}).get(key, PAPER[key]))
+
+
+def explicit_fd_stable(r: float) -> bool:
+    """Whether explicit FD at r = D dt / dx^2 damps every mode: r < 1/2 strictly (the checkerboard
+    mode's amplification factor 1 - 4 r is -1 at r = 1/2), r = 1/2 to round-off counting as 1/2."""
+    return r < 0.5 and not math.isclose(r, 0.5, rel_tol=1e-12)
 
 
 @dataclass(frozen=True)
@@ -237,8 +248,13 @@ class RunConfig:
         # the case dimensions are checked by Case; the shared settings by their definitions
         if not isinstance(self.case, Case) or self.case.n is None:
             raise SettingError("case", self.case, "a Case at one N")
-        if self.method == "fd" and (self.n < 2 or self.n % 2):
-            raise SettingError("n", self.n, "for fd an even number of intervals >= 2, so that a node sits at x = 0")
+        if self.method == "fd" and (self.n < FD_MIN_INTERVALS or self.n % 2):
+            raise SettingError(
+                "n",
+                self.n,
+                f"for fd an even number of intervals >= {FD_MIN_INTERVALS}: a node at x = 0 with an interior node "
+                "either side for the 3-point stencil (with 2 its mass only drains into the zero ends)",
+            )
         for name in ("D", "t_final", "dt0", "omega", "fd_length", "fixed_kernel_time", "transfer_tolerance"):
             check_setting(BY_NAME[name], getattr(self, name))
         if not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
@@ -264,16 +280,17 @@ class RunConfig:
         if self.advection not in ADVECTION_SCHEMES:
             raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
+        self._check_resolution()
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2
-            if r > 0.5 or self.dt_growth != 1.0:
+            if not explicit_fd_stable(r) or self.dt_growth != 1.0:
                 raise SettingError(
                     "dt0",
                     self.dt0,
-                    f"explicit fd is stable only for r = D dt / dx^2 <= 1/2 with a fixed step: dt0 <= "
-                    f"{0.5 * dx**2 / self.D:.6g} and dt_growth = 1 for n={self.n} "
-                    f"(got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
+                    f"explicit fd needs r = D dt / dx^2 < 1/2 with a fixed step (at r = 1/2 its checkerboard mode's "
+                    f"factor 1 - 4 r is -1: it never decays): dt0 < {0.5 * dx**2 / self.D:.6g} and dt_growth = 1 for "
+                    f"n={self.n} (got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
                 )
         if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:
             raise SettingError(
@@ -292,7 +309,7 @@ class RunConfig:
         width = 2.0 * (self.source.half_width + math.sqrt(variance))
         source = "" if self.source == PAPER_SOURCE else f" + the source's extent {2 * self.source.half_width:.6g}"
         for name, length, models in (("fd_length", self.fd_length, ("fd",)), ("omega", self.omega, ("pt", "mtpt"))):
-            if self.method in models and length < width and (name == "fd_length" or not self.at_rest):
+            if self.method in models and length < width and (self.method != "pt" or not self.at_rest):
                 raise SettingError(
                     name,
                     length,
@@ -300,6 +317,37 @@ class RunConfig:
                     f"t_final = {self.t_final:g}: the plume would outgrow the "
                     + ("grid" if name == "fd_length" else "particles"),
                 )
+
+    def check_domain(self) -> None:
+        """The domain checks alone (_check_reference), whatever the grid: a config's FD domain
+        lengths before any of its grids (crosschecks.check_fd_domain)."""
+        self._check_reference()
+
+    def _check_resolution(self) -> None:
+        """Refuse an FD grid whose dx is wider than the plume it measures at t_final: dx > E(t_final),
+        the exact dilution index (sqrt(4 pi e D t_final) for the paper's point), i.e. t_final before
+        the settling time dx^2 / (4 pi e D) of Section 3. The plume then sits on one node: the
+        implicit solution and the sampled reference (Eq. 44, normalised on the same nodes) are both
+        that spike, the SSE tends to 0 and COMIC (Eq. 43) to -inf, an extreme score that measures
+        nothing. A grid with an advection term (a scene's v != 0) spreads the plume over v dx / 2 of
+        numerical dispersion: it does not collapse, a coarse grid scores badly instead. Particles
+        (MTPT's Omega / N, binned PT) are not bounded here: runs before their settling time are
+        valid and flagged (the `settled` column)."""
+        if self.method != "fd" or self.v != 0.0:
+            return
+        dx = self.fd_span()[1] / self.n
+        spread = self.reference(self.t_final).dilution()
+        if dx <= spread:
+            return
+        low = 2.0 * (self.source.half_width + math.sqrt(2.0 * self.D * self.t_final))
+        raise SettingError(
+            "fd_length",
+            self.fd_length,
+            f"a length in [{low:.6g}, {self.n * spread:.6g}] for n = {self.n}, D = {self.D:g}, t_final = "
+            f"{self.t_final:g}: its grid spacing dx = fd_length / n = {dx:.6g} must not exceed the plume's dilution "
+            f"index E = {spread:.6g} at t_final (t_final past the settling time dx^2 / (4 pi e D) = "
+            f"{settling_time(dx, self.D):.6g}), else the plume sits on one node and COMIC tends to -inf",
+        )
 
     def rng(self, stream: int = 0) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels, eta and schemes share positions and walks.
