@@ -141,10 +141,12 @@ def looks_only():
 def check_writable(look_only):
     """Stop in one line, before any job, where this run cannot write what it must: .snakemake/
     (every invocation: Snakemake keeps its state there), and for a run of jobs results/ and, run
-    here, numba's cache of compiled kernels (verify.numba_cache_folders; a cluster node has its
-    own). Else every job fails on a traceback or an empty log."""
+    here before this code's kernels are compiled, numba's cache (verify.numba_cache_folders; a
+    cluster node has its own). Else every job fails on a traceback or an empty log."""
     problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
-    if not look_only and workflow.local_exec:
+    if not look_only and workflow.local_exec and not Path(kernels_folder()).is_dir():
+        # numba's cache is written while the kernels of this code are compiled (rule compile_kernels);
+        # once they are, jobs load them and numba caches nothing
         problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
     if problems:
         raise WorkflowError("\n".join(problems))
