@@ -291,7 +291,7 @@ def optimum_plan_runs(name, plan):
 
 def optimum_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
-    import pandas as pd  # here, not at parse: only a search's DAG reads its plans
+    from particle_entropy.core.io import read_parquet  # here, not at parse: only a search's DAG reads plans
 
     if wildcards.name not in OPTIMUM:
         raise WorkflowError(f"no optimum search {wildcards.name!r} in config optimum: one of {', '.join(OPTIMUM)}")
@@ -300,7 +300,7 @@ def optimum_round_inputs(wildcards):
     if k == 0:
         return {}
     path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k - 1)).output[0]
-    plan = pd.read_parquet(path)
+    plan = read_parquet(path)  # every page checked (core.io)
     if plan["done"].any():
         raise ValueError(f"optimum search {wildcards.name} stopped at round {k - 1}: there is no round {k}")
     return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
@@ -308,13 +308,12 @@ def optimum_round_inputs(wildcards):
 
 def optimum_final_inputs(wildcards):
     """The first finished plan of a search and its runs: rounds are requested one at a time."""
-    import pandas as pd
-
     from particle_entropy.analysis.optimum import MAX_ROUNDS
+    from particle_entropy.core.io import read_parquet
 
     for k in range(MAX_ROUNDS + 2):  # next_plan stops by round MAX_ROUNDS + 1
         path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k)).output[0]
-        plan = pd.read_parquet(path)
+        plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
     raise ValueError(f"optimum search {wildcards.name}: no finished plan after {MAX_ROUNDS + 2} rounds")
@@ -322,9 +321,8 @@ def optimum_final_inputs(wildcards):
 
 def scene_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
-    import pandas as pd
-
     from particle_entropy.analysis.scene_search import plan_paths
+    from particle_entropy.core.io import read_parquet
 
     if wildcards.name not in SCENES:
         raise WorkflowError(f"no scene {wildcards.name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
@@ -333,7 +331,7 @@ def scene_round_inputs(wildcards):
     if k == 0:
         return {}
     path = checkpoints.scene_round.get(name=wildcards.name, k=str(k - 1)).output[0]
-    plan = pd.read_parquet(path)
+    plan = read_parquet(path)  # every page checked (core.io)
     if plan["done"].any():
         raise ValueError(f"scene {wildcards.name} stopped at round {k - 1}: there is no round {k}")
     return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
@@ -341,13 +339,12 @@ def scene_round_inputs(wildcards):
 
 def scene_final_inputs(wildcards):
     """The finished plan of a scene and its runs: rounds are requested one at a time."""
-    import pandas as pd
-
     from particle_entropy.analysis.scene_search import MAX_ROUNDS, plan_paths
+    from particle_entropy.core.io import read_parquet
 
     for k in range(MAX_ROUNDS + 1):
         path = checkpoints.scene_round.get(name=wildcards.name, k=str(k)).output[0]
-        plan = pd.read_parquet(path)
+        plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
     raise ValueError(f"scene {wildcards.name}: no finished plan after {MAX_ROUNDS + 1} rounds")
