@@ -9,10 +9,13 @@ min_version("8.0")
 sys.path.insert(0, str(Path(workflow.basedir) / "workflow" / "lib"))
 from particle_entropy.pipeline.configcheck import load_yaml
 
-# Snakemake's loader does not say where a YAML error is, keeps the last of two equal keys and runs
-# a file with __use_yte__ as a template (code): config.yaml is checked before it is loaded; a
-# --configfile was loaded (and any template run) before this file, so it is refused here after
-# the fact (the README: a --configfile is trusted like the Snakefile).
+# Snakemake's loader does not say where a YAML error is, keeps the last of two equal keys, reads
+# 010 as 8 and 1:30 as 90, expands alias bombs and reads pipes and devices without end, and runs a
+# file with __use_yte__ as a template (code): config.yaml is checked (load_yaml: a regular file of
+# at most 1 MB, as written) before it is loaded. A --configfile was loaded, by Snakemake's command
+# line before this file runs, so it is refused here after the fact; one Snakemake cannot load at all
+# (missing, a folder, not UTF-8, nested too deep, a pipe, a device) stops there with Snakemake's own
+# error (README: "Config files"). The README: a --configfile is trusted like the Snakefile.
 for _config_file in (["config.yaml"] if Path("config.yaml").exists() else []) + list(workflow.overwrite_configfiles):
     load_yaml(_config_file)
 

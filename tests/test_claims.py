@@ -379,3 +379,23 @@ def test_a_model_on_its_own_time_grid_is_judged_at_its_own_step_and_says_which()
     assert len(own) == 2 and all("at t = 1000 (its step t = 1021.1)" in k for k in own)
     assert all("at t = 1000 (" in k for k in claims if k not in own)
     assert not any("its step" in k for k in claims if k not in own)
+
+
+def test_a_time_with_every_n_unscored_is_worded_not_printed_as_n_minus_1():
+    """comic_times: [0, ...]: at t = 0 every SSE is 0, no N is scored and the minima table holds
+    the sentinel n_opt = -1; the claims table read 't=0: -1', a particle number of -1."""
+    zero = "SSE = 0: the model equals the reference at every point (t = 0, or a reference narrower than the points)"
+    fd = Case("fd", "implicit")
+    minima = _minima([(fd, 0.0, -1, -1), (fd, 500.0, 3000, 3000), (fd, 1000.0, 3000, 3000)])
+    minima["unscored"] = [f"N = 30: {zero}; N = 300: {zero}", "", ""]
+    coll = _minima([(COLL1, 1000.0, -1, -1)])  # judged at the last time: here every N unscored too
+    coll["unscored"] = f"N = 1000: {zero}"
+    claims = comic_claims(pd.concat([minima, coll]), EMPTY_COMIC, TOL)
+    fd_claim = next(c for c in claims if case_label(fd) in c["claim"])
+    assert fd_claim["reproduced"].startswith("t=0: every N unscored (SSE = 0), t=500: 3000"), fd_claim["reproduced"]
+    assert "-1" not in fd_claim["reproduced"]
+    coll_claims = [c for c in claims if case_label(COLL1) + ":" in c["claim"]]
+    assert len(coll_claims) == 2
+    for c in coll_claims:
+        assert c["reproduced"].endswith("every N unscored (SSE = 0)") and "-1" not in c["reproduced"], c["reproduced"]
+        assert c["passed"] is False

@@ -10,7 +10,7 @@ import sys
 import pytest
 from conftest import ROOT
 
-from particle_entropy.analysis import aggregate, claims, optimum
+from particle_entropy.analysis import aggregate, claims, optimum, scene_search
 from particle_entropy.core import case, columns, records
 from particle_entropy.figures import fig10, style
 from particle_entropy.pipeline import columnsdoc
@@ -21,6 +21,7 @@ MODULES = {  # the module names the page cites as sources of its columns
     "columns": columns,
     "aggregate": aggregate,
     "optimum": optimum,
+    "scene_search": scene_search,
     "style": style,
     "fig10": fig10,
     "columnsdoc": columnsdoc,

@@ -17,13 +17,25 @@ from particle_entropy.pipeline.configcheck import check_schema, load_schema, ret
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 retype_overrides(config, workflow.config_settings.config)  # --config physics={D: 0.002}: a number
-check_schema(config, load_schema(SCHEMA))  # one short message naming the key path
+# the merged config (config.yaml, --configfile, --config): one short message naming the key path; an
+# integer is an int, so --config base_seed=1e3 (1000.0 to Snakemake) is refused, not run as seeds~1000.0
+check_schema(config, load_schema(SCHEMA))
 validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
 from particle_entropy.numerics.compiled import kernels_folder
-from particle_entropy.pipeline.verify import CORRUPT_SUFFIX, CRATE_DIR, TableError, set_aside_corrupt
+from particle_entropy.pipeline.verify import (
+    CORRUPT_SUFFIX,
+    CRATE_DIR,
+    DIGESTS,
+    TableError,
+    folder_problems,
+    numba_cache_folders,
+    numba_cache_problem,
+    set_aside_corrupt,
+    tables_below,
+)
 from particle_entropy.pipeline.crate import provenance
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
@@ -68,20 +80,21 @@ SCENES = scenes(
 )
 
 
-def set_aside_corrupt_tables(root="results", look_only=False, digests=".snakemake/particle_entropy/table_digests.json"):
+def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS):
     """Tables whose bytes no longer match their checksum (truncated, a flipped bit, empty) are
     moved to <name>.corrupt before the DAG is built. The default target rebuilds every table set
     aside and not yet rebuilt, so a dry run in between loses nothing. ``look_only`` (a dry run):
     read no table and move none, only name those set aside before. ``digests``: each table's
-    SHA-256 against its size, mtime and inode (verify.corrupt_tables), so a table is reread only when
-    it changed; beside Snakemake's own state, not in results/, which may be copied elsewhere.
-    Deleting it makes the next run read every table."""
+    SHA-256 against its size, mtime, inode and ctime (verify.corrupt_tables), so a table is reread
+    only when it changed; beside Snakemake's own state, not in results/, which may be copied
+    elsewhere. Deleting it makes the next run read every table. Folders linked under ``root`` are
+    followed (results/runs on another disk), each once (verify.tables_below)."""
     if not look_only:
         try:
             set_aside_corrupt(root, digests, named_columns, report=lambda line: print(line, file=sys.stderr))
         except TableError as e:  # a read-only results/: one line, and stop
             raise WorkflowError(str(e)) from None
-    aside = Path(root).rglob(f"*.parquet{CORRUPT_SUFFIX}") if Path(root).exists() else []
+    aside = tables_below(root, f".parquet{CORRUPT_SUFFIX}")
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     return sorted(m for m in missing if not Path(m).exists())
 
@@ -128,6 +141,22 @@ def looks_only():
     return DRY_RUN or runs_no_job(snakemake_options(sys.argv)) or (locks.is_dir() and any(locks.iterdir()))
 
 
+def check_writable(look_only):
+    """Stop in one line, before any job, where this run cannot write what it must: .snakemake/
+    (every invocation: Snakemake keeps its state there), and for a run of jobs results/ and, run
+    here before this code's kernels are compiled, numba's cache (verify.numba_cache_folders; a
+    cluster node has its own). Else every job fails on a traceback or an empty log."""
+    problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
+    if not look_only and workflow.local_exec and not Path(kernels_folder()).is_dir():
+        # numba's cache is written while the kernels of this code are compiled (rule compile_kernels);
+        # once they are, jobs load them and numba caches nothing
+        problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
+    if problems:
+        raise WorkflowError("\n".join(problems))
+
+
+if workflow.is_main_process:
+    check_writable(looks_only())
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
 
 
@@ -265,7 +294,7 @@ def optimum_plan_runs(name, plan):
 
 def optimum_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
-    import pandas as pd  # here, not at parse: only a search's DAG reads its plans
+    from particle_entropy.core.io import read_parquet  # here, not at parse: only a search's DAG reads plans
 
     if wildcards.name not in OPTIMUM:
         raise WorkflowError(f"no optimum search {wildcards.name!r} in config optimum: one of {', '.join(OPTIMUM)}")
@@ -274,7 +303,7 @@ def optimum_round_inputs(wildcards):
     if k == 0:
         return {}
     path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k - 1)).output[0]
-    plan = pd.read_parquet(path)
+    plan = read_parquet(path)  # every page checked (core.io)
     if plan["done"].any():
         raise ValueError(f"optimum search {wildcards.name} stopped at round {k - 1}: there is no round {k}")
     return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
@@ -282,13 +311,12 @@ def optimum_round_inputs(wildcards):
 
 def optimum_final_inputs(wildcards):
     """The first finished plan of a search and its runs: rounds are requested one at a time."""
-    import pandas as pd
-
     from particle_entropy.analysis.optimum import MAX_ROUNDS
+    from particle_entropy.core.io import read_parquet
 
     for k in range(MAX_ROUNDS + 2):  # next_plan stops by round MAX_ROUNDS + 1
         path = checkpoints.optimum_round.get(name=wildcards.name, k=str(k)).output[0]
-        plan = pd.read_parquet(path)
+        plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": optimum_plan_runs(wildcards.name, plan)}
     raise ValueError(f"optimum search {wildcards.name}: no finished plan after {MAX_ROUNDS + 2} rounds")
@@ -296,9 +324,8 @@ def optimum_final_inputs(wildcards):
 
 def scene_round_inputs(wildcards):
     """Round 0 reads nothing; round k reads plan k-1 and its runs (a finished plan has no round after it)."""
-    import pandas as pd
-
     from particle_entropy.analysis.scene_search import plan_paths
+    from particle_entropy.core.io import read_parquet
 
     if wildcards.name not in SCENES:
         raise WorkflowError(f"no scene {wildcards.name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
@@ -307,7 +334,7 @@ def scene_round_inputs(wildcards):
     if k == 0:
         return {}
     path = checkpoints.scene_round.get(name=wildcards.name, k=str(k - 1)).output[0]
-    plan = pd.read_parquet(path)
+    plan = read_parquet(path)  # every page checked (core.io)
     if plan["done"].any():
         raise ValueError(f"scene {wildcards.name} stopped at round {k - 1}: there is no round {k}")
     return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
@@ -315,13 +342,12 @@ def scene_round_inputs(wildcards):
 
 def scene_final_inputs(wildcards):
     """The finished plan of a scene and its runs: rounds are requested one at a time."""
-    import pandas as pd
-
     from particle_entropy.analysis.scene_search import MAX_ROUNDS, plan_paths
+    from particle_entropy.core.io import read_parquet
 
     for k in range(MAX_ROUNDS + 1):
         path = checkpoints.scene_round.get(name=wildcards.name, k=str(k)).output[0]
-        plan = pd.read_parquet(path)
+        plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
     raise ValueError(f"scene {wildcards.name}: no finished plan after {MAX_ROUNDS + 1} rounds")

@@ -19,12 +19,14 @@ from particle_entropy.analysis.aggregate import (
     read_realisations,
 )
 from particle_entropy.core.case import MODEL_COLUMNS
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.pipeline.htmlpage import page
+
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
 inp, out = snakemake.input, snakemake.output
 times = [float(t) for t in snakemake.params.times]
-comic = comic_table([pd.read_parquet(p) for p in inp.summaries], times)
+comic = comic_table([read_parquet(p) for p in inp.summaries], times)
 realisations = read_realisations(list(inp.runs), times)
 argmin = comic_argmin(realisations)
 minima = comic_minima(comic, argmin)

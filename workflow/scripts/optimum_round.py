@@ -6,15 +6,15 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import pandas as pd
-
 from particle_entropy.analysis.optimum import Search, advance, initial_plan
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
+
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
 inp, par, out = snakemake.input, snakemake.params, snakemake.output
 search = Search.from_config(snakemake.wildcards.name, par.spec, par.settings)
 if "plan" in inp.keys():
-    plan = advance(search, pd.read_parquet(inp.plan), list(inp.runs))
+    plan = advance(search, read_parquet(inp.plan), list(inp.runs))
 else:
     plan = initial_plan(search, int(par.base_seed))
 write_parquet(plan, out[0])

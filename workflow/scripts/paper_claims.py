@@ -7,17 +7,17 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
 from pathlib import Path
 
-import pandas as pd
-
 from particle_entropy.analysis import claims as C
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.pipeline.htmlpage import page
+
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
 inp, par = snakemake.input, snakemake.params
 tol, defaults = par.claims, par.case_defaults
-rows = C.single_run_claims([pd.read_parquet(p) for p in inp.runs], defaults)
-rows += C.ensemble_claims([pd.read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]), defaults)
-rows += C.comic_claims(pd.read_parquet(inp.minima), pd.read_parquet(inp.comic), tol, pd.read_parquet(inp.realisations))
+rows = C.single_run_claims([read_parquet(p) for p in inp.runs], defaults)
+rows += C.ensemble_claims([read_parquet(p) for p in inp.summaries], float(tol["adaptive_pt_hc_tolerance"]), defaults)
+rows += C.comic_claims(read_parquet(inp.minima), read_parquet(inp.comic), tol, read_parquet(inp.realisations))
 claims = C.claims_table(rows)
 write_parquet(claims, snakemake.output.table)
 Path(snakemake.output.md).write_text(C.to_markdown(claims))

@@ -9,13 +9,13 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd
-
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.figures import fig10
 
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
+
 out = snakemake.output
-states = [pd.read_parquet(p) for p in snakemake.input]
+states = [read_parquet(p) for p in snakemake.input]
 figure, data = fig10.fig10(states)
 fig10.save_figure(figure, out.png, out.pdf)
 write_parquet(data, out.data)

@@ -8,15 +8,15 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd
-
 from particle_entropy.core.case import Case
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.figures import figure_function
 from particle_entropy.figures.style import save_figure
 
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
+
 par, out = snakemake.params, snakemake.output
-tables = [pd.read_parquet(p) for p in snakemake.input]
+tables = [read_parquet(p) for p in snakemake.input]
 cases = [Case.from_wildcards(c) for c in par.cases]
 draw = figure_function(par.fig)
 figure, data = draw(tables, cases, D=float(par.D), t_final=float(par.t_final), **par.options)

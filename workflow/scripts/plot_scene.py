@@ -8,10 +8,11 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import pandas as pd
-
+from particle_entropy.core.io import exit_on_table_errors, read_parquet
 from particle_entropy.figures.scene import scene
 from particle_entropy.figures.style import save_figure
 
-figure = scene(pd.read_parquet(snakemake.input[0]))
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
+
+figure = scene(read_parquet(snakemake.input[0]))
 save_figure(figure, snakemake.output.png, snakemake.output.pdf)

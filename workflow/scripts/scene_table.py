@@ -5,15 +5,15 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-import pandas as pd
-
 from particle_entropy.analysis.scene_search import judged, read_runs, result
-from particle_entropy.core.io import write_parquet
+from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.experiments.scene import Scene
+
+exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
 inp, par = snakemake.input, snakemake.params
 scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
-plan = pd.read_parquet(inp.plan)
+plan = read_parquet(inp.plan)
 table = result(scene, judged(scene, read_runs(plan, list(inp.runs))))
 write_parquet(table, snakemake.output[0])
 print(table.to_string(), file=sys.stderr)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
 
 from .core.case import NONE, from_text
@@ -100,28 +101,35 @@ def build_parser() -> argparse.ArgumentParser:
         help="check workflow config files as a dry run would, with YAML line numbers",
         description="Check one or more workflow config files, merged in order as Snakemake merges "
         "config.yaml and --configfile: YAML syntax (line and column), the schema and every rule "
-        "between fields. Exit 0 when the workflow would accept them, 2 otherwise.",
+        "between fields. Exit 0 when the workflow would accept them, 2 otherwise. An adaptive "
+        "search or a scene is judged, as by the run, only for its own targets: one that they would "
+        "refuse is named on a line of its own, not judged against the rest. Only regular files of "
+        "at most 1 MB are read.",
     )
     c.add_argument("files", nargs="+", help="YAML config files, later ones overriding earlier ones")
     return p
 
 
 def check_config_files(files: list[str]) -> int:
-    """The check-config command: merge the files, check them, print one line."""
+    """The check-config command: merge the files, check them as the run would, print one line (and
+    one line for each search or scene that only its own targets would refuse)."""
     from snakemake.utils import update_config
 
     from .pipeline.configcheck import ConfigFileError, check_config, load_yaml
     from .pipeline.memory import available_bytes
 
     config: dict = {}
+    not_judged: list[str] = []
     try:
         for f in files:
             update_config(config, dict(load_yaml(f)))
-        check_config(config, available=available_bytes())  # the dry run's checks, memory on this machine too
+        check_config(config, available=available_bytes(), not_judged=not_judged)  # the dry run's checks
     except (ConfigFileError, SettingError, OSError) as e:
         print(f"check-config: {e}", file=sys.stderr)
         return 2
     print(f"check-config: {' + '.join(files)}: accepted")
+    for line in not_judged:
+        print(f"check-config: {line}")
     return 0
 
 
@@ -141,11 +149,45 @@ def _same_file(a: str, b: str) -> bool:
         return False
 
 
+class Stopped(Exception):
+    """SIGTERM, raised where the run is (as SIGINT raises KeyboardInterrupt), so that it ends as SIGINT does."""
+
+
+def _stop(signum, frame):
+    raise Stopped(signum)
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     a = parser.parse_args(argv)
     if a.command == "check-config":
         return check_config_files(a.files)
+    before = _identity(a.out)
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        return simulate(parser, a)
+    except (KeyboardInterrupt, Stopped) as e:
+        # one line, no traceback; exit 128 + the signal's number, as a shell reports a process it ended
+        signum = e.args[0] if isinstance(e, Stopped) else signal.SIGINT
+        outputs = " and ".join(flag for flag, target in (("--out", a.out), ("--state-out", a.state_out)) if target)
+        written = _identity(a.out) != before  # a new table is a new file (io: renamed into place)
+        what = f"{outputs} written" if written else f"nothing written ({outputs} as they were)"
+        print(f"simulate: stopped by {signal.Signals(signum).name}; {what}", file=sys.stderr)
+        return 128 + signum
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _identity(path: str) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_mtime_ns
+
+
+def simulate(parser: argparse.ArgumentParser, a: argparse.Namespace) -> int:
+    """The simulate command, after its arguments are parsed."""
     try:
         cfg = config_from_args(a)
     except SettingError as e:
@@ -172,15 +214,16 @@ def main(argv=None) -> int:
             "lower --n or take fewer, longer steps (--dt0, --dt-growth)"
         )
     from .core.heap import keep_freed_pages
-    from .core.io import write_parquet
+    from .core.io import write_parquet, write_run
     from .models.simulate import run
 
     keep_freed_pages()  # steps reuse the pages of the last step's arrays
     progress = None if a.quiet else (lambda msg: print(msg, file=sys.stderr, flush=True))
     table, state = run(cfg, progress=progress, want_state=a.state_out is not None)
-    write_parquet(table, a.out)
-    if state is not None:
-        write_parquet(state, a.state_out)
+    if state is None:
+        write_parquet(table, a.out)
+    else:  # one run's pair: named by a run id in each, so tables of two runs are never taken for one
+        write_run({a.out: table, a.state_out: state})
     last = table.iloc[-1]
     if progress:
         progress(

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import CASE_COLUMNS, MODEL_COLUMNS, by_model, case_of_table, rows_of
+from ..core.io import read_parquet
 from ..core.labels import case_label
 from ..core.measures import comic
 from ..core.registry import CONVENTION_NAMES
@@ -71,7 +72,7 @@ def summarise_files(paths: list[str], out: str) -> int:
     the number of realisations."""
     from ..core.io import write_parquet
 
-    blocks = pd.concat([pd.read_parquet(p) for p in paths], ignore_index=True)
+    blocks = pd.concat([read_parquet(p) for p in paths], ignore_index=True)
     runs = [g for _, g in blocks.groupby("seed", sort=True)]
     write_parquet(summarise_runs(runs), out)
     return len(runs)
@@ -307,7 +308,7 @@ RUN_COLUMNS = ["step", "time", "seed", "SSE", "COMIC", "n_sse", "dV", "SSE_point
 
 def read_realisations(paths: list[str], times: list[float]) -> pd.DataFrame:
     """``realisations_table`` of the run tables at ``paths`` (blocks of seeds, any cases)."""
-    return realisations_table([pd.read_parquet(p, columns=RUN_COLUMNS) for p in paths], times)
+    return realisations_table([read_parquet(p, columns=RUN_COLUMNS) for p in paths], times)
 
 
 def realisations_table(runs: list[pd.DataFrame], times: list[float]) -> pd.DataFrame:

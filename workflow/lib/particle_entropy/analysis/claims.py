@@ -186,10 +186,28 @@ def _model_words(model: Case) -> tuple[str, str]:
     return f"{SCHEME_DOCS[model.scheme]}{cut}", "this variant gives"
 
 
+def _every_n_unscored(row: pd.Series) -> str:
+    """The words for a time at which no N is scored (aggregate's sentinel n_opt = -1, never a
+    particle number): 'every N unscored (SSE = 0)', the reasons of the minima table's `unscored`
+    column, each once, in their short form (before the colon)."""
+    listed = str(row.get("unscored", "") or "")
+    reasons = [part.split(": ", 2)[1] for part in listed.split("; ") if part.count(": ") >= 1]
+    short = list(dict.fromkeys(r.split(":", 1)[0] for r in reasons))
+    return "every N unscored" + (f" ({', '.join(short)})" if short else "")
+
+
+def _n_text(row: pd.Series, prefix: str = "n_opt") -> str:
+    """An optimum N as the claims table prints it: the N, or the words for an all-unscored time."""
+    n = int(row[prefix])
+    return _every_n_unscored(row) if n < 0 else str(n)
+
+
 def _optimum_text(row: pd.Series, prefix: str) -> str:
     """An optimum with its bootstrap interval and share, e.g. '3000 (95% CI 1000-3000; argmin in
     81% of 2000 resamples)'."""
     n_opt, resamples = int(row[prefix]), int(row.get("n_resamples", 0))
+    if n_opt < 0:
+        return _every_n_unscored(row)
     lo, hi, share = row.get(f"{prefix}_ci_lo", -1), row.get(f"{prefix}_ci_hi", -1), row.get(f"{prefix}_share")
     if resamples > 0:
         return f"{n_opt} (95% CI {int(lo)}-{int(hi)}; argmin in {share:.0%} of {resamples} resamples)"
@@ -300,7 +318,7 @@ def comic_claims(
             _claim(
                 f"{case_label(model)}: COMIC minimal near 3000 nodes at almost every time",
                 "~3000",
-                ", ".join(f"t={t:g}: {n}" for t, n in zip(fd["time"], fd["n_opt"])),
+                ", ".join(f"t={row['time']:g}: {_n_text(row)}" for _, row in fd.iterrows()),
                 f"N_opt in [{lo}, {hi}]",
                 inside.mean() >= 0.5,
             )

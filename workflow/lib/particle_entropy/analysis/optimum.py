@@ -42,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.case import APPLIES, Case, SettingError
+from ..core.io import read_parquet
 from ..core.labels import case_label
 from ..core.registry import MEASURE_NAMES, MEASUREMENT_POINTS
 from ..core.runconfig import first_step
@@ -631,13 +632,13 @@ def _costs(frames: list[pd.DataFrame]) -> pd.DataFrame:
 
 def read_costs(paths: list[str]) -> pd.DataFrame:
     """Measured core-seconds of every run in the run tables at ``paths`` (_costs)."""
-    return _costs([pd.read_parquet(p, columns=[*COST_KEYS, "wall_s"]) for p in paths])
+    return _costs([read_parquet(p, columns=[*COST_KEYS, "wall_s"]) for p in paths])
 
 
 def read_runs(paths: list[str], time: float) -> tuple[pd.DataFrame, pd.DataFrame]:
     """A search's inputs from its run tables, each read once: the per-realisation values at
     ``time`` (aggregate.realisations_table) and the measured costs (_costs)."""
-    frames = [pd.read_parquet(p, columns=list(dict.fromkeys([*RUN_COLUMNS, "wall_s"]))) for p in paths]
+    frames = [read_parquet(p, columns=list(dict.fromkeys([*RUN_COLUMNS, "wall_s"]))) for p in paths]
     return realisations_table(frames, [time]), _costs(frames)
 
 
@@ -650,7 +651,7 @@ def _visited_end(table: pd.DataFrame, search: Search, best) -> str:
 def advance(search: Search, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """The next plan (next_plan) from the run tables of ``plan``'s seed blocks at ``paths``: their
     values at the search's time; their measured wall times are not read."""
-    frames = [pd.read_parquet(p, columns=RUN_COLUMNS) for p in paths]
+    frames = [read_parquet(p, columns=RUN_COLUMNS) for p in paths]
     return next_plan(search, plan, realisations_table(frames, [search.time]))
 
 

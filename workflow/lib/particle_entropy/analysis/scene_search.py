@@ -20,6 +20,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..core.io import read_parquet
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 
 MAX_ROUNDS = 40  # a search's rounds at most: a ladder has at most ~40 rungs (ratio 2)
@@ -254,7 +255,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_min", "dV", "work"]
     rows = []
     for r, path in zip(plan.itertuples(), paths):
-        table = pd.read_parquet(path)
+        table = read_parquet(path)
         for seed, g in table.groupby("seed", sort=True):
             last = g.loc[g["step"].idxmax()]
             rows.append(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -10,13 +11,18 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
+from .measures import settling_time
 from .reference import Reference, Source
 from .registry import DEFAULT_KERNEL
 from .settings import BY_NAME, MAX_SEED, PAPER, Setting
-from .timegrid import MAX_STEPS, max_first_step, step_count
+from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
 PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
 ADVECTION_SCHEMES = ("upwind", "central")  # FD's advection term (models/fd.py)
+# FD's fewest intervals: a node at the source's x = 0 (an even number) whose 3-point stencil reaches
+# an interior node on either side. With 2 the one interior node's neighbours are both zero ends: its
+# mass only drains into them (5 % by t = 1000 at the paper's settings) and never spreads (H_C stays 0).
+FD_MIN_INTERVALS = 4
 
 
 def check_setting(setting: Setting, value):
@@ -35,6 +41,80 @@ def check_setting(setting: Setting, value):
     return check_range(setting.name, value, setting.low, setting.high, open_low=setting.open_low)
 
 
+# The widest reconstruction grid a run may build (models/pt.kernel_grid: spacing min(0.1, spread / 4,
+# h / 2), the bins Omega / N), as MAX_STEPS bounds the steps: 800 MB an array; the plume a grid
+# must hold is the source and PLUME_SIGMAS standard deviations either side of it.
+MAX_GRID_POINTS = 100_000_000
+GRID_SPACING = 0.1
+PLUME_SIGMAS = 8.0
+
+
+def plume_span(cfg: RunConfig) -> float:
+    """The width a run's particles spread over by t_final: the source's extent plus PLUME_SIGMAS
+    sqrt(2 D t_final) either side [L]."""
+    return 2.0 * (cfg.source.half_width + PLUME_SIGMAS * math.sqrt(2.0 * cfg.D * cfg.t_final))
+
+
+def check_arithmetic(cfg: RunConfig) -> None:
+    """Refuse finite settings whose derived widths, variances or grids overflow or underflow, by
+    name with the range allowed at the other settings: each variance 2 D t (t_final, dt0, and
+    the fixed kernel's time) a normal float, the plume within a grid of MAX_GRID_POINTS at
+    spacing GRID_SPACING (t_final), and the fixed kernel's grid within MAX_GRID_POINTS too."""
+    tiny = sys.float_info.min
+    times = ["t_final", "dt0"] + (["fixed_kernel_time"] if (cfg.method, cfg.kernel) == ("pt", "fixed") else [])
+    for name in times:
+        t = getattr(cfg, name)
+        variance = 2.0 * cfg.D * t
+        if not math.isfinite(4.0 * math.pi * math.e * variance):  # E = sqrt(2 pi e variance)
+            raise SettingError("D", cfg.D, f"a number with 2 D {name} finite ({name} = {t:g})")
+        if variance < tiny:  # a subnormal (or zero) variance: 1 / sqrt(variance) overflows
+            raise SettingError(
+                name,
+                t,
+                f"a number with 2 D {name} a normal float (>= {tiny:.3g}): >= {tiny / (2 * cfg.D):.3g} "
+                f"for D = {cfg.D:g}",
+            )
+    widest = MAX_GRID_POINTS * GRID_SPACING
+    span = plume_span(cfg)
+    if span > widest:
+        room = (widest / 2.0 - cfg.source.half_width) / PLUME_SIGMAS
+        raise SettingError(
+            "t_final",
+            cfg.t_final,
+            f"a number in (0, {room * room / (2.0 * cfg.D):.6g}] for D = {cfg.D:g}: a plume 2 x {PLUME_SIGMAS:g} "
+            f"sqrt(2 D t_final) wide at most {widest:g}, the {MAX_GRID_POINTS:,} points of a grid at spacing "
+            f"{GRID_SPACING:g} (this one {span:.3g})",
+        )
+    if (cfg.method, cfg.kernel) == ("pt", "fixed"):
+        _check_kernel_grid(cfg, span)
+
+
+def _check_kernel_grid(cfg: RunConfig, span: float) -> None:
+    """The fixed kernel's grid (models/pt.kernel_grid: the plume plus 6 h either side, at spacing
+    at least min(0.1, h / 4)) within MAX_GRID_POINTS: h = sqrt(2 D fixed_kernel_time) neither so
+    narrow that the spacing h / 4 needs more, nor so wide that its 12 h at spacing 0.1 do."""
+    h = math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
+    points = (span + 12.0 * h) / min(GRID_SPACING, h / 4.0)
+    if points > MAX_GRID_POINTS:
+        h_lo = 4.0 * span / (MAX_GRID_POINTS - 48.0)  # (span + 12 h) / (h / 4) = MAX_GRID_POINTS
+        h_hi = (MAX_GRID_POINTS * GRID_SPACING - span) / 12.0  # (span + 12 h) / 0.1 = MAX_GRID_POINTS
+        if h_lo > h_hi:  # no kernel fits: the plume itself is too wide for the grid
+            raise SettingError(
+                "t_final",
+                cfg.t_final,
+                f"a plume 2 x {PLUME_SIGMAS:g} sqrt(2 D t_final) = {span:.3g} that a fixed kernel's grid of at most "
+                f"{MAX_GRID_POINTS:,} points holds at spacing h / 4 <= {GRID_SPACING:g} (D = {cfg.D:g})",
+            )
+        lo, hi = h_lo * h_lo / (2.0 * cfg.D), h_hi * h_hi / (2.0 * cfg.D)
+        raise SettingError(
+            "fixed_kernel_time",
+            cfg.fixed_kernel_time,
+            f"a number in [{lo:.3g}, {hi:.3g}] for D = {cfg.D:g}, t_final = {cfg.t_final:g}: a kernel "
+            f"sqrt(2 D fixed_kernel_time) whose grid has at most {MAX_GRID_POINTS:,} points "
+            f"(this one about {points:.3g})",
+        )
+
+
 def first_step_key(method: str, dt_growth: float) -> str:
     """The `time` setting of a run's first step: FD its fixed fd_dt; particles dt0, or fixed_dt
     when the step is fixed (dt_growth 1)."""
@@ -47,6 +127,12 @@ def first_step(method: str, dt_growth: float, time: Mapping | None = None) -> fl
     """The first time step of a run from a config's `time` section (the paper's where it has none)."""
     key = first_step_key(method, dt_growth)
     return float((time or {}).get(key, PAPER[key]))
+
+
+def explicit_fd_stable(r: float) -> bool:
+    """Whether explicit FD at r = D dt / dx^2 damps every mode: r < 1/2 strictly (the checkerboard
+    mode's amplification factor 1 - 4 r is -1 at r = 1/2), r = 1/2 to round-off counting as 1/2."""
+    return r < 0.5 and not math.isclose(r, 0.5, rel_tol=1e-12)
 
 
 @dataclass(frozen=True)
@@ -162,8 +248,13 @@ class RunConfig:
         # the case dimensions are checked by Case; the shared settings by their definitions
         if not isinstance(self.case, Case) or self.case.n is None:
             raise SettingError("case", self.case, "a Case at one N")
-        if self.method == "fd" and (self.n < 2 or self.n % 2):
-            raise SettingError("n", self.n, "for fd an even number of intervals >= 2, so that a node sits at x = 0")
+        if self.method == "fd" and (self.n < FD_MIN_INTERVALS or self.n % 2):
+            raise SettingError(
+                "n",
+                self.n,
+                f"for fd an even number of intervals >= {FD_MIN_INTERVALS}: a node at x = 0 with an interior node "
+                "either side for the 3-point stencil (with 2 its mass only drains into the zero ends)",
+            )
         for name in ("D", "t_final", "dt0", "omega", "fd_length", "fixed_kernel_time", "transfer_tolerance"):
             check_setting(BY_NAME[name], getattr(self, name))
         if not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
@@ -176,8 +267,10 @@ class RunConfig:
                 "dt0",
                 self.dt0,
                 f"a first step reaching t_final = {self.t_final:g} in at most {MAX_STEPS:,} steps with dt_growth = "
-                f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} (this one needs {steps:,})",
+                f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} "
+                f"(this one needs {count_text(steps)})",
             )
+        check_arithmetic(self)
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
         check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
         if not isinstance(self.source, Source):
@@ -187,16 +280,17 @@ class RunConfig:
         if self.advection not in ADVECTION_SCHEMES:
             raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
+        self._check_resolution()
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2
-            if r > 0.5 or self.dt_growth != 1.0:
+            if not explicit_fd_stable(r) or self.dt_growth != 1.0:
                 raise SettingError(
                     "dt0",
                     self.dt0,
-                    f"explicit fd is stable only for r = D dt / dx^2 <= 1/2 with a fixed step: dt0 <= "
-                    f"{0.5 * dx**2 / self.D:.6g} and dt_growth = 1 for n={self.n} "
-                    f"(got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
+                    f"explicit fd needs r = D dt / dx^2 < 1/2 with a fixed step (at r = 1/2 its checkerboard mode's "
+                    f"factor 1 - 4 r is -1: it never decays): dt0 < {0.5 * dx**2 / self.D:.6g} and dt_growth = 1 for "
+                    f"n={self.n} (got r = {r:.6g}, dt_growth = {self.dt_growth}); or use kernel implicit",
                 )
         if self.transfer_method in ("taylor", "fgt") and self.truncation is not None:
             raise SettingError(
@@ -215,7 +309,7 @@ class RunConfig:
         width = 2.0 * (self.source.half_width + math.sqrt(variance))
         source = "" if self.source == PAPER_SOURCE else f" + the source's extent {2 * self.source.half_width:.6g}"
         for name, length, models in (("fd_length", self.fd_length, ("fd",)), ("omega", self.omega, ("pt", "mtpt"))):
-            if self.method in models and length < width and (name == "fd_length" or not self.at_rest):
+            if self.method in models and length < width and (self.method != "pt" or not self.at_rest):
                 raise SettingError(
                     name,
                     length,
@@ -223,6 +317,37 @@ class RunConfig:
                     f"t_final = {self.t_final:g}: the plume would outgrow the "
                     + ("grid" if name == "fd_length" else "particles"),
                 )
+
+    def check_domain(self) -> None:
+        """The domain checks alone (_check_reference), whatever the grid: a config's FD domain
+        lengths before any of its grids (crosschecks.check_fd_domain)."""
+        self._check_reference()
+
+    def _check_resolution(self) -> None:
+        """Refuse an FD grid whose dx is wider than the plume it measures at t_final: dx > E(t_final),
+        the exact dilution index (sqrt(4 pi e D t_final) for the paper's point), i.e. t_final before
+        the settling time dx^2 / (4 pi e D) of Section 3. The plume then sits on one node: the
+        implicit solution and the sampled reference (Eq. 44, normalised on the same nodes) are both
+        that spike, the SSE tends to 0 and COMIC (Eq. 43) to -inf, an extreme score that measures
+        nothing. A grid with an advection term (a scene's v != 0) spreads the plume over v dx / 2 of
+        numerical dispersion: it does not collapse, a coarse grid scores badly instead. Particles
+        (MTPT's Omega / N, binned PT) are not bounded here: runs before their settling time are
+        valid and flagged (the `settled` column)."""
+        if self.method != "fd" or self.v != 0.0:
+            return
+        dx = self.fd_span()[1] / self.n
+        spread = self.reference(self.t_final).dilution()
+        if dx <= spread:
+            return
+        low = 2.0 * (self.source.half_width + math.sqrt(2.0 * self.D * self.t_final))
+        raise SettingError(
+            "fd_length",
+            self.fd_length,
+            f"a length in [{low:.6g}, {self.n * spread:.6g}] for n = {self.n}, D = {self.D:g}, t_final = "
+            f"{self.t_final:g}: its grid spacing dx = fd_length / n = {dx:.6g} must not exceed the plume's dilution "
+            f"index E = {spread:.6g} at t_final (t_final past the settling time dx^2 / (4 pi e D) = "
+            f"{settling_time(dx, self.D):.6g}), else the plume sits on one node and COMIC tends to -inf",
+        )
 
     def rng(self, stream: int = 0) -> np.random.Generator:
         """Generator keyed by (seed, method, N): kernels, eta and schemes share positions and walks.

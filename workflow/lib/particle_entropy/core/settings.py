@@ -6,7 +6,7 @@ Each config section is declared here once, as a tuple of ``Setting``: the run se
 (``FIGURE_OPTIONS``), seeds and their blocks (``SEEDS``), the COMIC times (``COMIC_TIMES``), the
 claims' tolerances (``CLAIMS``), the trade-off sweep (``TRADEOFF``), the mechanism experiments
 (``MECHANISM``), the shear flow (``SHEAR``) and an adaptive search (``SEARCH``), with the caps
-they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``SHEAR_MAX_N``). From them come the paper's
+they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``MAX_N``, ``SHEAR_MAX_N``). From them come the paper's
 defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
 checks, the CLI's options (cli.py), the schema's blocks, which
 ``python -m particle_entropy.pipeline.schemagen --write`` writes into
@@ -35,6 +35,7 @@ from .registry import (
 
 MAX_REALISATIONS = 10_000  # realisations of one case or N: more is a typo, not an ensemble
 MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
+MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB for mass transfer; more is a typo
 SHEAR_MAX_N = 10**8  # shear particles: 5,000 x the paper's, ~40 GB for a random walk; more is a typo
 NO_DEFAULT = object()  # a setting the config must give (or may leave out, with no default)
 
@@ -313,10 +314,11 @@ MECHANISM = (
         "n",
         "mechanism.lattice.n",
         NO_DEFAULT,
-        "particles on the lattice (a particle at x = 0)",
+        "particles on the lattice (a particle at x = 0; the memory check may refuse fewer)",
         kind="integer",
         low=3,
-        range_text="an odd integer >= 3",
+        high=MAX_N,
+        range_text=f"an odd integer in [3, {MAX_N:,}]",
         required=True,
     ),
     Setting(
@@ -523,8 +525,28 @@ SHEAR = (  # Appendix B; ShearConfig's fields (models/shear2d.py) besides `case`
         range_text="a number in (strip_lo, length]",
         required=True,
     ),
-    Setting("alpha_L", "shear.alpha_L", 1e-2, "longitudinal dispersivity", "L", 0.0, open_low=True, required=True),
-    Setting("alpha_T", "shear.alpha_T", 1e-3, "transverse dispersivity", "L", 0.0, required=True),
+    Setting(
+        "alpha_L",
+        "shear.alpha_L",
+        1e-2,
+        "longitudinal dispersivity",
+        "L",
+        0.0,
+        open_low=True,
+        range_text="a number > 0 with a step's dispersion sqrt(2 alpha_L v_max dt) <= length / 10 (v_max = 1/4)",
+        required=True,
+    ),
+    Setting(
+        "alpha_T",
+        "shear.alpha_T",
+        1e-3,
+        "transverse dispersivity",
+        "L",
+        0.0,
+        range_text="a number >= 0 with a step's dispersion sqrt(2 alpha_T v_max dt) <= 1/10 of the channel's width "
+        "(v_max = 1/4): alpha_T dt <= 0.02",
+        required=True,
+    ),
     Setting("beta", "shear.beta", 0.5, "mass-transfer coefficient of Eq. 16 for the mt case", low=0.0, high=1.0),
     Setting("dt", "shear.dt", 1.0, "time step", "T", 0.0, open_low=True, required=True),
     Setting(

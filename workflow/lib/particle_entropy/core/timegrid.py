@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 
@@ -12,17 +13,36 @@ MAX_STEPS = 10_000_000
 
 
 def step_count(t_final: float, dt0: float, growth: float) -> int:
-    """Steps from dt0 growing by ``growth`` to reach t_final (without building them)."""
+    """Steps from dt0 growing by ``growth`` to reach t_final (without building them). Exact
+    arithmetic where the ratio t_final / dt0 overflows a float (1e308 / 0.01): the count is
+    then refused by MAX_STEPS, never an OverflowError."""
     if growth == 1.0:
-        n = math.ceil(t_final / dt0 - 1e-9)
+        ratio = t_final / dt0
+        n = math.ceil(ratio - 1e-9) if math.isfinite(ratio) else math.ceil(Fraction(t_final) / Fraction(dt0))
     else:  # smallest n with dt0 (growth^n - 1)/(growth - 1) >= t_final
-        n = math.ceil(math.log1p(t_final * (growth - 1) / dt0) / math.log(growth) - 1e-9)
+        ratio = t_final * (growth - 1) / dt0
+        # log1p(ratio) = log(ratio) to round-off wherever ratio overflows (> 1e308)
+        log_sum = (
+            math.log1p(ratio) if math.isfinite(ratio) else math.log(t_final) + math.log(growth - 1) - math.log(dt0)
+        )
+        n = math.ceil(log_sum / math.log(growth) - 1e-9)
     return max(n, 1)
 
 
+def count_text(n: int) -> str:
+    """A step count as messages give it: 14,560, or about 10^311 where digits would fill the line."""
+    return f"{n:,}" if n < 10**15 else f"about 10^{len(str(n)) - 1}"
+
+
 def max_first_step(t_final: float, growth: float, steps: int = MAX_STEPS) -> float:
-    """The smallest dt0 that reaches t_final in ``steps`` steps growing by ``growth``."""
-    return t_final / steps if growth == 1.0 else t_final * (growth - 1) / math.expm1(steps * math.log(growth))
+    """The smallest dt0 that reaches t_final in ``steps`` steps growing by ``growth`` (0 where it is
+    below every float: growth^steps overflows)."""
+    if growth == 1.0:
+        return t_final / steps
+    exponent = steps * math.log(growth)
+    if exponent < 700.0:  # expm1 is finite
+        return t_final * (growth - 1) / math.expm1(exponent)
+    return math.exp(math.log(t_final) + math.log(growth - 1) - exponent)  # expm1 = exp to round-off
 
 
 def time_steps(t_final: float, dt0: float, growth: float, grid: str = "exact") -> np.ndarray:

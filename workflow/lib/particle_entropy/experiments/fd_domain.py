@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core import measures as M
 from ..core.case import SettingError
-from ..core.runconfig import RunConfig
+from ..core.runconfig import FD_MIN_INTERVALS, RunConfig
 from ..core.settings import PAPER
 
 if TYPE_CHECKING:  # pandas and the FD model (numba) load when the experiment runs, not when a config is checked
@@ -70,12 +70,16 @@ def reference(
 
 def grid_intervals(n: int, length: float, ref_length: float) -> int:
     """Intervals on a domain of ``length`` at the spacing dx = ref_length / n of grid n; SettingError
-    (named `n`) unless an even whole number >= 2, so that a node sits at x = 0."""
+    (named `n`) unless an even whole number >= FD_MIN_INTERVALS (4), so that a node sits at x = 0
+    with an interior node either side (RunConfig.check)."""
     m = n * length / ref_length
     whole = math.isfinite(m) and abs(m - round(m)) <= 1e-9 * max(1.0, abs(m))
-    if not whole or round(m) < 2 or round(m) % 2:
+    if not whole or round(m) < FD_MIN_INTERVALS or round(m) % 2:
         raise SettingError(
-            "n", n, f"a grid whose dx = {ref_length:g} / n fits an even whole number (>= 2) of times in {length:g}"
+            "n",
+            n,
+            f"a grid whose dx = {ref_length:g} / n fits an even whole number (>= {FD_MIN_INTERVALS}) of times in "
+            f"{length:g}",
         )
     return int(round(m))
 

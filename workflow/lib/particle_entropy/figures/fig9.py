@@ -22,6 +22,7 @@ from .style import (
     Series,
     distinct_models,
     draw,
+    fit_titles,
     mark_missing,
     mark_no_data,
     n_ticks,
@@ -245,4 +246,5 @@ def fig9(tables, cases, *, D: float, t_final: float, bars: str = "eq43"):
     for ax, bar_ax in list(zip(tops, bottoms, strict=True))[len(families) :]:
         ax.set_visible(False)
         bar_ax.set_visible(False)
+    fit_titles(fig)  # seven families' titles with their time ran past the panel's edge
     return fig, source_table("fig9", out)

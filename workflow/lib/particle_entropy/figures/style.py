@@ -342,12 +342,67 @@ def rows_nearest(df: pd.DataFrame, time: float, column: str = "time") -> pd.Data
 # ---------------------------------------------------------------- axes helpers
 def save_figure(fig: Figure, png_path, pdf_path) -> None:
     """Write ``fig`` as PNG and PDF (150 dpi, no time stamps or versions: byte-stable) and close it."""
+    fit_titles(fig)
     for path, meta in ((png_path, PNG_META), (pdf_path, PDF_META)):
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(path, dpi=150, metadata=meta)
     import matplotlib.pyplot as plt  # only to release figures a caller made through pyplot
 
     plt.close(fig)
+
+
+MIN_TITLE_SIZE = 7.0  # points: a title shrinks no further, once wrapped
+
+
+def _titles(ax) -> list:
+    """The title texts of ``ax`` that hold text (left, centre, right)."""
+    texts = [getattr(ax, "_left_title", None), ax.title, getattr(ax, "_right_title", None)]
+    return [t for t in texts if t is not None and t.get_text()]
+
+
+def _overhang(title, ax, renderer) -> float:
+    """How far (pixels) a drawn title reaches past its axes' or the figure's sides; 0 if inside."""
+    box, room, page = title.get_window_extent(renderer), ax.get_window_extent(renderer), ax.figure.bbox
+    left, right = max(room.x0, page.x0), min(room.x1, page.x1)
+    return max(0.0, left - box.x0, box.x1 - right)
+
+
+def fit_titles(fig: Figure, rounds: int = 4) -> None:
+    """Make every panel title fit its panel, measured on the drawn text: a title wider than its
+    axes is wrapped at its commas or spaces (as many lines as its width needs), then shrunk down to
+    MIN_TITLE_SIZE points; the figure is drawn again after each change (constrained layout moves
+    the axes)."""
+    import textwrap
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    if not isinstance(fig.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(fig)
+    for _ in range(rounds):
+        fig.canvas.draw()
+        renderer, changed = fig.canvas.get_renderer(), False
+        for ax in fig.axes:
+            if not ax.get_visible():
+                continue
+            for title in _titles(ax):
+                box = title.get_window_extent(renderer)
+                over = _overhang(title, ax, renderer)
+                if over <= 0.5:
+                    continue
+                text = " ".join(title.get_text().split("\n"))
+                share = max((box.width - over) / box.width, 0.1)
+                lines = max(max(len(line) for line in title.get_text().split("\n")), 1)
+                width = max(int(lines * share) - 1, 8)
+                wrapped = textwrap.fill(text, width=width, break_long_words=False)
+                if wrapped != title.get_text():
+                    title.set_text(wrapped)
+                elif title.get_fontsize() > MIN_TITLE_SIZE:
+                    title.set_fontsize(max(title.get_fontsize() * max(share, 0.8), MIN_TITLE_SIZE))
+                else:
+                    continue
+                changed = True
+        if not changed:
+            return
 
 
 def new_figure(ncols: int, width: float = 5.2, height: float = 4.0, nrows: int = 1):

@@ -1,8 +1,12 @@
 """Finite differences for 1-D diffusion (Section 6.1, Fig. 8): implicit (backward Euler, the
-paper's) and explicit (forward Euler, refused past its stability limit r = 1/2). With a uniform
+paper's) and explicit (forward Euler, refused from its stability limit r = 1/2 on). With a uniform
 velocity v (a scene), the implicit scheme gains an advection term on the fixed grid: first-order
 upwind (monotone; numerical dispersion v dx / 2) or central differences (second order; oscillates
-where the grid Peclet number v dx / D exceeds 2)."""
+where the grid Peclet number v dx / D exceeds 2).
+
+Every step balances its mass: the interior's mass falls by exactly the flux into the two end nodes
+held at zero (the boundary of Fig. 8, fd_domain.py), to round-off. A step that loses or invents more
+raises MassError naming the mass error: such a run is a failure, never a score."""
 
 from __future__ import annotations
 
@@ -13,6 +17,28 @@ import numpy as np
 from ..core import measures as M
 from ..core.runconfig import RunConfig
 from ..numerics.compiled import kernels
+
+# a step's mass error (interior mass before - after - outflow) beyond this many ulps of the step's
+# largest terms is no round-off: the sums of N + 1 terms and the solve's residual (1 + 4 r + |p|) times eps
+MASS_ULPS = 64.0
+
+
+class MassError(ArithmeticError):
+    """An FD step that did not conserve mass beyond round-off (one line: the mass error)."""
+
+
+def check_balance(before: np.ndarray, after: np.ndarray, outflow: float, scale: float) -> None:
+    """MassError unless sum(before) - sum(after) equals ``outflow`` (the flux into the zero end
+    nodes, per dx) to round-off: ``scale`` (>= 1, the step matrix's largest row sum) times the sums'
+    magnitude and length in ulps."""
+    lost = float(before.sum()) - float(after.sum()) - outflow
+    size = float(np.abs(before).sum()) + float(np.abs(after).sum()) + abs(outflow)
+    tol = MASS_ULPS * np.finfo(np.float64).eps * scale * size * max(1.0, math.sqrt(before.size))
+    if not abs(lost) <= tol:
+        raise MassError(
+            f"fd step lost mass: mass error {lost:.3g} (interior {float(before.sum()):.17g} -> "
+            f"{float(after.sum()):.17g}, boundary outflow {outflow:.3g}) beyond round-off {tol:.3g}"
+        )
 
 
 def grid(cfg: RunConfig) -> tuple[np.ndarray, float]:
@@ -60,7 +86,10 @@ class ImplicitSolver:
         self._inv_piv, self._upper = kernels().thomas_factor(n_interior, self.r)
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
-        return kernels().thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
+        out = kernels().thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
+        # summing (I - r A) c' = c: sum c - sum c' = r (c'_1 + c'_M), the flux into the zero ends
+        check_balance(c_interior, out, self.r * (out[0] + out[-1]), 1.0 + 4.0 * self.r)
+        return out
 
 
 class AdvectionSolver:
@@ -90,18 +119,31 @@ class AdvectionSolver:
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         dl, d, du, du2, ipiv, _ = self._factors
         out, info = self._solve(dl, d, du, du2, ipiv, c_interior)
+        check_balance(c_interior, out, self.outflow(out), 1.0 + 4.0 * self.r + 2.0 * abs(self.p))
         return out
+
+    def outflow(self, c: np.ndarray) -> float:
+        """The mass per dx that the step's solution ``c`` sends into the zero end nodes: diffusion's
+        r (c_1 + c_M) plus the advective flux, the sum of p B c over the interior."""
+        p = self.p
+        if self.scheme == "upwind":
+            advected = p * c[-1] if p > 0 else -p * c[0]
+        else:
+            advected = 0.5 * p * (c[-1] - c[0])
+        return self.r * (c[0] + c[-1]) + advected
 
 
 class ExplicitSolver:
-    """Forward Euler c^{n+1} = c^n + r (c_{i-1} - 2 c_i + c_{i+1}); callers ensure r <= 1/2."""
+    """Forward Euler c^{n+1} = c^n + r (c_{i-1} - 2 c_i + c_{i+1}); RunConfig.check ensures r < 1/2."""
 
     def __init__(self, n_interior: int, r: float):
         self.r = r
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         padded = np.concatenate([[0.0], c_interior, [0.0]])
-        return c_interior + self.r * (padded[:-2] - 2.0 * c_interior + padded[2:])
+        out = c_interior + self.r * (padded[:-2] - 2.0 * c_interior + padded[2:])
+        check_balance(c_interior, out, self.r * (c_interior[0] + c_interior[-1]), 1.0 + 4.0 * self.r)
+        return out
 
 
 def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -> dict:

@@ -42,6 +42,13 @@ if TYPE_CHECKING:
 WALL_BAND = 0.05  # width of the near-wall band of ``wall_fraction`` [L]
 V_MAX = 0.25  # max of y - y^2 on [0, 1] [L/T]
 KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self weight
+# a step's dispersion, sqrt(2 alpha v_max dt) (its standard deviation where v_x is largest), may be at
+# most this fraction of the room it moves in: the channel's width 1 in y, the periodic length in x. The
+# Ito-Euler walk (and the drift alpha_T (1 - 2y) dt, at most alpha_T dt, smaller still) assumes that D
+# changes little over a step; D_yy = alpha_T v_x goes from 0 at a wall to its largest at y = 1/2, so a
+# step must be well below the channel. The paper's is 0.022 (alpha_T = 1e-3, dt = 1): a tenth allows
+# alpha_T dt <= 0.02, 20 times it. A step as wide as the channel folds every walker onto a wall.
+STEP_FRACTION = 0.1
 
 
 SHEAR_DEFAULTS = defaults(SHEAR)  # settings.SHEAR: each field's default, range and meaning
@@ -83,6 +90,17 @@ class ShearConfig:
             raise SettingError(
                 "dt", self.dt, f"at most {MAX_STEPS:,} steps to t_final: dt >= {self.t_final / MAX_STEPS:.3g}"
             )
+        for name, room in (("alpha_T", 1.0), ("alpha_L", self.length)):
+            alpha = getattr(self, name)
+            limit = (STEP_FRACTION * room) ** 2 / (2.0 * V_MAX * self.dt)
+            if alpha > limit:
+                where = "the channel's width 1" if name == "alpha_T" else f"length = {self.length:g}"
+                raise SettingError(
+                    name,
+                    alpha,
+                    f"a number in [0, {limit:.6g}] for dt = {self.dt:g}: a step's dispersion sqrt(2 {name} v_max dt) "
+                    f"(v_max = {V_MAX:g}) at most {STEP_FRACTION:g} x {where}",
+                )
         if self.case == "mt" and self.length / math.sqrt(self.alpha_L) <= 2.0 * kernel_cutoff(self):
             # the minimum-image distance in x is only exact while the kernel fits in half the box
             raise SettingError(

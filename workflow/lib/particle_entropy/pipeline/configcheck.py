@@ -10,7 +10,10 @@ one useful line.
 from __future__ import annotations
 
 import difflib
+import json
+import os
 import re
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -30,13 +33,60 @@ class ConfigFileError(ValueError):
     """A config file that cannot be read as YAML; the message names the file, line and column."""
 
 
+MAX_CONFIG_BYTES = 1_000_000  # a config file is read only up to this size: config.yaml is ~20 kB
+MAX_VALUES = 100_000  # values a file may hold once its aliases are expanded: config.yaml has ~2,000
+MAX_DEPTH = 40  # nesting levels of mappings and lists: config.yaml has 6
+MESSAGE_CHARS = 300  # a value (or a quoted schema message) longer than this is abbreviated in a message
+ALLOWED_CHARS = 1000  # the allowed text: a schema description (the longest ~400) and a hint
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+_OCTAL_1_1 = re.compile(r"[-+]?0[0-7]+")  # YAML 1.1 octal (0-prefixed); 1.2's 0o17 is text to YAML 1.1
+
+
+class _Abbreviated(str):
+    """A value too long for a message, shown as its abbreviated repr (no quotes around it)."""
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
+def _short(value, limit: int = 60):
+    """``value`` itself, or its repr abbreviated to ``limit`` characters."""
+    text = repr(value)
+    return value if len(text) <= limit else _Abbreviated(text[: limit - 3] + "...")
+
+
+def _clip(text: str, limit: int = MESSAGE_CHARS) -> str:
+    text = " ".join(str(text).split())  # one line
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def bounded(error: SettingError) -> SettingError:
+    """``error`` with its name, value and allowed text abbreviated: at most ~1,600 characters."""
+    value, allowed = _short(error.value, MESSAGE_CHARS), _clip(error.allowed, ALLOWED_CHARS)
+    if value is error.value and allowed == error.allowed and len(error.name) <= MESSAGE_CHARS:
+        return error
+    return SettingError(_clip(error.name), value, allowed)
+
+
 class _StrictLoader(SAFE_LOADER):
-    """The safe loader, refusing a key given twice in one mapping (YAML keeps the last one
-    silently) and the yte switch (Snakemake would run the file's templates as Python code)."""
+    """The safe loader, refusing what YAML would read other than as written: a key given twice in
+    one mapping (YAML keeps the last one silently), YAML 1.1's octal (010 = 8) and base-60
+    (1:30 = 90) numbers, a file whose aliases expand beyond MAX_VALUES values (or nest beyond
+    MAX_DEPTH) and the yte switch (Snakemake would run the file's templates as Python code).
+    Merge keys (<<: *anchor) work as in YAML 1.1, a key written beside them overriding theirs."""
+
+    def get_single_data(self):
+        node = self.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node, 0, {}, set())  # before anything walks the values an alias repeats
+        return self.construct_document(node)
 
     def construct_mapping(self, node, deep=False):
         seen = {}
         for key_node, _ in node.value:
+            if key_node.tag == _MERGE_TAG:  # its keys may be overridden here: not a duplicate
+                continue
             key = self.construct_object(key_node, deep=True)
             line = key_node.start_mark.line + 1
             if key == YTE_KEY:
@@ -45,31 +95,143 @@ class _StrictLoader(SAFE_LOADER):
                     "a config of this workflow is data: remove the key and write the values out"
                 )
             try:
-                first = seen.setdefault(key, line)
+                first = seen.get(key)
             except TypeError:  # an unhashable key: the base loader says so
                 break
-            if first != line:
-                raise ConfigFileError(f"line {line}: key {key!r} given twice in one mapping (first at line {first})")
+            seen[key] = line
+            if first is not None:  # on any line, a flow mapping's too
+                raise ConfigFileError(
+                    f"line {line}: key {_short(key)!r} given twice in one mapping (first at line {first}); "
+                    "each key once"
+                )
         return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node):
+        _refuse_yaml11_number(node, super().construct_yaml_int(node))
+        return super().construct_yaml_int(node)
+
+    def construct_yaml_float(self, node):
+        _refuse_yaml11_number(node, super().construct_yaml_float(node))
+        return super().construct_yaml_float(node)
+
+
+_StrictLoader.add_constructor("tag:yaml.org,2002:int", _StrictLoader.construct_yaml_int)
+_StrictLoader.add_constructor("tag:yaml.org,2002:float", _StrictLoader.construct_yaml_float)
+
+
+def _refuse_yaml11_number(node, number) -> None:
+    """ConfigFileError for a plain scalar that YAML 1.1 reads as octal or base 60."""
+    text, line = str(node.value), node.start_mark.line + 1
+    if node.style:  # quoted: written as text on purpose (plain: None, libyaml: "")
+        return
+    digits = text.replace("_", "")
+    if ":" in digits:
+        raise ConfigFileError(
+            f"line {line}: {_short(text)} is a YAML 1.1 base-60 number, read as {number!r}; write {number!r} "
+            f"(or quote it, '{_clip(text, 60)}', for text)"
+        )
+    if _OCTAL_1_1.fullmatch(digits):
+        decimal = int(digits.lstrip("+-").lstrip("0") or "0") * (-1 if digits.startswith("-") else 1)
+        spelling = f"write {decimal}" if decimal == number else f"write {decimal} for ten-based or {number!r}"
+        raise ConfigFileError(
+            f"line {line}: {_short(text)} is a YAML 1.1 octal number, read as {number!r}; {spelling} (no leading zero)"
+        )
+
+
+def _expanded_size(node, depth: int, sizes: dict, open_nodes: set) -> int:
+    """The number of values ``node`` holds once every alias in it is written out (an alias is the
+    same node object again: counted once per use, computed once); ConfigFileError naming the line
+    past MAX_VALUES, MAX_DEPTH or a value that contains itself."""
+    key = id(node)
+    if key in sizes:
+        return sizes[key]
+    line = node.start_mark.line + 1
+    if depth > MAX_DEPTH:
+        raise ConfigFileError(f"line {line}: nested deeper than {MAX_DEPTH} levels of mappings and lists")
+    if key in open_nodes:
+        raise ConfigFileError(f"line {line}: this value contains itself through an alias; write it out")
+    if isinstance(node, yaml.ScalarNode):
+        return 1
+    open_nodes.add(key)
+    children = node.value if isinstance(node, yaml.SequenceNode) else [n for pair in node.value for n in pair]
+    total = 1
+    for child in children:
+        total += _expanded_size(child, depth + 1, sizes, open_nodes)
+        if total > MAX_VALUES:
+            raise ConfigFileError(
+                f"line {line}: this value's aliases expand it to more than {MAX_VALUES} values "
+                "(a config has a few thousand); write the values out or use fewer aliases"
+            )
+    open_nodes.discard(key)
+    sizes[key] = total
+    return total
+
+
+_KIND = {
+    stat.S_IFIFO: "a pipe (FIFO)",
+    stat.S_IFCHR: "a character device",
+    stat.S_IFBLK: "a block device",
+    stat.S_IFSOCK: "a socket",
+    stat.S_IFDIR: "a folder",
+}
+
+
+def read_config_text(path: str | Path) -> str:
+    """The text of the config file at ``path``: a regular file of at most MAX_CONFIG_BYTES bytes of
+    UTF-8, checked before it is opened (a pipe or a device is never read); ConfigFileError else."""
+    limit = f"a config is a regular file of at most {MAX_CONFIG_BYTES // 1_000_000} MB"
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        raise ConfigFileError(f"{path}: no such file") from None
+    except OSError as e:
+        raise ConfigFileError(f"{path}: cannot be read ({e.strerror or e})") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = _KIND.get(stat.S_IFMT(info.st_mode), "not a regular file")
+        raise ConfigFileError(f"{path}: {kind}, not a config file; {limit}")
+    too_big = ConfigFileError(f"{path}: larger than {MAX_CONFIG_BYTES} bytes; {limit}")
+    if info.st_size > MAX_CONFIG_BYTES:
+        raise too_big
+    try:
+        with open(path, "rb") as f:
+            raw = f.read(MAX_CONFIG_BYTES + 1)  # a file that grows, or a /proc file of size 0
+    except OSError as e:
+        raise ConfigFileError(f"{path}: cannot be read ({e.strerror or e})") from None
+    if len(raw) > MAX_CONFIG_BYTES:
+        raise too_big
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:  # the whole file: the offset counts from its start
+        line = raw[: e.start].count(b"\n") + 1
+        where = f"line {line} (byte {e.start} is 0x{raw[e.start]:02x})"
+        raise ConfigFileError(f"{path}: not UTF-8 text at {where}") from None
+
+
+def _json_object(pairs):
+    """A JSON object as a dict, refusing a key given twice (json keeps the last one)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise ConfigFileError(f"key {_short(key)!r} given twice in one JSON object; each key once")
+        out[key] = value
+    return out
 
 
 def load_yaml(path: str | Path) -> Mapping:
-    """The YAML file at ``path`` as a mapping; ConfigFileError names the line of a syntax error, of
-    a key given twice or of the yte switch, and a file that is not UTF-8 text."""
+    """The config file at ``path`` as a mapping, read as Snakemake reads it (JSON when it is JSON,
+    else YAML 1.1) but only from a regular file of at most MAX_CONFIG_BYTES (read_config_text);
+    ConfigFileError names the line of a syntax error, of a key given twice, of a YAML 1.1 octal or
+    base-60 number, of an alias bomb, of the yte switch, and a file that is not UTF-8 text."""
+    text = read_config_text(path)
     try:
-        with open(path, encoding="utf-8") as f:
-            data = yaml.load(f, Loader=_StrictLoader)
+        try:
+            data = json.loads(text, object_pairs_hook=_json_object)  # Snakemake tries JSON first
+        except json.JSONDecodeError:
+            data = yaml.load(text, Loader=_StrictLoader)
     except ConfigFileError as e:
         raise ConfigFileError(f"{path}: {e}") from None
-    except UnicodeDecodeError:
-        raw = Path(path).read_bytes()
-        try:
-            raw.decode("utf-8")
-        except UnicodeDecodeError as e:  # the whole file: the offset counts from its start
-            line = raw[: e.start].count(b"\n") + 1
-            where = f"line {line} (byte {e.start} is 0x{raw[e.start]:02x})"
-            raise ConfigFileError(f"{path}: not UTF-8 text at {where}") from None
-        raise
+    except RecursionError:
+        raise ConfigFileError(f"{path}: nested deeper than {MAX_DEPTH} levels of mappings and lists") from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark is not None else "somewhere"
@@ -78,10 +240,12 @@ def load_yaml(path: str | Path) -> Mapping:
         if context and start is not None:
             context += f" started at line {start.line + 1}, column {start.column + 1}"
         raise ConfigFileError(
-            f"{path}: not valid YAML at {where}: {problem}" + (f" ({context})" if context else "")
+            _clip(f"{path}: not valid YAML at {where}: {problem}" + (f" ({context})" if context else ""))
         ) from None
     if not isinstance(data, Mapping):
-        raise ConfigFileError(f"{path}: a config is a YAML mapping of keys (physics:, time:, ...), got {data!r}")
+        raise ConfigFileError(
+            f"{path}: a config is a YAML mapping of keys (physics:, time:, ...), got {_short(data)!r}"
+        )
     return data
 
 
@@ -133,18 +297,54 @@ def key_path(parts) -> str:
     return out or "(top level)"
 
 
-def _short(value, limit: int = 60):
-    text = repr(value)
-    return value if len(text) <= limit else text[: limit - 3] + "..."
+_NUMBER_PARTS = re.compile(r"([+-]?)(\d*)(?:\.(\d*))?(?:[eE]([+-]?)(\d+))?")
 
 
-def _number_hint(value) -> str:
-    """YAML 1.1 reads 1e-3 (no decimal point) as text: say how to write it as a number."""
-    if isinstance(value, str) and _NUMBER_TEXT.match(value.strip()):
-        mantissa, _, exponent = value.strip().lower().partition("e")
-        fixed = (mantissa if "." in mantissa else mantissa + ".0") + (f"e{exponent}" if exponent else "")
-        return f"; YAML reads {value} as text: write {fixed}"
-    return ""
+def float_spelling(text: str) -> str | None:
+    """The number ``text`` spelt so that YAML 1.1 reads it as a float (a dot in the mantissa, a
+    sign in the exponent: 1e3 -> 1.0e+3, .5e-2 -> 0.5e-2), or None when it is not a number."""
+    m = _NUMBER_PARTS.fullmatch(text.strip())
+    if m is None or not (m[2] or m[3]):
+        return None
+    sign, whole, fraction, exponent_sign, exponent = m.groups()
+    out = f"{sign}{whole or '0'}.{fraction or '0'}" + (f"e{exponent_sign or '+'}{exponent}" if exponent else "")
+    return out if isinstance(yaml.load(out, Loader=SAFE_LOADER), float) else None
+
+
+def _wants_integer(schema: Mapping) -> bool:
+    kind = schema.get("type")
+    return kind == "integer" or (isinstance(kind, list) and "integer" in kind and "number" not in kind)
+
+
+def _number_hint(value, schema: Mapping | None = None) -> str:
+    """How to write ``value`` as the number it looks like: YAML 1.1 reads 1e-3 (no dot in the
+    mantissa, no sign in the exponent) and 0o17 as text; an integer setting takes no 1000.0."""
+    integer = _wants_integer(schema or {})
+    if isinstance(value, float) and integer and value.is_integer() and abs(value) < 2**63:
+        return f"; write {int(value)}: an integer, with no decimal point or exponent"
+    if not isinstance(value, str):
+        return ""
+    text = value.strip()
+    if re.fullmatch(r"[+-]?0o[0-7]+", text):
+        return f"; YAML 1.1 reads {_short(text)} as text: write {int(text.replace('0o', ''), 8)} (ten-based)"
+    spelling = float_spelling(text)
+    if spelling is None:
+        return ""
+    number = float(spelling)
+    if integer and number.is_integer() and abs(number) < 2**63:
+        return f"; YAML reads {_short(text)} as text: write {int(number)}"
+    return f"; YAML 1.1 reads {_short(text)} as text: write {spelling}"
+
+
+def _strict_validator():
+    """Draft 2020-12 with an integer that is an int: JSON Schema counts 1000.0 as an integer, but a
+    seed or an N of 1000.0 names files seeds~1000.0 that no rule makes."""
+    from jsonschema import Draft202012Validator, validators
+
+    integer = Draft202012Validator.TYPE_CHECKER.redefine(
+        "integer", lambda checker, value: isinstance(value, int) and not isinstance(value, bool)
+    )
+    return validators.extend(Draft202012Validator, type_checker=integer)
 
 
 def _schema_error_to_setting(error) -> SettingError:
@@ -172,20 +372,20 @@ def _schema_error_to_setting(error) -> SettingError:
             key_path([*path, key]), "(missing)", "a required key" + (f": {described}" if described else "")
         )
     described = schema.get("description", "")
-    allowed = f"{described} ({error.message})" if described else error.message
+    message = _clip(error.message)  # it quotes the value
+    allowed = f"{described} ({message})" if described else message
     if error.validator in ("type", "oneOf"):
-        allowed += _number_hint(error.instance)
+        allowed += _number_hint(error.instance, schema)
     return SettingError(key_path(path), _short(error.instance), allowed)
 
 
 def check_schema(config: Mapping, schema: Mapping) -> None:
     """SettingError for the most relevant way ``config`` breaks ``schema`` (none if it conforms)."""
-    from jsonschema import Draft202012Validator
     from jsonschema.exceptions import best_match
 
-    error = best_match(Draft202012Validator(schema).iter_errors(dict(config)))
+    error = best_match(_strict_validator()(schema).iter_errors(dict(config)))
     if error is not None:
-        raise _schema_error_to_setting(error)
+        raise bounded(_schema_error_to_setting(error))
 
 
 def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
@@ -193,19 +393,46 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
-def check_config(config: Mapping, schema: Mapping | None = None, available: float | None = None) -> None:
+def check_config(
+    config: Mapping, schema: Mapping | None = None, available: float | None = None, not_judged: list | None = None
+) -> None:
     """Everything a dry run checks: the schema, then every rule between fields (crosschecks.check_sweeps),
     with ``available`` bytes (the machine's, for the check-config command) that every job fits
-    (crosschecks.check_memory), and every adaptive search and scene, which a dry run checks only when
-    a target needs it."""
-    from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_optimum, check_scene_memory, check_sweeps
+    (crosschecks.check_memory), and every adaptive search and scene. A run checks a search or a
+    scene only when a requested target needs it (none of the default target's do): given a list
+    ``not_judged``, one that would be refused is not raised but said there, one line each, naming
+    the targets that would refuse it (the check-config command: judged as the run judges).
+    Every message is bounded (``bounded``): a long value is abbreviated."""
+    from ..experiments.scene import PECLET_PREFIX, scenes
+    from .crosschecks import check_memory, check_scene_memory, check_search, check_sweeps
 
-    check_schema(config, load_schema() if schema is None else schema)
-    check_sweeps(config)
-    if available is not None:
-        check_memory(config, available)
-    check_optimum(config, available)
+    try:
+        check_schema(config, load_schema() if schema is None else schema)
+        check_sweeps(config)
+        if available is not None:
+            check_memory(config, available)
+    except SettingError as e:
+        raise bounded(e) from None
+
+    def judge(check, section: str, targets: str) -> None:
+        try:
+            check()
+        except SettingError as e:
+            if not_judged is None:
+                raise bounded(e) from None
+            not_judged.append(f"{section} not judged: only {targets} use it, and they would refuse it: {bounded(e)}")
+
+    for name in config.get("optimum", {}) or {}:
+        judge(
+            lambda name=name: check_search(name, config, available),
+            f"optimum.{name}",
+            f"`snakemake optimum` and results/optimum/{name}.parquet",
+        )
     every = scenes(config, None if available is None else lambda scene: check_scene_memory(scene, available))
     for name in every:  # builds and checks each scene
-        every[name]
+        peclet = name.startswith(PECLET_PREFIX)
+        judge(
+            lambda name=name: every[name],
+            f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",
+            "`snakemake scenes` and " + ("figures/scenes_peclet.png" if peclet else f"figures/scene_{name}.png"),
+        )

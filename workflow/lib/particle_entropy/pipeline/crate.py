@@ -39,7 +39,7 @@ from pathlib import Path
 
 import yaml
 
-from .verify import CRATE_DIR, cached_digests, file_sha256, recorded_digest
+from .verify import CRATE_DIR, DIGESTS, cached_digests, file_sha256, recorded_digest, restamp_digests, stamp
 
 RO_CRATE_VERSION = "1.1"  # the version the Workflow Run Crate profiles 0.5 build on
 SHA256_TERM = "https://w3id.org/ro/terms/workflow-run#sha256"  # the profiles' digest property
@@ -115,24 +115,29 @@ def recorded_jobs(workdir: Path, coded: Iterable[str]) -> list[Job]:
 
 
 class Digests:
-    """SHA-256 of files below a run folder: a table from the run's digest cache where its size,
-    mtime and inode still match (the table check has read it), anything else read once."""
+    """SHA-256 of files below a run folder: a table from the run's digest cache where its entry
+    still vouches for it (the table check has read it), anything else read once. ``linked`` then
+    gives the cache the new stamps of vouched tables that were hard-linked since (a link moves a
+    file's ctime, not its bytes), so the next check does not read them again either."""
 
     def __init__(self, workdir: Path):
         self.workdir = workdir
-        self.cache = cached_digests(workdir / ".snakemake" / "particle_entropy" / "table_digests.json")
+        self.cache = cached_digests(workdir / DIGESTS)
         self.reads = 0  # files read to hash them
         self._known: dict[str, str] = {}
+        self._vouched: dict[str, str] = {}  # cache key -> digest, for tables the cache vouched for
+
+    @staticmethod
+    def _key(rel: str) -> str | None:
+        return Path(rel).relative_to("results").as_posix() if rel.startswith("results/") else None
 
     def __call__(self, rel: str) -> str:
         if rel not in self._known:
             path = self.workdir / rel
-            st = path.stat()
-            remembered = (
-                self.cache.get(Path(rel).relative_to("results").as_posix()) if rel.startswith("results/") else None
-            )
-            if remembered and remembered[:3] == [st.st_size, st.st_mtime_ns, st.st_ino]:
-                digest = remembered[3]
+            key = self._key(rel)
+            entry = self.cache.get(key) if key else None
+            if entry and entry[:4] == stamp(path.stat()):
+                digest = self._vouched[key] = entry[4]
             else:
                 digest = file_sha256(path)
                 self.reads += 1
@@ -141,6 +146,15 @@ class Digests:
                     raise ValueError(f"{rel}: its SHA-256 differs from the one recorded beside it; rerun the workflow")
             self._known[rel] = digest
         return self._known[rel]
+
+    def linked(self) -> None:
+        """Restamp the cache entries of the vouched tables (verify.restamp_digests)."""
+        tables = {}
+        for key, digest in self._vouched.items():
+            path = self.workdir / "results" / key
+            tables[key] = [*stamp(path.stat()), digest]
+        if tables:
+            restamp_digests(self.workdir / DIGESTS, tables)
 
 
 def git_state(folder: Path) -> tuple[str, bool | None]:
@@ -249,8 +263,8 @@ def build_crate(
         """The crate's File entity for ``rel`` (a path below the run), placed in the crate once."""
         if rel not in files:
             src = source if source is not None else workdir / rel
+            props.setdefault("sha256", digests(rel) if source is None else file_sha256(src))  # before the link
             _place(src, out / rel)
-            props.setdefault("sha256", digests(rel) if source is None else file_sha256(src))
             props.setdefault("contentSize", str(src.stat().st_size))
             with warnings.catch_warnings():  # the file is placed here, not copied by the library
                 warnings.simplefilter("ignore", UserWarning)
@@ -441,6 +455,7 @@ def build_crate(
     )
     crate.root_dataset["mentions"] = [run]
     crate.root_dataset["about"] = citation
+    digests.linked()
     with warnings.catch_warnings():  # the files are placed already: nothing for the library to copy
         warnings.simplefilter("ignore", UserWarning)
         crate.write(out)

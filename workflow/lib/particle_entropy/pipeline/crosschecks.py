@@ -11,7 +11,7 @@ from collections.abc import Mapping
 
 from ..core.case import Case, SettingError
 from ..core.labels import case_label
-from ..core.runconfig import MAX_SEED, RunConfig, first_step_key
+from ..core.runconfig import FD_MIN_INTERVALS, MAX_SEED, RunConfig, first_step_key
 from ..core.settings import PAPER, SETTINGS
 from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
@@ -62,15 +62,18 @@ def check_fd_domain(config: Mapping) -> None:
     settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
     for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
         try:
-            RunConfig.of(method="fd", kernel="implicit", n=2, fd_length=float(length), **settings).check()
+            cfg = RunConfig.of(method="fd", kernel="implicit", n=FD_MIN_INTERVALS, fd_length=float(length), **settings)
+            cfg.check_domain()
         except SettingError as e:
             raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
-    for n in spec["n"]:
+    for n in spec["n"]:  # each grid as it runs: a dx that resolves the plume
         for length in spec["lengths"]:
             try:
-                grid_intervals(int(n), float(length), ref)
+                n_int = grid_intervals(int(n), float(length), ref)
+                RunConfig.of(method="fd", kernel="implicit", n=n_int, fd_length=float(length), **settings).check()
             except SettingError as e:
-                raise SettingError("mechanism.fd_domain.n", n, e.allowed) from None
+                key, value = ("lengths", length) if e.name == "fd_length" else ("n", n)
+                raise SettingError(f"mechanism.fd_domain.{key}", value, e.allowed) from None
 
 
 def check_finite(value, where: str = "") -> None:
@@ -161,12 +164,15 @@ def optimum_largest_jobs(search) -> list[Ensemble]:
 
 def check_memory(config: Mapping, available: float) -> None:
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
-    of its seed block; the shear jobs: shear_memory_mb; an adaptive search's jobs: check_search)."""
+    of its seed block; each run of the lattice floors; the shear jobs: shear_memory_mb; an adaptive
+    search's jobs: check_search)."""
     jobs = [
         (f"{name}.n", ens, block_size(ens, config))
         for name, spec in case_sections(config).items()
         for ens in spec_ensembles(spec, config)
     ]
+    # the floors job runs its lattice cases one after another in one process: each must fit
+    jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(config)]
     _check_jobs_fit(jobs, config, available)
     if "shear" in config:
         need = shear_memory_mb(config) * 2**20

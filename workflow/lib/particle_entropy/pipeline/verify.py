@@ -3,9 +3,12 @@
 Beside each table a ``<name>.sha256`` file records the SHA-256 of its bytes (io.write_parquet);
 ``corrupt_tables`` finds every table whose bytes no longer match (a truncation, a flipped bit,
 an empty file) so that the workflow can set it aside and rebuild it. Given a digests file, it
-remembers each table's SHA-256 against the table's size, mtime and inode (as DVC does) and reads
-a table again only when one of them changed. Only the workflow's main process and the crate
-job (pipeline/crate.py) import this module, so editing it reruns no rule but `crate`.
+remembers each table's SHA-256 against the table's size, mtime, inode and ctime (DVC keeps the
+first three; the ctime, which no user can set back, also sees an edit in place with the mtime
+put back) and reads a table again only when one of them changed. Folders linked under the root
+are followed (``tables_below``). It also says, before any job, which folder a run cannot write
+(``write_problems``). Only the workflow's main process and the crate job (pipeline/crate.py)
+import this module, so editing it reruns no rule but `crate`.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import json
 import os
 import re
 import shutil
+import tempfile
 import time
 from pathlib import Path
 
@@ -22,6 +26,7 @@ from ..core.io import checksum_path, write_bytes_atomically
 
 CORRUPT_SUFFIX = ".corrupt"
 CRATE_DIR = "results/ro-crate"  # a run's RO-Crate (pipeline/crate.py): links to tables checked where they were made
+DIGESTS = ".snakemake/particle_entropy/table_digests.json"  # the table check's digest cache, below a run folder
 MAGIC = b"PAR1"
 
 
@@ -100,22 +105,45 @@ def content_problem(path: str | os.PathLike, expected: dict) -> str | None:
     return None
 
 
-DIGESTS_VERSION = 1
+DIGESTS_VERSION = 2  # 2: the ctime joined the stamp
 # A table changed less than this before it was hashed is hashed again next time: a write in the
 # same tick of the file system's clock (or within its 1-2 s granularity) would keep the mtime.
 SETTLED_NS = 2 * 10**9
+
+
+def tables_below(root: str | os.PathLike, suffix: str = ".parquet") -> list[Path]:
+    """Everything below ``root`` whose name ends in ``suffix`` (files, and folders, pipes and devices
+    in a table's place), sorted, as paths through ``root``.
+    Folders that are symbolic links are followed (results/runs may be a link to another disk), each
+    real folder once: a link to a folder seen already, such as a loop back to an ancestor, is
+    skipped."""
+    seen, out = set(), []
+    for folder, dirs, files in os.walk(root, followlinks=True):
+        try:
+            st = os.stat(folder)
+        except OSError:  # gone since it was listed
+            dirs[:] = []
+            continue
+        if (st.st_dev, st.st_ino) in seen:
+            dirs[:] = []
+            continue
+        seen.add((st.st_dev, st.st_ino))
+        dirs.sort()
+        out += [Path(folder, name) for name in dirs + files if name.endswith(suffix)]  # a folder by a table's name too
+    return sorted(out)
 
 
 def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = None, expected=None) -> dict[Path, str]:
     """Every table below ``root`` that cannot be trusted, with the reason (a folder, pipe or device
     with a table's name included).
 
-    With ``digests`` (a JSON file) each table's SHA-256 is kept against its size, mtime and inode,
-    as DVC does, and a table is read again only when one of them changed, as a new write (a new
-    file renamed into place) always does; the checksum beside it is read every time, and a table
-    that seems not to match is read before it is condemned. The accepted limit: bytes changed with
-    all three kept (rewritten in place with the mtime set back, or decayed on the disk) go unseen
-    until the digests file is deleted. A missing or unreadable digests file is rebuilt.
+    With ``digests`` (a JSON file) each table's SHA-256 is kept against its size, mtime, inode and
+    ctime, and a table is read again only when one of them changed, as a new write (a new file
+    renamed into place) and an edit in place (the mtime set back or not) always do; the checksum
+    beside it is read every time, and a table that seems not to match is read before it is
+    condemned. Bytes that decay on the disk change none of the four: a job reading such a table
+    fails on its page checksums (core.io.read_parquet), which moves its ctime, so the next check
+    hashes it again. A missing or unreadable digests file is rebuilt.
 
     ``expected``: a function of a table's path (as found below ``root``) giving the column values
     its path names (``content_problem``), or None for a path that names none; every table read
@@ -126,7 +154,7 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
     known = _read_digests(digests) if digests is not None else {}
     kept, out = {}, {}
     crate = Path(CRATE_DIR).relative_to("results").as_posix() + "/"
-    for path in sorted(root.rglob("*.parquet")):
+    for path in tables_below(root):
         key = path.relative_to(root).as_posix()
         if key.startswith(crate):  # hard links of tables checked at their own paths
             continue
@@ -134,10 +162,10 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
         remembered = False
         if path.is_file() and recorded_digest(path) is not None:
             st = path.stat()
-            stamp = [st.st_size, st.st_mtime_ns, st.st_ino]
-            remembered = known.get(key, [])[:3] == stamp
+            stamp = [st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns]
+            remembered = known.get(key, [])[:4] == stamp
             if remembered:
-                digest = known[key][3]
+                digest = known[key][4]
             else:
                 hashed_at = time.time_ns()
                 digest = file_sha256(path)
@@ -160,8 +188,8 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
 
 
 def _read_digests(path: str | os.PathLike) -> dict[str, list]:
-    """The entries of a digests file, {table: [size, mtime_ns, inode, sha256]}; none when it is
-    missing, not a regular file, unreadable or not in this format."""
+    """The entries of a digests file, {table: [size, mtime_ns, inode, ctime_ns, sha256]}; none when
+    it is missing, not a regular file, unreadable or not in this format."""
     path = Path(path)
     try:
         if not path.is_file():
@@ -173,19 +201,33 @@ def _read_digests(path: str | os.PathLike) -> dict[str, list]:
             for key, entry in tables.items()
             if isinstance(key, str)
             and isinstance(entry, list)
-            and len(entry) == 4
-            and all(type(x) is int for x in entry[:3])
-            and isinstance(entry[3], str)
+            and len(entry) == 5
+            and all(type(x) is int for x in entry[:4])
+            and isinstance(entry[4], str)
         }
     except (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError):
         return {}
 
 
+def stamp(st: os.stat_result) -> list[int]:
+    """What a digest cache entry holds a table's SHA-256 against: size, mtime, inode and ctime."""
+    return [st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns]
+
+
 def cached_digests(path: str | os.PathLike) -> dict[str, list]:
-    """The digest cache at ``path`` as the table check left it: {table below results/: [size,
-    mtime_ns, inode, sha256]} (empty when missing or unreadable); entries vouch for a table only
-    while its size, mtime and inode match."""
+    """The digest cache at ``path`` as the table check left it: {table below results/: [*stamp,
+    sha256]} (empty when missing or unreadable); an entry vouches for a table only while its stamp
+    matches the table's."""
     return _read_digests(path)
+
+
+def restamp_digests(path: str | os.PathLike, tables: dict[str, list]) -> None:
+    """Give the cache entries of ``tables`` ({table below results/: [*stamp, sha256]}) their new
+    stamps: for tables whose entry vouched for them just before a change that leaves their bytes
+    alone (a hard link moves the ctime), so that the next check does not read them again."""
+    known = _read_digests(path)
+    known.update(tables)
+    _write_digests(Path(path), known)
 
 
 def _write_digests(path: Path, tables: dict[str, list]) -> None:
@@ -229,6 +271,38 @@ def set_aside_corrupt(root, digests=None, expected=None, report=print) -> list[P
             ) from None
         report(f"corrupt table {path}: {problem}; moved to {target.name}; the default target rebuilds it")
         moved.append(path)
+    return moved + set_aside_mixed_runs(root, report)
+
+
+def set_aside_mixed_runs(root, report=print) -> list[Path]:
+    """Set aside (as ``set_aside``) every table below ``root`` that names a run (io.write_run)
+    whose other tables are there from another run, or from none: a run stopped between the
+    renames of its tables (SIGKILL, a power cut) left tables of two runs side by side, each
+    whole and under its own checksum. Both sides are moved, so the job writing them runs again.
+    A table whose partner is missing is left (the job reruns for the missing one); a table that
+    cannot be read is corrupt_tables' to judge. Reads each table's footer (its key-value metadata)
+    only. Returns the tables moved; one that cannot be moved raises TableError."""
+    from ..core.io import run_of
+
+    root = Path(root)
+    mixed = {}
+    for path in sorted(root.rglob("*.parquet")) if root.exists() else []:
+        run = run_of(path) if path.is_file() else None
+        for name in (run or {}).get("tables", []):
+            other = path.parent / str(name)
+            if other.is_file() and (run_of(other) or {}).get("id") != run["id"]:
+                mixed[path] = f"it is from run {run['id'][:12]}, its {name} from another run"
+    moved = []
+    for path, problem in mixed.items():
+        try:
+            target = set_aside(path)
+        except OSError as e:
+            raise TableError(
+                f"table {path}: {problem}; it cannot be moved aside ({e.strerror or e}): "
+                "make its folder writable, or delete it, and rerun"
+            ) from None
+        report(f"table {path}: {problem}; moved to {target.name}; the default target rebuilds it")
+        moved.append(path)
     return moved
 
 
@@ -268,3 +342,70 @@ def disk_space_problems(paths=(".", "results", ".snakemake"), device_of=lambda p
         if problem:
             out.append(problem)
     return out
+
+
+# A run writes .snakemake/ (Snakemake's state) and results/, and numba writes its cache of compiled
+# kernels; where one of them cannot be written every job fails, on a traceback or an empty log.
+# The workflow says so in one line before any job instead (workflow/rules/common.smk).
+NUMBA_CACHE_PROBE_BYTES = 4 * 2**20  # twice what numba's cache of every kernel takes (1.8 MB)
+
+
+def write_problem(folder: str | os.PathLike, probe_bytes: int = 0) -> str | None:
+    """Why no file can be written in ``folder``, or None: the folder is made if missing (as the run
+    would), a temporary file made in it with ``probe_bytes`` written, then removed."""
+    try:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder) as f:
+            for _ in range(0, probe_bytes, 2**20):
+                f.write(bytes(2**20))
+            f.flush()
+    except OSError as e:
+        return e.strerror or str(e)
+    return None
+
+
+def folder_problems(folders=(".snakemake", "results")) -> list[str]:
+    """A line for each of ``folders`` in which nothing can be written, naming it and what to do."""
+    out = []
+    for folder in folders:
+        why = write_problem(folder)
+        if why:
+            out.append(
+                f"cannot write in {folder}/ ({Path(folder).absolute()}): {why}; run in a writable working "
+                "directory (snakemake -d <folder>) or make this one writable"
+            )
+    return out
+
+
+def numba_cache_folders(library: str | os.PathLike, environ=os.environ) -> list[Path]:
+    """Where numba keeps the compiled kernels of ``library``'s numerics, in the order numba tries
+    them (numba.core.caching's locators): $NUMBA_CACHE_DIR, the __pycache__ beside the kernels'
+    sources, the user's cache ($XDG_CACHE_HOME or ~/.cache, then numba). Numba takes the first in
+    which it can make a file, and fails on a write there (a full disk) or when none is writable."""
+    folders = [Path(environ["NUMBA_CACHE_DIR"])] if environ.get("NUMBA_CACHE_DIR") else []
+    folders.append(Path(library) / "particle_entropy" / "numerics" / "__pycache__")
+    folders.append(Path(environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "numba")
+    return folders
+
+
+def numba_cache_problem(folders: list[Path], probe_bytes: int = NUMBA_CACHE_PROBE_BYTES) -> str | None:
+    """A line when numba cannot keep compiled kernels in the first of ``folders`` it would take (no
+    room: ENOSPC or a quota) or can take none (all read-only or not folders), naming the folder and
+    what to change; None otherwise."""
+    tried = []
+    for folder in folders:
+        why = write_problem(folder)
+        if why is None:
+            full = write_problem(folder, probe_bytes)
+            if full is None:
+                return None
+            mb = probe_bytes / 2**20
+            return (
+                f"No space left for numba's cache of compiled kernels in {folder} ({full}): free {mb:.0f} MB "
+                f"there, or set NUMBA_CACHE_DIR to a folder with room, and rerun"
+            )
+        tried.append(f"{folder} ({why})")
+    return (
+        f"numba has no writable folder for its cache of compiled kernels: {'; '.join(tried)}; "
+        "set NUMBA_CACHE_DIR to a writable folder and rerun"
+    )
