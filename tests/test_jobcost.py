@@ -69,6 +69,8 @@ def test_the_simulate_rule_gives_each_job_its_estimate_as_priority(tmp_path):
     proc = run_snakemake(tmp_path, "figures/fig9.png", dry_run=True, configfile=ROOT / "config.yaml")
     out = proc.stdout + proc.stderr
     blocks = out.split("\nrule simulate:")
-    long = next(b for b in blocks if "collision/n~30000/eta~1/trunc~3/growth~1.05/scheme~authors" in b.split("reason:")[0])
+    long = next(
+        b for b in blocks if "collision/n~30000/eta~1/trunc~3/growth~1.05/scheme~authors" in b.split("reason:")[0]
+    )
     expected = estimated_seconds(run_config(_authors("collision", 1, 30000), CONFIG), 4)
     assert f"priority: {expected}" in long

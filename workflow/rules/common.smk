@@ -36,7 +36,7 @@ from particle_entropy.pipeline.verify import (
     set_aside_corrupt,
     tables_below,
 )
-from particle_entropy.pipeline.crate import provenance
+from particle_entropy.pipeline.crate import METADATA as CRATE_METADATA, provenance
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR

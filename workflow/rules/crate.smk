@@ -7,7 +7,7 @@ rule crate:
     input:
         all_targets(),
     output:
-        directory(CRATE_DIR),
+        f"{CRATE_DIR}/{CRATE_METADATA}",  # the crate's other files are links, kept where they hold
     log:
         "logs/crate.log",
     localrule: True

@@ -1,6 +1,7 @@
 """The run's RO-Crate: results/ro-crate/ (pipeline/crate.py)."""
 
 import sys
+from pathlib import Path
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
@@ -12,10 +13,11 @@ summary = build_crate(
     par.checkout,
     snakemake.config,
     par.coded,
-    out=snakemake.output[0],
+    out=Path(snakemake.output[0]).parent,
     progress=lambda line: print(line, file=sys.stderr),
 )
 print(
-    f"crate: {summary['files']} files, {summary['jobs']} jobs, {summary['hashed']} files hashed -> {summary['path']}",
+    f"crate: {summary['files']} files, {summary['jobs']} jobs, {summary['hashed']} files hashed "
+    f"({summary['tables']} tables hashed) -> {summary['path']}",
     file=sys.stderr,
 )

@@ -124,6 +124,7 @@ class Digests:
         self.workdir = workdir
         self.cache = cached_digests(workdir / DIGESTS)
         self.reads = 0  # files read to hash them
+        self.tables_read = 0  # of which tables
         self._known: dict[str, str] = {}
         self._vouched: dict[str, str] = {}  # cache key -> digest, for tables the cache vouched for
 
@@ -141,6 +142,7 @@ class Digests:
             else:
                 digest = file_sha256(path)
                 self.reads += 1
+                self.tables_read += rel.endswith(".parquet")
                 want = recorded_digest(path) if rel.endswith(".parquet") else None
                 if want is not None and want != digest:
                     raise ValueError(f"{rel}: its SHA-256 differs from the one recorded beside it; rerun the workflow")
@@ -187,14 +189,28 @@ def config_digest(config: Mapping) -> str:
 
 
 def _place(source: Path, target: Path) -> None:
-    """Put ``source`` at ``target``: a hard link, else a copy (another file system)."""
+    """Put ``source`` at ``target``: a hard link, else a copy (another file system). A link to the
+    same file already there is kept: replacing it would move the file's ctime, and with it the
+    table check's trust in its digest."""
     target.parent.mkdir(parents=True, exist_ok=True)
+    if target.is_file() and not target.is_symlink() and os.path.samefile(source, target):
+        return
     if target.exists() or target.is_symlink():
         target.unlink()
     try:
         os.link(source, target)
     except OSError:
         shutil.copy2(source, target)
+
+
+def _remove_others(folder: Path, keep: set[Path]) -> None:
+    """Remove every file below ``folder`` that is not in ``keep`` (a crate's files of an older run)."""
+    for path in sorted(folder.rglob("*"), reverse=True):
+        if path.is_dir() and not path.is_symlink():
+            if not any(path.iterdir()):
+                path.rmdir()
+        elif path not in keep:
+            path.unlink()
 
 
 def _when(seconds: float) -> str:
@@ -236,9 +252,7 @@ def build_crate(
 
     workdir, checkout = Path(workdir).resolve(), Path(checkout).resolve()
     out = (workdir / out).resolve()
-    if out.exists():
-        shutil.rmtree(out)
-    out.mkdir(parents=True)
+    out.mkdir(parents=True, exist_ok=True)  # an older crate's links are kept where they still hold
     digests = Digests(workdir)
     jobs = [j for j in recorded_jobs(workdir, coded) if any(o.startswith(DESCRIBED) for o in j.outputs)]
     progress(f"crate: {len(jobs)} recorded jobs")
@@ -456,10 +470,17 @@ def build_crate(
     crate.root_dataset["mentions"] = [run]
     crate.root_dataset["about"] = citation
     digests.linked()
+    _remove_others(out, {out / rel for rel in files} | {out / "Snakefile", out / CONFIG_AS_RUN, out / METADATA})
     with warnings.catch_warnings():  # the files are placed already: nothing for the library to copy
         warnings.simplefilter("ignore", UserWarning)
         crate.write(out)
-    return {"files": len(files) + 2, "jobs": len(jobs), "hashed": digests.reads, "path": str(out)}
+    return {
+        "files": len(files) + 2,
+        "jobs": len(jobs),
+        "hashed": digests.reads,
+        "tables": digests.tables_read,
+        "path": str(out),
+    }
 
 
 def _version(name: str) -> str:
