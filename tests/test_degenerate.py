@@ -7,6 +7,7 @@ raises. The bounds are derived here from the physics, not read from the code und
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 
 import numpy as np
@@ -193,3 +194,29 @@ def test_explicit_step_balance_detects_a_lost_mass():
     assert abs(c.sum() - good.sum() - outflow) < 1e-13  # the sums of 29 terms near 8, to round-off
     with pytest.raises(fd.MassError, match="mass error"):
         fd.check_balance(c, good * (1.0 - 1e-9), outflow, 1.0 + 4.0 * r)
+
+
+@pytest.mark.parametrize("scheme", ["symmetric", "sequential"])
+def test_a_particle_transfer_that_loses_mass_is_a_failure_not_a_score(monkeypatch, scheme):
+    """MTPT's total mass is checked at every step: a transfer that loses 0.1 % raises MassError
+    naming the error, whichever scheme (the matrix, or the authors' loop with its clipping)."""
+    from particle_entropy.models import simulate
+    from particle_entropy.models.conservation import PARTICLE_MASS_TOLERANCE, MassError
+    from particle_entropy.numerics import mass_transfer, sequential
+
+    cfg = RunConfig.of("mtpt", "collision", 100, scheme=scheme, truncation=3.0, t_final=5.0).resolved()
+    simulate.run(cfg)  # as written: the mass holds to round-off
+    if scheme == "symmetric":
+        real = mass_transfer.mass_transfer
+
+        def leaky(*args, **kwargs):
+            res = real(*args, **kwargs)
+            return dataclasses.replace(res, mass=res.mass * 0.999)
+
+        monkeypatch.setattr(mass_transfer, "mass_transfer", leaky)
+    else:
+        real_seq = sequential.sequential_transfer
+        monkeypatch.setattr(sequential, "sequential_transfer", lambda *a, **k: real_seq(*a, **k) * 0.999)
+    with pytest.raises(MassError, match=r"^mtpt lost mass: total 0\.99[0-9]+ at t = [0-9.e-]+, an error of -0\.00"):
+        simulate.run(cfg)
+    assert PARTICLE_MASS_TOLERANCE < 1e-3 * 1e-3  # far below the 0.1 % lost here

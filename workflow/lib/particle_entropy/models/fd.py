@@ -17,14 +17,11 @@ import numpy as np
 from ..core import measures as M
 from ..core.runconfig import RunConfig
 from ..numerics.compiled import kernels
+from .conservation import MassError
 
 # a step's mass error (interior mass before - after - outflow) beyond this many ulps of the step's
 # largest terms is no round-off: the sums of N + 1 terms and the solve's residual (1 + 4 r + |p|) times eps
 MASS_ULPS = 64.0
-
-
-class MassError(ArithmeticError):
-    """An FD step that did not conserve mass beyond round-off (one line: the mass error)."""
 
 
 def check_balance(before: np.ndarray, after: np.ndarray, outflow: float, scale: float) -> None:

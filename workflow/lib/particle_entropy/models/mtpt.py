@@ -11,6 +11,7 @@ from ..core import measures as M
 from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
+from .conservation import check_particle_mass
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -86,6 +87,7 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
     the cloud, measures.sse_points)."""
     dV = cfg.dV
     total = float(m.sum())
+    check_particle_mass(total, t)  # a transfer that lost or made mass is a failure, never a score
     h_d = M.entropy_discrete(m / total)
     ref = cfg.reference(t)
     g = ref.sampled(x, dV)
