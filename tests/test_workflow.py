@@ -403,6 +403,10 @@ def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_co
     from particle_entropy.pipeline.crate import METADATA, verify_crate
     from particle_entropy.pipeline.verify import DIGESTS, cached_digests, corrupt_tables, file_sha256, stamp
 
+    def listed(entity, key):  # RO-Crate 1.1 writes one value without brackets
+        value = entity.get(key, [])
+        return value if isinstance(value, list) else [value]
+
     work = tiny_run_copy
     run_snakemake(work, "crate", configfile=TINY)
     crate = work / "results/ro-crate"
@@ -412,15 +416,18 @@ def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_co
     for fig in DEFAULT_FIGURES:
         png = f"figures/{fig}.png"
         assert graph[png]["sha256"] == file_sha256(work / png)
-        made = [e for e in graph.values() if e.get("@type") == "CreateAction" and {"@id": png} in e.get("result", [])]
+        made = [e for e in graph.values() if e.get("@type") == "CreateAction" and {"@id": png} in listed(e, "result")]
         (action,) = [e for e in made if e["@id"] != "#run"]  # the job; the run's action lists every figure
         assert graph[action["instrument"]["@id"]]["name"] == f"rule plot_{fig}"
-        assert {"@id": f"results/figures/{fig}.parquet"} in action["result"]
+        assert {"@id": f"results/figures/{fig}.parquet"} in listed(action, "result")
         assert re.fullmatch(r"code hash [0-9a-f]{16}", action["description"])
     assert graph["config-as-run.yaml"]["sha256"] == file_sha256(crate / "config-as-run.yaml")
     assert graph["https://doi.org/10.1016/j.advwatres.2020.103509"]["@type"] == "ScholarlyArticle"
     assert (crate / "requirements.lock").read_bytes() == (ROOT / "requirements.lock").read_bytes()
     assert "commit " in graph["#git"]["value"]
+    assert "SHA-256 " + graph["config-as-run.yaml"]["sha256"] in (crate / "README.md").read_text()
+    tools = [e for e in graph.values() if str(e["@id"]).startswith("#rule-plot_")]
+    assert tools and all(re.fullmatch(r"[0-9a-f]{16}", t["softwareVersion"]) for t in tools)  # the code hash
     # the crate read no table the check had read, and the next check reads none again: the cache's
     # entries of the linked tables carry their new ctime; and the check skips the crate's links
     run_snakemake(work, "crate", "--forcerun", "crate", configfile=TINY)  # a rebuild keeps the links that hold

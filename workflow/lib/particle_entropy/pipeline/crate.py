@@ -54,6 +54,22 @@ PROFILES = {  # the profiles the crate conforms to (versioned permalinks)
 KEY_PACKAGES = ("numpy", "scipy", "pandas", "pyarrow", "numba", "matplotlib", "snakemake", "rocrate")
 SNAKEMAKE_URL = "https://snakemake.github.io"
 DESCRIBED = ("figures/", "results/")  # the folders whose job outputs the crate holds
+FORMATS = {  # a file's media type by its suffix (encodingFormat)
+    ".parquet": "application/vnd.apache.parquet",
+    ".png": "image/png",
+    ".pdf": "application/pdf",
+    ".html": "text/html",
+    ".md": "text/markdown",
+    ".py": "text/x-python",
+    ".smk": "text/x-python",  # Snakemake's rule files: Python with rule blocks
+    ".yaml": "application/yaml",
+    ".cff": "application/yaml",
+    ".json": "application/json",
+    ".tsv": "text/tab-separated-values",
+    ".lock": "text/plain",
+    ".log": "text/plain",
+}
+README = "README.md"
 
 
 @dataclass(frozen=True)
@@ -213,6 +229,26 @@ def _remove_others(folder: Path, keep: set[Path]) -> None:
             path.unlink()
 
 
+def _one(values: list):
+    """A list, or its one value alone (RO-Crate 1.1 writes a single value without brackets)."""
+    return values[0] if len(values) == 1 else values
+
+
+def _readme(commit: str, dirty: bool | None, config: Mapping, jobs: int, files: int) -> str:
+    """The crate's README.md: what it holds and how it was made."""
+    state = {True: " (tracked files differed from it)", False: "", None: ""}[dirty]
+    return (
+        "# A run of the particle-entropy workflow\n\n"
+        "This folder is a Workflow Run RO-Crate (Provenance Run Crate 0.5): `ro-crate-metadata.json` describes "
+        f"the workflow (`Snakefile`, `workflow/`), the config as run (`{CONFIG_AS_RUN}`, SHA-256 "
+        f"{config_digest(config)}), the pinned software (`requirements.lock`) and the {jobs} jobs that made "
+        f"its {files} files, each with its SHA-256.\n\n"
+        f"Made at commit {commit or 'unknown'}{state} by `snakemake -j2 crate` "
+        "(docs/deposit.md of the workflow). It reproduces Benson et al. (2020), Advances in Water Resources "
+        "103509, https://doi.org/10.1016/j.advwatres.2020.103509 (`CITATION.cff`).\n"
+    )
+
+
 def _when(seconds: float) -> str:
     return datetime.fromtimestamp(seconds, UTC).isoformat(timespec="seconds")
 
@@ -263,7 +299,9 @@ def build_crate(
     crate.description = (
         "Every figure and table of a run of the particle-entropy workflow, with the jobs that made them."
     )
-    crate.license = "https://spdx.org/licenses/MIT"
+    crate.license = crate.add(
+        ContextEntity(crate, "https://spdx.org/licenses/MIT", {"@type": "CreativeWork", "name": "MIT License"})
+    )
     crate.root_dataset["datePublished"] = _when(max((j.end for j in jobs), default=0.0))
     profiles = [
         crate.add(ContextEntity(crate, uri, {"@type": "CreativeWork", "name": key, "version": uri.rsplit("/", 1)[-1]}))
@@ -280,6 +318,10 @@ def build_crate(
             props.setdefault("sha256", digests(rel) if source is None else file_sha256(src))  # before the link
             _place(src, out / rel)
             props.setdefault("contentSize", str(src.stat().st_size))
+            props.setdefault("name", Path(rel).name)
+            fmt = FORMATS.get(Path(rel).suffix) or FORMATS.get(Path(rel).name[Path(rel).name.rfind(".") :])
+            if fmt:
+                props.setdefault("encodingFormat", fmt)
             with warnings.catch_warnings():  # the file is placed here, not copied by the library
                 warnings.simplefilter("ignore", UserWarning)
                 files[rel] = crate.add_file(None, dest_path=rel, properties={"@type": kind, **props})
@@ -290,7 +332,7 @@ def build_crate(
     rules = sorted((checkout / "workflow" / "rules").glob("*.smk"))
     scripts = sorted((checkout / "workflow" / "scripts").glob("*.py"))
     for p in rules + scripts:  # the rule files and scripts, as they were in the checkout
-        data(p.relative_to(checkout).as_posix(), p, kind=["File", "SoftwareSourceCode"])
+        data(p.relative_to(checkout).as_posix(), p, kind=["File", "SoftwareSourceCode"], version=commit or "unknown")
     snakefile = checkout / "Snakefile"
     _place(snakefile, out / "Snakefile")
     workflow = crate.add_workflow(
@@ -301,6 +343,7 @@ def build_crate(
         properties={
             "@type": ["File", "SoftwareSourceCode", "ComputationalWorkflow", "HowTo"],  # HowTo: it has steps
             "name": "particle-entropy workflow",
+            "encodingFormat": FORMATS[".smk"],
             "sha256": file_sha256(snakefile),
             "version": commit or "unknown",
         },
@@ -391,14 +434,19 @@ def build_crate(
         )
         entity["exampleOfWork"] = param
         out_params.append(param)
-    workflow["input"] = [config_param]
-    workflow["output"] = out_params
+    workflow["input"] = config_param
+    workflow["output"] = _one(out_params)
 
     # per rule a tool and a step; per job a CreateAction and a ControlAction
     tools, steps = {}, {}
     script_of = {j.rule: j.script for j in jobs}
+    codes: dict[str, set] = defaultdict(set)
+    for j in jobs:
+        codes[j.rule].add(j.code)
     for position, rule in enumerate(sorted(script_of)):
         tool = {"@type": "SoftwareApplication", "name": f"rule {rule}"}
+        if codes[rule] - {""}:  # its version: the code hash of the modules it ran (one per code version)
+            tool["softwareVersion"] = ", ".join(sorted(codes[rule] - {""}))
         script = f"workflow/scripts/{script_of[rule]}"
         if script_of[rule] and script in files:
             tool["hasPart"] = files[script]  # the rule's script, as it was in the checkout
@@ -413,7 +461,7 @@ def build_crate(
     workflow["hasPart"] = list(tools.values())  # the tools it orchestrates: one per rule that ran
     workflow["step"] = list(steps.values())
 
-    controls = []
+    controls, actions = [], []
     by_rule: dict[str, int] = defaultdict(int)
     for k, job in enumerate(jobs):
         by_rule[job.rule] += 1
@@ -428,8 +476,9 @@ def build_crate(
         if job.code:
             props["description"] = f"code hash {job.code}"
         action = crate.add_action(
-            tools[job.rule], identifier=f"#job-{k}", object=inputs, result=outputs, properties=props
+            tools[job.rule], identifier=f"#job-{k}", object=_one(inputs), result=_one(outputs), properties=props
         )
+        actions.append(action)
         controls.append(
             crate.add(
                 ContextEntity(
@@ -449,6 +498,7 @@ def build_crate(
         result=[files[r] for r in figures],
         properties={
             "name": "the workflow run",
+            "description": "Snakemake ran the workflow with the config as run: every job, and the figures it made",
             "startTime": _when(min((j.start for j in jobs), default=0.0)),
             "endTime": _when(max((j.end for j in jobs), default=0.0)),
             "actionStatus": "http://schema.org/CompletedActionStatus",
@@ -467,10 +517,17 @@ def build_crate(
             },
         )
     )
-    crate.root_dataset["mentions"] = [run]
+    crate.root_dataset["mentions"] = [run, *actions]
     crate.root_dataset["about"] = citation
+    (out / README).write_text(_readme(commit, dirty, config, len(jobs), len(files)))
+    crate.add_file(
+        None,
+        dest_path=README,
+        properties={"name": "what this crate is", "encodingFormat": "text/markdown", "about": crate.root_dataset},
+    )
     digests.linked()
-    _remove_others(out, {out / rel for rel in files} | {out / "Snakefile", out / CONFIG_AS_RUN, out / METADATA})
+    kept = {out / "Snakefile", out / CONFIG_AS_RUN, out / METADATA, out / README}
+    _remove_others(out, {out / rel for rel in files} | kept)
     with warnings.catch_warnings():  # the files are placed already: nothing for the library to copy
         warnings.simplefilter("ignore", UserWarning)
         crate.write(out)
