@@ -107,12 +107,14 @@ class _StrictLoader(SAFE_LOADER):
         return super().construct_mapping(node, deep=deep)
 
     def construct_yaml_int(self, node):
-        _refuse_yaml11_number(node, super().construct_yaml_int(node))
-        return super().construct_yaml_int(node)
+        number = super().construct_yaml_int(node)
+        _refuse_yaml11_number(node, number)
+        return number
 
     def construct_yaml_float(self, node):
-        _refuse_yaml11_number(node, super().construct_yaml_float(node))
-        return super().construct_yaml_float(node)
+        number = super().construct_yaml_float(node)
+        _refuse_yaml11_number(node, number)
+        return number
 
 
 _StrictLoader.add_constructor("tag:yaml.org,2002:int", _StrictLoader.construct_yaml_int)

@@ -22,6 +22,7 @@ files against the digests it records.
 from __future__ import annotations
 
 import base64
+import functools
 import hashlib
 import json
 import os
@@ -319,7 +320,7 @@ def build_crate(
             _place(src, out / rel)
             props.setdefault("contentSize", str(src.stat().st_size))
             props.setdefault("name", Path(rel).name)
-            fmt = FORMATS.get(Path(rel).suffix) or FORMATS.get(Path(rel).name[Path(rel).name.rfind(".") :])
+            fmt = FORMATS.get(Path(rel).suffix)
             if fmt:
                 props.setdefault("encodingFormat", fmt)
             with warnings.catch_warnings():  # the file is placed here, not copied by the library
@@ -571,17 +572,17 @@ def described(folder: str | os.PathLike) -> Iterable[str]:
     return [e["@id"] for e in graph if "File" in (e["@type"] if isinstance(e["@type"], list) else [e["@type"]])]
 
 
-_GIT: dict[str, tuple[str, bool | None]] = {}
+@functools.cache
+def _git_state_once(checkout: str) -> tuple[str, bool | None]:
+    """git_state of a checkout, asked once per process: a report asks it for every figure."""
+    return git_state(Path(checkout))
 
 
 def provenance(figure: str, rule: str, module: str, data: str, config: Mapping, checkout) -> dict[str, str]:
     """Where a figure came from, for its entry in the report (as showyourwork's margins): the
     commit (and whether the tree was dirty), the config's digest, its rule and module, its source
     data table and that table's SHA-256 as recorded beside it."""
-    key = str(checkout)
-    if key not in _GIT:
-        _GIT[key] = git_state(Path(checkout))
-    commit, dirty = _GIT[key]
+    commit, dirty = _git_state_once(str(checkout))
     recorded = recorded_digest(data) if data.endswith(".parquet") else None
     if recorded is None:
         recorded = file_sha256(data) if Path(data).is_file() else "not made yet"

@@ -158,19 +158,19 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
         key = path.relative_to(root).as_posix()
         if key.startswith(crate):  # hard links of tables checked at their own paths
             continue
-        stamp = digest = None
+        now = digest = None  # the table's stamp, while it may be vouched for
         remembered = False
         if path.is_file() and recorded_digest(path) is not None:
             st = path.stat()
-            stamp = [st.st_size, st.st_mtime_ns, st.st_ino, st.st_ctime_ns]
-            remembered = known.get(key, [])[:4] == stamp
+            now = stamp(st)
+            remembered = known.get(key, [])[:4] == now
             if remembered:
                 digest = known[key][4]
             else:
                 hashed_at = time.time_ns()
                 digest = file_sha256(path)
                 if st.st_mtime_ns > hashed_at - SETTLED_NS:
-                    stamp = None  # too fresh to vouch for: hashed again next time
+                    now = None  # too fresh to vouch for: hashed again next time
         problem = table_problem(path, digest)
         if problem and remembered:  # a remembered digest may spare a read, never condemn
             digest = file_sha256(path)
@@ -180,8 +180,8 @@ def corrupt_tables(root: str | os.PathLike, digests: str | os.PathLike | None = 
             problem = content_problem(path, names) if names else None
         if problem:
             out[path] = problem
-        elif stamp:
-            kept[key] = [*stamp, digest]
+        elif now:
+            kept[key] = [*now, digest]
     if digests is not None and kept != known:
         _write_digests(Path(digests), kept)
     return out
