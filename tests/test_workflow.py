@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -22,6 +23,7 @@ from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, rows_o
 from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.figures import CASE_FIGURES, FIGURES
+from particle_entropy.numerics.compiled import CACHE_ENV
 from particle_entropy.pipeline.sweeps import (
     Ensemble,
     case_run_paths,
@@ -1042,7 +1044,11 @@ def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     from particle_entropy.experiments.scene import Scene
 
     work = tmp_path / "scenes"
-    run_snakemake(work, "scenes", "--configfile", TINY, SCENE_CONFIG)
+    # from an empty kernel cache: the first job compiles the kernels, and a run exiting 0 has made
+    # every target (issue 39: a compile job with an ancient output once hid the jobs after it)
+    empty_cache = {**os.environ, CACHE_ENV: str(tmp_path / "kernel-cache")}
+    run_snakemake(work, "scenes", "--configfile", TINY, SCENE_CONFIG, env=empty_cache)
+    assert (tmp_path / "kernel-cache").is_dir()  # the kernels were built in this run, not copied
     table = pd.read_parquet(work / "results/scenes/carried.parquet")
     heading, _, documented = _section_of("results/scenes/carried.parquet", _column_doc_sections())
     assert heading == SCENE_SECTION and set(table.columns) == documented  # docs/columns.md says what it holds

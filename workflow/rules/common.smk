@@ -148,7 +148,7 @@ def check_writable(look_only):
     cluster node has its own). Else every job fails on a traceback or an empty log."""
     problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
     if not look_only and workflow.local_exec and not Path(kernels_folder()).is_dir():
-        # numba's cache is written while the kernels of this code are compiled (rule compile_kernels);
+        # numba's cache is written while the first job compiles the kernels of this code (compiled.take);
         # once they are, jobs load them and numba caches nothing
         problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
     if problems:
@@ -158,6 +158,16 @@ def check_writable(look_only):
 if workflow.is_main_process:
     check_writable(looks_only())
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
+
+
+def unmade_targets():
+    """The requested targets (a target rule's inputs where it has no output) that are not there
+    after a run; none to check under --until or --omit-from, which stop short of them on purpose."""
+    dag = workflow.dag
+    if dag.untilrules or dag.untilfiles or dag.omitrules or dag.omitfiles:
+        return []
+    files = {str(f) for job in dag.targetjobs for f in (job.output or job.input)}
+    return sorted(f for f in files if not Path(f).exists())
 
 
 def in_config(section):
@@ -379,7 +389,6 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
-KERNELS = kernels_folder()  # the ahead-of-time kernels of this code, numba and CPU
 SUMMARY_CODE = code_version(
     "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
 )

@@ -5,8 +5,6 @@
 
 
 rule simulate_scene:
-    input:
-        kernels=ancient(KERNELS),
     output:
         SCENE_RUN_PATTERN,
     log:
