@@ -72,7 +72,7 @@ def test_ladders_rise_by_about_two_and_fd_takes_even_grids():
         ({"candidates": [MTPT, {**MTPT, "advection": "upwind"}]}, "scenes.s.candidates[1].advection"),
         ({"candidates": [{**FD, "advection": "lax"}]}, "scenes.s.candidates[0].advection"),
         ({"candidates": [{**MTPT, "eta": 2.0}]}, "scenes.s.candidates[0].eta"),
-        ({"candidates": [FD, FD]}, "scenes.s.candidates"),
+        ({"candidates": [FD, FD]}, "scenes.s.candidates[1]"),
         ({"omega": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.omega"),
         ({"fd_length": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.fd_length"),
         ({"cost": {"fd": [1.0]}}, "scenes.s.cost.fd"),
@@ -128,9 +128,9 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
     base = spec()
     del base["v"]
     got = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01, 0.1]}})
-    assert list(got) == ["peclet_0", "peclet_1", "peclet_2"]
+    assert list(got) == list(got.sweep) == ["peclet-0", "peclet-1", "peclet-2"]
     assert [got[n].v for n in got] == [0.0, 0.01, 0.1]
-    assert got["peclet_2"].peclet == pytest.approx(0.1 * got["peclet_2"].fd_length / 1e-3)
+    assert got["peclet-2"].peclet == pytest.approx(0.1 * got["peclet-2"].fd_length / 1e-3)
     for bad, key in (
         ({"base": spec(), "v": [0.0, 1.0]}, "scenes_peclet.base.v"),
         ({"base": base, "v": [1.0, 0.5]}, "scenes_peclet.v"),
@@ -142,7 +142,10 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
 
 def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
     at_rest = Scene.from_config("s", spec(v=0.0, candidates=[FD, {**FD, "advection": "central"}, MTPT]))
-    assert [c.label for c in at_rest.candidates] == ["fd implicit dt=0.05", "mtpt collision eta=1"]
+    labels = ["fd implicit dt=0.05", "fd implicit dt=0.05", "mtpt collision eta=1"]
+    assert [c.label for c in at_rest.candidates] == labels  # one model, each at the index written
+    fd, central, _ = at_rest.candidates
+    assert at_rest.same_as(1) == 0 and at_rest.identity(central) == at_rest.identity(fd)
 
 
 def test_a_scene_at_rest_measures_over_its_own_window_and_the_paper_over_its_own():
@@ -350,14 +353,14 @@ def test_a_gaussian_too_narrow_for_its_variance_is_refused():
         ({"candidates": [{**S_FD, "n_range": [15, 64]}]}, "scenes.s.candidates[0].n_range"),
         ({"candidates": [{**S_FD, "n_range": [16, 17]}]}, "scenes.s.candidates[0].n_range"),
         ({"candidates": [S_FD, {**S_FD, "fd_dt": 1.0e-9}]}, "scenes.s.candidates[1].fd_dt"),
-        ({"candidates": [S_PT, {"method": "pt", "kernel": "adaptive", "ladder": [3, 2 * 10**9]}]}, None),
+        ({"candidates": [S_PT, {"method": "fd", "kernel": "implicit", "ladder": [2, 64]}]}, None),
         ({"candidates": [S_FD, S_PT, S_PT]}, "scenes.s.candidates[2]"),
     ],
 )
 def test_every_refusal_names_a_key_the_user_wrote(over, key):
     """Point 14: no candidates[0].dt0, no candidates[0].n, no message without a key."""
     spec_ = small(**over)
-    if key is None:  # a top rung beyond MAX_N: the ladder
+    if key is None:  # an FD rung of 2 intervals (fewer than its stencil needs): the ladder
         key = "scenes.s.candidates[1].ladder"
     err = _refused(spec_)
     assert err.name == key, err

@@ -248,16 +248,20 @@ def test_a_budget_below_every_first_rung_answers_over_budget():
 def test_the_round_cap_follows_the_longest_ladder():
     """Issue 39, point 13: a written-out ladder of 100 rungs, never met, stopped on "no finished plan
     after 41 rounds"; the cap is the rounds its search can take."""
-    pt = {"method": "pt", "kernel": "adaptive", "ladder": list(range(30, 130))}
-    scene = _scene(value=1e-9, candidates=(FD, pt))
-    plan, rounds = S.next_plan(scene, None, None, 0), 1
-    while not plan["done"].all():
-        plan = S.next_plan(scene, plan, _runs(plan, lambda ci, n, seed: 1.0 / n), 0)
-        rounds += 1
-        assert rounds <= S.max_rounds(scene)
-    assert rounds > 41 and rounds == S.max_rounds(scene)  # never met: the climb to the top and the stop
-    met = _scene(value=0.02, candidates=(pt,))  # met at the top after the climb: one bisection more
-    assert S.max_rounds(met) == S.max_rounds(scene)
+    pt = {"method": "pt", "kernel": "adaptive", "ladder": list(range(30, 131))}  # 101 rungs
+
+    def rounds(scene, law):
+        plan, k = S.next_plan(scene, None, None, 0), 1
+        while not plan["done"].all():
+            plan = S.next_plan(scene, plan, _runs(plan, law), 0)
+            k += 1
+            assert k <= S.max_rounds(scene)
+        return k
+
+    never = _scene(value=1e-9, candidates=(FD, pt))
+    assert 41 < rounds(never, lambda ci, n, seed: 1.0 / n) == S.max_rounds(never) - 1  # the climb and the stop
+    at_top = _scene(value=0.5, candidates=(pt,))  # met at the top rung only: one bisection round more
+    assert rounds(at_top, lambda ci, n, seed: 0.1 if n == 130 else 1.0) == S.max_rounds(at_top)
 
 
 def test_at_rest_twin_candidates_run_once_and_keep_their_index():
