@@ -296,7 +296,7 @@ def test_typos_under_the_peclet_base_are_refused_with_did_you_mean(typo, key, ne
     """Point 7: the schema and the scene itself refuse them, naming scenes_peclet.base.<key>."""
     from conftest import ROOT
 
-    from particle_entropy.pipeline.configcheck import check_config, load_yaml
+    from particle_entropy.pipeline.configcheck import check_config, check_schema, load_schema, load_yaml
 
     base = {**{k: v for k, v in small().items() if k != "v"}, **typo}
     with pytest.raises(SettingError) as err:
@@ -308,9 +308,10 @@ def test_typos_under_the_peclet_base_are_refused_with_did_you_mean(typo, key, ne
     assert err.value.name == f"scenes.s.{key}" and f"did you mean {near}" in err.value.allowed
     config = dict(load_yaml(ROOT / "config.yaml"))
     config["scenes_peclet"] = {"base": base, "v": [0.0, 0.01]}
-    with pytest.raises(SettingError) as err:  # before any job: at the schema
-        check_config(config)
-    assert err.value.name == f"scenes_peclet.base.{key}" and f"did you mean {near}" in err.value.allowed
+    for check in (lambda: check_schema(config, load_schema()), lambda: check_config(config)):  # at the parse
+        with pytest.raises(SettingError) as err:
+            check()
+        assert err.value.name == f"scenes_peclet.base.{key}" and f"did you mean {near}" in err.value.allowed
 
 
 def test_at_rest_fd_candidates_keep_the_user_s_indexes():

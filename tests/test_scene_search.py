@@ -246,7 +246,7 @@ def test_a_budget_below_every_first_rung_answers_over_budget():
 
 
 def test_the_round_cap_follows_the_longest_ladder():
-    """Issue 39, point 13: a written-out ladder of 100 rungs, never met, stopped on "no finished plan
+    """Issue 39, point 13: a written-out ladder of 101 rungs, never met, stopped on "no finished plan
     after 41 rounds"; the cap is the rounds its search can take."""
     pt = {"method": "pt", "kernel": "adaptive", "ladder": list(range(30, 131))}  # 101 rungs
 
