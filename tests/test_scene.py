@@ -354,6 +354,11 @@ def test_a_gaussian_too_narrow_for_its_variance_is_refused():
         ({"candidates": [{**S_FD, "n_range": [15, 64]}]}, "scenes.s.candidates[0].n_range"),
         ({"candidates": [{**S_FD, "n_range": [16, 17]}]}, "scenes.s.candidates[0].n_range"),
         ({"candidates": [S_FD, {**S_FD, "fd_dt": 1.0e-9}]}, "scenes.s.candidates[1].fd_dt"),
+        ({"D": 1e-6, "t_final": 1.0e6, "candidates": [{**S_FD, "fd_dt": 0.05}]}, "scenes.s.candidates[0].fd_dt"),
+        (
+            {"D": 1e-6, "t_final": 1.0e6, "candidates": [{k: v for k, v in S_FD.items() if k != "fd_dt"}]},
+            "scenes.s.t_final",
+        ),
         ({"candidates": [S_PT, {"method": "fd", "kernel": "implicit", "ladder": [2, 64]}]}, None),
         ({"candidates": [S_FD, S_PT, S_PT]}, "scenes.s.candidates[2]"),
     ],

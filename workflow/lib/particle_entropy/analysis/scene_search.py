@@ -29,7 +29,8 @@ NEGATIVE_TOLERANCE = 1e-12  # a node mass below -this (of unit total) is a negat
 
 
 RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a finished scene
-    "candidate": "the candidate's index in `scenes.<name>.candidates` (a Peclet scene: in its base's)",
+    "candidate": "the candidate's index in `scenes.<name>.candidates` as written (a Peclet scene: in its base's; "
+    "at v = 0 an FD candidate that differs from an earlier one only in advection repeats its rows)",
     "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
     "method": "fd, pt or mtpt",
     "n": "the resolution: particles, or FD intervals",

@@ -18,7 +18,7 @@ from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
 from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_plume_width, check_setting
 from ..core.settings import BY_KEY, PAPER, SCENE, defaults
-from ..core.timegrid import MAX_STEPS, time_steps
+from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -298,11 +298,13 @@ def _candidate_error(scene: Scene, i: int, spec: Mapping, e: SettingError) -> Se
             most = e.value * MAX_STEPS if g == 1.0 else e.value * (g**MAX_STEPS - 1.0) / (g - 1.0)
         except OverflowError:
             most = math.inf
+        fd = cand.case.method == "fd"
+        hint = f"; or give {where} an fd_dt >= {max_first_step(scene.t_final, g):.3g}" if fd else ""
         return SettingError(
             scene.key("t_final"),
             scene.t_final,
             f"a number in (0, {most:.6g}] [T]: what {cand.label} ({where}) reaches in at most {MAX_STEPS:,} steps "
-            f"from its first step {e.value:g} ({e.allowed})",
+            f"of its first step {e.value:g}{hint}",
         )
     if e.name in _CASE_DIMS:
         key = scene.key(f"{where}.{e.name}") if e.name in spec else f"case_defaults.{e.name}"
