@@ -1133,3 +1133,31 @@ def test_a_run_table_decayed_on_the_disk_fails_its_reader_then_is_set_aside_and_
     assert f"corrupt table {rel}: its SHA-256" in again.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS)), before)
     assert summary.exists()
+
+
+def test_user_scenes_named_peclet_are_their_own_and_the_sweep_draws_only_its_scenes(tmp_path):
+    """Issue 39, point 6: scenes.peclet_0 was replaced by the sweep's scene, peclet_mine was drawn in
+    figures/scenes_peclet.png and a scene named peclet never ran (its table was the sweep's)."""
+    scene = yaml.safe_load(SCENE_CONFIG.read_text())["scenes"]["carried"]
+    base = {k: v for k, v in scene.items() if k != "v"}
+    overlay = tmp_path / "peclet_names.yaml"
+    overlay.write_text(
+        yaml.safe_dump(
+            {
+                "scenes": {"peclet": scene, "peclet_0": {**scene, "v": 0.02}, "peclet_mine": scene},
+                "scenes_peclet": {"base": base, "v": [0.0, 0.01]},
+            }
+        )
+    )
+    work = tmp_path / "w"
+    sweep = planned_outputs(
+        run_snakemake(work, "figures/scenes_peclet.png", "--configfile", TINY, overlay, dry_run=True),
+        "results/scenes/",
+    )
+    rounds = {p.split("/")[2] for p in sweep if "/round~" in p}
+    assert rounds and not rounds & {"peclet", "peclet_0", "peclet_mine"}, rounds
+    mine = planned_outputs(
+        run_snakemake(work, "figures/scene_peclet.png", "--configfile", TINY, overlay, dry_run=True),
+        "results/scenes/",
+    )
+    assert "results/scenes/peclet/round~0.parquet" in mine, mine

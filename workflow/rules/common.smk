@@ -59,7 +59,7 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_scene_memory, check_sweeps, optimum_searches
-from particle_entropy.experiments.scene import PECLET_PREFIX, SCENE_RUN_PATTERN, scenes
+from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 
@@ -78,6 +78,8 @@ SCENES = scenes(
     None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE),
     paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
 )
+# A scene's name: a user's (the schema's pattern) or one of the Peclet sweep's, peclet-<k>.
+SCENE_NAME = rf"[A-Za-z0-9_]+|{SWEEP_PREFIX}[0-9]+"
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS):
@@ -351,16 +353,18 @@ def scene_round_inputs(wildcards):
 
 
 def scene_final_inputs(wildcards):
-    """The finished plan of a scene and its runs: rounds are requested one at a time."""
-    from particle_entropy.analysis.scene_search import MAX_ROUNDS, plan_paths
+    """The finished plan of a scene and its runs: rounds are requested one at a time, at most as
+    many as its search can take (scene_search.max_rounds: its longest ladder's)."""
+    from particle_entropy.analysis.scene_search import max_rounds, plan_paths
     from particle_entropy.core.io import read_parquet
 
-    for k in range(MAX_ROUNDS + 1):
+    rounds = max_rounds(SCENES[wildcards.name])
+    for k in range(rounds):
         path = checkpoints.scene_round.get(name=wildcards.name, k=str(k)).output[0]
         plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
-    raise ValueError(f"scene {wildcards.name}: no finished plan after {MAX_ROUNDS + 1} rounds")
+    raise ValueError(f"scene {wildcards.name}: no finished plan after {rounds} rounds")
 
 
 def sim_mem_mb(wildcards):
