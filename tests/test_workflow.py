@@ -734,6 +734,20 @@ def test_two_clones_whose_results_link_to_one_folder_do_not_both_run(tmp_path):
     assert again.returncode == 0, again.stderr[-2000:]
 
 
+def test_a_read_only_home_is_no_obstacle(tmp_path):
+    """Snakemake made ~/.cache/snakemake/source-cache before reading the Snakefile, so a HOME that
+    cannot be written (here a file, which stops root too) ended every command in its traceback. The
+    default profile keeps that cache in Snakemake's own temporary folder (shared-fs-usage)."""
+    import os
+
+    home = tmp_path / "home"
+    home.write_text("not a folder")
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_CACHE_HOME", "XDG_CONFIG_HOME")} | {"HOME": str(home)}
+    proc = run_snakemake(tmp_path, "figures/fig8.png", dry_run=True, configfile=TINY, env=env, check=False)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
+    assert "compile_kernels" in proc.stdout
+
+
 def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
     import os
     import resource
