@@ -183,6 +183,20 @@ def test_a_device_or_directory_out_is_refused_and_left_alone(tmp_path):
     assert res.returncode == 2 and "is a directory" in res.stderr
 
 
+@pytest.mark.parametrize("flag", ["--out", "--state-out"])
+@pytest.mark.parametrize("name", ["newdir/", "newdir/.", "newdir/..", "."])
+def test_an_out_that_names_a_folder_is_refused_in_one_line(tmp_path, flag, name):
+    """`--out newdir/` wrote a file named `newdir` (round 4, P09): a path ending in a separator, `.`
+    or `..` names a folder, new or existing, and is refused before the run; nothing is made."""
+    target = os.path.join(str(tmp_path), name)
+    other = ["--out", str(tmp_path / "x.parquet")] if flag == "--state-out" else []
+    res = _small_run(*other, flag, target)
+    assert res.returncode == 2, res.stderr
+    last = res.stderr.strip().splitlines()[-1]
+    assert f"{flag}: {target}: names a folder, not a file" in last and "run.parquet" in last
+    assert "Traceback" not in res.stderr and sorted(p.name for p in tmp_path.iterdir()) == []
+
+
 def test_an_out_inside_a_file_is_refused_before_the_run(tmp_path):
     blocker = tmp_path / "notes.txt"
     blocker.write_text("a file where a folder would be")

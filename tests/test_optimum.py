@@ -476,6 +476,60 @@ def test_a_coarse_grid_finer_than_the_stopping_width_is_refused():
     assert wide.max_initial_points == 13  # a narrower stopping width allows a finer grid
 
 
+_SPEC = {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range": [30, 30000], "budget_runs": 50}
+
+
+@pytest.mark.parametrize(
+    "change, key",
+    [
+        ({"n_range": [30]}, "n_range"),
+        ({"n_range": "abc"}, "n_range"),
+        ({"n_range": [30.5, 300]}, "n_range"),
+        ({"time": None}, "time"),
+        ({"time": "x"}, "time"),
+        ({"case": None}, "case"),
+        ({"case": "fd"}, "case"),
+        ({"width": "w"}, "width"),
+        ({"budget_runs": "a"}, "budget_runs"),
+        ({"realisations": 0}, "realisations"),
+        ({"initial_points": 4.5}, "initial_points"),
+        ({"n_range": None, "growth_range": [1.1], "n": 300}, "growth_range"),
+        ({"n_range": None, "growth_range": [1.01, 1.5], "n": "a"}, "n"),
+        ({"cost": [[30]], "budget_core_s": 10}, "cost"),
+        ({"budget_core_s": "x"}, "budget_core_s"),
+        ({"time_volume": "yes"}, "time_volume"),
+        ({"budjet_runs": 3}, "budjet_runs"),
+    ],
+)
+def test_every_bad_search_value_is_named_by_its_key_path(change, key):
+    """Round 4: a search's messages named no key path where a value was missing or of the wrong type
+    (KeyError 'time', 'not enough values to unpack', 'invalid literal for int()'): each is now a
+    SettingError naming optimum.<name>.<key>, its value and what is allowed, whoever calls."""
+    config = {"physics": {"t_final": 1000}, "time": {"dt0": 0.01, "fd_dt": 0.05, "fixed_dt": 1.0}}
+    spec = {k: v for k, v in {**_SPEC, **change}.items() if v is not None}
+    with pytest.raises(SettingError) as refused:
+        Search.from_config("s", spec, config)
+    assert refused.value.name == f"optimum.s.{key}"
+    assert str(refused.value).startswith(f"optimum.s.{key}=") and "is not allowed: " in str(refused.value)
+
+
+def test_a_search_whose_seeds_overflow_names_its_max_realisations():
+    """Seeds run to base_seed + max_realisations - 1: the refusal names the search's key."""
+    from particle_entropy.core.runconfig import MAX_SEED
+    from particle_entropy.pipeline.crosschecks import check_search
+
+    config = {
+        "base_seed": MAX_SEED - 10,
+        "physics": {"t_final": 1000, "D": 1e-3, "omega": 10.0, "fd_length": 12.0},
+        "time": {"dt0": 0.01, "fd_dt": 0.05, "fixed_dt": 1.0},
+        "optimum": {"s": {**_SPEC, "case": {"method": "mtpt", "kernel": "sph", "eta": 1}, "max_realisations": 64}},
+    }
+    with pytest.raises(SettingError) as refused:
+        check_search("s", config)
+    assert refused.value.name == "optimum.s.max_realisations" and refused.value.value == 64
+    assert "an integer <= 11 with base_seed = " in refused.value.allowed
+
+
 def test_a_search_takes_the_same_path_under_different_timings(tmp_path):
     """Issue 23: a core-second budget decided from measured wall times, so one config gave
     different optima on different machines. Real runs, written as run tables twice: as on a fast
@@ -574,5 +628,6 @@ def test_an_unscored_point_is_never_the_optimum_and_none_scored_is_said():
     _, opt = evaluate(mtpt(budget_runs=100), table)
     assert opt["best"] == 300
     table["COMIC"] = np.nan
-    with pytest.raises(ValueError, match=r"search t: no visited point scores a COMIC \(SSE = 0: ...\)"):
+    none = r"search t: no visited point scores a COMIC \(SSE = 0: ...\); try a later optimum.t.time \(now 1000\)"
+    with pytest.raises(ValueError, match=none):
         evaluate(mtpt(budget_runs=100), table)

@@ -11,7 +11,7 @@ from scipy.integrate import quad
 from scipy.special import erf
 
 from particle_entropy.core import measures as M
-from particle_entropy.core.reference import Reference, Source, box_entropy
+from particle_entropy.core.reference import Reference, Source, box_entropy, box_mean
 
 
 def _quad_box_entropy(width: float, dt: float) -> float:
@@ -40,10 +40,54 @@ def test_box_entropy_limits():
     # a box much narrower than sqrt(4 D t) is a Gaussian of variance w^2/12 + 2 D t (to O((w/s)^4))
     w, dt = 1e-3, 4.0
     gaussian = 0.5 * math.log(2 * math.pi * math.e * (w * w / 12 + 2 * dt))
-    assert box_entropy(w, dt) == pytest.approx(gaussian, abs=1e-11)  # erf differences lose ~1e-12
+    assert box_entropy(w, dt) == pytest.approx(gaussian, abs=1e-14)
     # spreading only adds entropy
     values = [box_entropy(1.0, dt) for dt in (0.0, 1e-4, 1e-2, 1.0)]
     assert values == sorted(values) and len(set(values)) == 4
+
+
+@pytest.mark.parametrize("width", [1e-6, 1e-10, 1e-14, 1e-15, 1e-16, 1e-17, 1e-20, 1e-100, 1e-300, 5e-324])
+def test_a_narrowing_box_tends_to_the_point_sources_gaussian(width):
+    """As the width -> 0 the dispersed box is the point source's Gaussian of variance 2 D t (plus the
+    box's own w^2 / 12), whose entropy is ln sqrt(2 pi e sigma^2): down to the smallest float width.
+    The erf difference lost all of it below ~1e-16 (0.36 too low at 1e-16, 0 from 1e-20)."""
+    D, t = 1e-3, 50.0
+    gaussian = 0.5 * math.log(2 * math.pi * math.e * (2 * D * t + width * width / 12))
+    assert box_entropy(width, D * t) == pytest.approx(gaussian, abs=1e-14)
+    point = Reference(Source("point", x0=width / 2), D, 0.01, t)
+    box = Reference(Source("box", a=0.0, b=width), D, 0.01, t)  # at 0: any width is a float there
+    x = np.linspace(point.centre - 1.0, point.centre + 1.0, 41)
+    assert box.density(x) == pytest.approx(point.density(x), rel=1e-13)
+    at_start = Reference(Source("box", a=0.0, b=width), D, 0.01, 0.0).sampled(np.array([-0.5, 0.0, 0.5]), 0.5)
+    assert at_start.tolist() == [0.0, 2.0, 0.0]  # its indicator: 1 / width overflows below 5.6e-309
+
+
+@pytest.mark.parametrize("a", [1e3, -7.5, 1e-3, 3e8])
+def test_a_box_one_float_wide_is_the_point_source(a):
+    """The narrowest box a float can hold at its position, [a, next float after a], is the point
+    source at its centre: density, sampled reference, entropy (the erf difference of x - a and
+    x - b lost ~1e-4 of the density at a = 1000)."""
+    D, v, t = 1e-3, 0.01, 50.0
+    b = math.nextafter(a, math.inf)
+    box = Reference(Source("box", a=a, b=b), D, v, t)
+    point = Reference(Source("point", x0=0.5 * (a + b)), D, v, t)
+    x = np.linspace(point.centre - 1.0, point.centre + 1.0, 201)
+    assert box.density(x) == pytest.approx(point.density(x), rel=1e-9)
+    assert box.sampled(x, 0.01) == pytest.approx(point.sampled(x, 0.01), rel=1e-9)
+    assert box.entropy() == pytest.approx(point.entropy(), abs=1e-14)
+
+
+@pytest.mark.parametrize(
+    "u, h",
+    [(0.0, 0.0), (3.0, 0.0), (2.0, 1e-300), (-5.0, 1e-17), (0.3, 1e-9), (9.0, 0.02), (-0.1, 0.3), (0.2, 2.5),
+     (4.0, 0.6), (15.0, 0.01), (-1e-12, 1e-12)],
+)  # fmt: skip
+def test_box_mean_is_the_gaussians_mean_over_the_interval(u, h):
+    """(erf(u + h) - erf(u - h)) / (4 h), against scipy's quadrature of exp(-z^2) / sqrt(pi)."""
+    f = lambda z: math.exp(-((u + h * z) ** 2)) / math.sqrt(math.pi)  # noqa: E731
+    cuts = sorted({-1.0, 1.0, *[p for p in (-u / h if h else 2.0,) if -1 < p < 1]})
+    exact = sum(quad(f, lo, hi, epsabs=0, epsrel=2e-14)[0] for lo, hi in zip(cuts, cuts[1:])) / 2
+    assert box_mean(np.array([u, -u]), h) == pytest.approx([exact, exact], rel=1e-13)
 
 
 @pytest.mark.parametrize(

@@ -33,6 +33,21 @@ def test_defaults_and_domains_from_the_margin():
     assert scene.peclet == pytest.approx(0.01 * scene.fd_length / 1e-3)
 
 
+@pytest.mark.parametrize("a", [0.0, 1000.0])
+def test_a_box_one_float_wide_scores_as_the_point_source(a):
+    """Issue 39: a box narrower than ~1e-15 got a wrong exact entropy. The narrowest box a float
+    holds at its position is the point source at its centre: an FD run of it has the point's exact
+    H_C, entropy and SSE (the same grid, the same masses)."""
+    from particle_entropy.models.simulate import run
+
+    b = math.nextafter(a, math.inf) if a else 5e-324
+    box = Scene.from_config("s", spec(source={"kind": "box", "a": a, "b": b}, candidates=[FD]))
+    point = Scene.from_config("p", spec(source={"kind": "point", "x0": box.source.centre}, candidates=[FD]))
+    rows = [run(s.run_config(s.candidates[0], 64))[0].iloc[-1] for s in (box, point)]
+    for column in ("H_C_analytic", "E_analytic", "SSE", "SSE_points", "H_C"):
+        assert rows[0][column] == pytest.approx(rows[1][column], rel=1e-10), column
+
+
 def test_identity_is_the_physics_only():
     base = Scene.from_config("a", spec())
     other_target = Scene.from_config("b", spec(target={"value": 1e-4, "measure": "entropy"}))

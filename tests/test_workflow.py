@@ -706,6 +706,50 @@ def test_a_second_run_in_the_same_directory_is_refused_and_the_first_completes(t
     pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / target), pd.read_parquet(tiny_run / target))
 
 
+def test_two_clones_whose_results_link_to_one_folder_do_not_both_run(tmp_path):
+    """Snakemake's lock is per working directory: clone b ran beside clone a in the results both
+    link to. Now b stops before any job, naming the run that holds results/ (runlock.py)."""
+    import os
+    import sys
+
+    shared = tmp_path / "shared"
+    for clone in ("a", "b"):
+        (tmp_path / clone).mkdir()
+        (tmp_path / clone / "results").symlink_to(shared, target_is_directory=True)
+    holder = (
+        "import sys; from particle_entropy.pipeline.runlock import hold; hold('results'); print('held', flush=True)"
+    )
+    holder += "; sys.stdin.read()"  # until the test closes the pipe
+    first = subprocess.Popen(
+        [sys.executable, "-c", holder], cwd=tmp_path / "a", stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert first.stdout.readline().strip() == "held"
+        second = run_snakemake(tmp_path / "b", "figures/fig8.png", configfile=TINY, check=False)
+    finally:
+        first.stdin.close()
+        first.wait(timeout=30)
+    assert second.returncode != 0 and "Traceback" not in second.stderr
+    assert f"results/ ({shared}) is in use by another run (pid {first.pid} on " in second.stderr
+    assert sorted(os.listdir(shared)) == [".run.lock"]  # no job ran, no kernels built
+    again = run_snakemake(tmp_path / "b", "--unlock", configfile=TINY, check=False)  # looks only: no lock taken
+    assert again.returncode == 0, again.stderr[-2000:]
+
+
+def test_a_read_only_home_is_no_obstacle(tmp_path):
+    """Snakemake made ~/.cache/snakemake/source-cache before reading the Snakefile, so a HOME that
+    cannot be written (here a file, which stops root too) ended every command in its traceback. The
+    default profile keeps that cache in Snakemake's own temporary folder (shared-fs-usage)."""
+    import os
+
+    home = tmp_path / "home"
+    home.write_text("not a folder")
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_CACHE_HOME", "XDG_CONFIG_HOME")} | {"HOME": str(home)}
+    proc = run_snakemake(tmp_path, "figures/fig8.png", dry_run=True, configfile=TINY, env=env, check=False)
+    assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
+    assert "compile_kernels" in proc.stdout
+
+
 def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
     import os
     import resource

@@ -157,8 +157,24 @@ def check_writable(look_only):
         raise WorkflowError("\n".join(problems))
 
 
+def hold_results():
+    """Hold results/'s own lock for this run (pipeline/runlock.py): Snakemake's lock is per working
+    directory, so two clones whose results/ link to one folder would both write there. A second
+    run is refused in one line naming the first; a file system without locks is said, not fatal."""
+    from particle_entropy.pipeline.runlock import FolderBusy, hold
+
+    try:
+        note = hold("results")
+    except FolderBusy as e:
+        raise WorkflowError(str(e)) from None
+    if note:
+        print(note, file=sys.stderr)
+
+
 if workflow.is_main_process:
     check_writable(looks_only())
+    if not looks_only():
+        hold_results()
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
 
 

@@ -205,6 +205,7 @@ class Search:
     def from_config(cls, name: str, spec: Mapping, config: Mapping) -> Search:
         """The search ``optimum.<name>`` of a workflow config; SettingError names the key path."""
         where = f"optimum.{name}"
+        _check_spec(where, spec)
         over = "dt_growth" if "growth_range" in spec else "n"
         if over == "dt_growth" and "n_range" in spec:
             raise SettingError(f"{where}.n_range", spec["n_range"], "absent when growth_range is set (one dimension)")
@@ -314,6 +315,52 @@ class Search:
         bad = len(set(xs)) != len(xs) or any(not (math.isfinite(c) and c > 0) for _, c in self.cost)
         if bad or any(not (math.isfinite(x) and valid(x)) for x in xs):
             raise SettingError(f"{where}.cost", [list(p) for p in self.cost], wanted)
+
+
+_SETTINGS = {s.name: s for s in SEARCH}
+_PAIRS = {"n_range": (int,), "growth_range": (int, float)}  # [low, high] of these types
+_RANGE_LATER = ("time", "width", "initial_points", "start_points", "budget_runs")  # Search.check, with its numbers
+
+
+def _check_spec(where: str, spec) -> None:
+    """Each key of the search ``where`` = optimum.<name> as its declaration (settings.SEARCH) types
+    it: SettingError naming ``where.<key>``, the value and what is allowed, before any value is
+    read. The JSON schema says the same in a run; this holds for every caller (scripts, tests)."""
+    if not isinstance(spec, Mapping):
+        raise SettingError(where, spec, "a mapping: case, time, n_range or growth_range, ...")
+    for key in spec:
+        if key not in _SETTINGS:
+            raise SettingError(f"{where}.{key}", spec[key], f"a known key: {', '.join(_SETTINGS)}")
+    for key in ("case", "time"):
+        if key not in spec:
+            raise SettingError(f"{where}.{key}", None, f"{_SETTINGS[key].allowed()} (required)")
+    for key, value in spec.items():
+        setting = _SETTINGS[key]
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if key in _PAIRS:
+            ok = isinstance(value, (list, tuple)) and len(value) == 2
+            ok = ok and all(isinstance(v, _PAIRS[key]) and not isinstance(v, bool) for v in value)
+            ok = ok and all(math.isfinite(v) for v in value)
+        elif key == "cost":
+            ok = isinstance(value, (list, tuple)) and all(
+                isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(v, (int, float)) for v in p)
+                for p in value
+            )
+        elif key == "case":
+            ok = isinstance(value, Mapping)
+        elif setting.kind == "boolean":
+            ok = isinstance(value, bool)
+        elif setting.choices is not None:
+            ok = value in setting.choices
+        elif setting.kind == "integer":
+            ok = isinstance(value, int) and not isinstance(value, bool)
+            ok = ok and (key in _RANGE_LATER or setting.low <= value <= setting.high)
+        else:
+            ok = number and math.isfinite(value)
+            ok = ok and (key in _RANGE_LATER or (value > setting.low if setting.open_low else value >= setting.low))
+        if not ok:
+            allowed = setting.allowed() if key != "case" else "a mapping: method, kernel and the dimensions that apply"
+            raise SettingError(f"{where}.{key}", value, allowed)
 
 
 def _block(search: Search, k: int, x, first: int, count: int) -> tuple:
@@ -474,7 +521,11 @@ def evaluate(search: Search, realisations: pd.DataFrame) -> tuple[pd.DataFrame, 
     if best < 0:
         why = values.get("COMIC_reason", pd.Series(["COMIC NaN"]))
         reasons = sorted(set(why) - {""})
-        raise ValueError(f"search {search.name}: no visited point scores a COMIC ({'; '.join(reasons)})")
+        where, key = f"optimum.{search.name}", "growth_range" if search.over == "dt_growth" else "n_range"
+        raise ValueError(
+            f"search {search.name}: no visited point scores a COMIC ({'; '.join(reasons)}); try a later "
+            f"{where}.time (now {search.time:g}) or another {where}.{key} ({search.lo:g} to {search.hi:g})"
+        )
     x_opt = search.x(float(fitted_minimum(u, minimised, counts)[0]))
     means = np.array([s.mean() for s in samples])
     stds = np.array([s.std(ddof=1) if len(s) > 1 else math.nan for s in samples])

@@ -46,7 +46,13 @@ def check_output_path(path: str | os.PathLike) -> Path:
     file, whose ``.sha256`` beside it is new or a regular file too, in a folder that exists or can
     be made and is writable, every name within the file system's limit. Else OutputError, before
     any work: nothing here is left to fail after a run (a name too long, a loop of links, a folder
-    where the checksum goes)."""
+    where the checksum goes). A path that names a folder (``out/``, ``out/.``, ``..``) is refused
+    whether or not that folder exists: pathlib drops the separator, so ``out/`` would be written as
+    a file named ``out``."""
+    text = os.fsdecode(path)
+    if os.path.basename(text) in ("", ".", ".."):
+        example = os.path.join(text, "run.parquet")
+        raise OutputError(f"{text}: names a folder, not a file; give the table's file name (e.g. {example})")
     p = Path(path)
     full = len(os.fsencode(os.path.abspath(p))) + len(CHECKSUM_SUFFIX)  # first: a stat of it would fail
     path_max = _limits(Path("/"))[1]

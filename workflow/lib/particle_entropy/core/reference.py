@@ -5,7 +5,10 @@ A point source at x0 spreads into the Gaussian of variance 2 D t centred at x0 +
 Eq. 2 carried by v); a Gaussian source of standard deviation sd into the Gaussian of variance
 sd^2 + 2 D t; a box of uniform concentration on [a, b] into
 
-    c(x, t) = [erf((x - a - v t) / s) - erf((x - b - v t) / s)] / (2 (b - a)),   s = sqrt(4 D t).
+    c(x, t) = [erf((x - a - v t) / s) - erf((x - b - v t) / s)] / (2 (b - a)),   s = sqrt(4 D t),
+
+the Gaussian's mean over the box, computed without the erf difference's cancellation (``box_mean``)
+for any width a float holds, down to the spacing of floats at the box's position.
 
 The differential entropy H_I = -integral c ln c dx of a Gaussian is ln sqrt(2 pi e variance)
 (Eq. 14); the box's has no closed form for t > 0 and is computed by Gauss-Legendre quadrature of
@@ -26,6 +29,8 @@ from . import measures as M
 SOURCE_KINDS = ("point", "gaussian", "box")
 _GL_NODES = 16  # Gauss-Legendre nodes per panel of box_entropy
 _TAIL_WIDTHS = 12.0  # box_entropy integrates to 12 s beyond each edge: erfc(12) ~ 1e-64
+_MEAN_NODES = 5  # Gauss-Legendre nodes of box_mean where the erf difference would cancel ...
+_NARROW = 0.05  # ... there: 4 |u| h below this
 
 
 @dataclass(frozen=True)
@@ -128,11 +133,8 @@ class Reference:
         if s.kind == "box":
             if self.spread == 0.0:
                 return np.where((x >= s.a + self.shift) & (x <= s.b + self.shift), 1.0 / (s.b - s.a), 0.0)
-            from scipy.special import erf
-
             w = math.sqrt(2.0 * self.spread)  # sqrt(4 D t)
-            lo, hi = (x - s.a - self.shift) / w, (x - s.b - self.shift) / w
-            return 0.5 * (erf(lo) - erf(hi)) / (s.b - s.a)
+            return box_mean((x - self.centre) / w, 0.5 * (s.b - s.a) / w) / w
         var = self.variance
         if not var > 0:
             raise ValueError("a point source has no density at t = 0 (a delta)")
@@ -170,8 +172,8 @@ class Reference:
         if self.source.kind == "point":
             return M.analytic_sampled(x - self.centre, self.D, self.t, dV)
         if self.variance > 0:
-            if self.source.kind == "box":
-                g = self.density(x)
+            if self.source.kind == "box":  # at t = 0 its indicator: 1 / width may overflow
+                g = self.density(x) if self.spread > 0 else self.density(x) > 0
             else:  # in log space: a plume narrower than the spacing keeps its peak
                 z = x - self.centre
                 logg = -0.5 * z * z / self.variance
@@ -219,8 +221,6 @@ def box_entropy(width: float, dt: float) -> float:
         raise ValueError(f"box width must be > 0, got {width!r}")
     if dt <= 0:
         return math.log(width)
-    from scipy.special import erf
-
     s = math.sqrt(4.0 * dt)
     half = 0.5 * width
     start = max(0.0, half - _TAIL_WIDTHS * s)
@@ -232,6 +232,45 @@ def box_entropy(width: float, dt: float) -> float:
     mid, rad = 0.5 * (edges[1:] + edges[:-1]), 0.5 * (edges[1:] - edges[:-1])
     x = (mid[:, None] + rad[:, None] * nodes[None, :]).ravel()
     w = (rad[:, None] * weights[None, :]).ravel()
-    c = 0.5 * (erf((x + half) / s) - erf((x - half) / s)) / width
+    c = box_mean(x / s, half / s) / s
     safe = np.where(c > 0, c, 1.0)
     return float(2.0 * (flat + np.dot(w, -c * np.log(safe))))
+
+
+def box_mean(u: np.ndarray, h: float) -> np.ndarray:
+    """The mean of exp(-z^2) / sqrt(pi) over [u - h, u + h], (erf(u + h) - erf(u - h)) / (4 h), to
+    round-off for every h >= 0 (h = 0: the density at u itself).
+
+    The erf difference cancels when both ends lie on one side of 0 and the interval is narrow: its
+    relative error is ~ eps / (1 - exp(-4 |u| h)), all of it for h below ~1e-16 (a box 1e-16 wide
+    at 4 D t = 0.2 had an entropy 0.36 too low). Where 4 |u| h < 1/20 and h < 1/10, the mean is
+    exp(-u^2) times that of exp(-2 u h z - h^2 z^2) over z in [-1, 1], a function within 4 % of 1
+    whose 5-node Gauss-Legendre quadrature is exact to round-off. Elsewhere the ends lie on one side
+    of 0 with 4 |u| h >= 1/20 (erfc(|u| - h) - erfc(|u| + h), which loses at most a factor 20 of
+    round-off to the difference) or straddle 0 with h >= 1/10 (erf(|u| + h) + erf(h - |u|): no
+    cancellation)."""
+    from scipy.special import erf, erfc
+
+    u = np.asarray(u, dtype=np.float64)
+    h = float(h)
+    if not h >= 0:
+        raise ValueError(f"half width must be >= 0, got {h!r}")
+    a = np.abs(u)  # by symmetry
+    narrow = (4.0 * a * h < _NARROW) & (h < 0.1)
+    out = np.empty_like(u)
+    if narrow.any():
+        nodes, weights = _mean_rule()
+        z = a[narrow][..., None] + h * nodes
+        out[narrow] = (0.5 / math.sqrt(math.pi)) * (np.exp(-z * z) @ weights)
+    side = ~narrow & (a >= h)
+    if side.any():
+        out[side] = (erfc(a[side] - h) - erfc(a[side] + h)) / (4.0 * h)
+    straddle = ~narrow & (a < h)
+    if straddle.any():
+        out[straddle] = (erf(a[straddle] + h) + erf(h - a[straddle])) / (4.0 * h)
+    return out
+
+
+@functools.cache
+def _mean_rule() -> tuple[np.ndarray, np.ndarray]:
+    return np.polynomial.legendre.leggauss(_MEAN_NODES)

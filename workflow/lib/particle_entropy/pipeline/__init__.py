@@ -1,5 +1,6 @@
 """What joins the library to the workflow: config sections to cases and paths (`sweeps`), the
 config's checks (`configcheck`: YAML and schema; `crosschecks`: the rules between fields), memory
-estimates of jobs (`memory`), table verification before a run (`verify`), content hashes of the
-code each rule runs (`codeversion`), the generated schema entries and column page (`schemagen`,
-`columnsdoc`) and the report's table pages (`htmlpage`). The top of the stack with `cli`."""
+estimates of jobs (`memory`), table verification before a run (`verify`), one run at a time in a
+results folder (`runlock`), content hashes of the code each rule runs (`codeversion`), the
+generated schema entries and column page (`schemagen`, `columnsdoc`) and the report's table pages
+(`htmlpage`). The top of the stack with `cli`."""

@@ -241,7 +241,16 @@ def check_search(name: str, config: Mapping, available: float | None = None):
             if e.name in ("n", "dt_growth"):
                 raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
             raise _case_error(e, f"{where}.case", case) from None
-    _check_seed_count(int(config["base_seed"]), search.max_realisations)
+    base = int(config["base_seed"])
+    try:
+        _check_seed_count(base, search.max_realisations)
+    except SettingError:  # named by the search's own key, which sets how far its seeds run
+        raise SettingError(
+            f"{where}.max_realisations",
+            search.max_realisations,
+            f"an integer <= {MAX_SEED - base + 1} with base_seed = {base} (seeds run to base_seed + "
+            "max_realisations - 1 and are stored as int64), or a lower base_seed",
+        ) from None
     if available is not None:
         _check_jobs_fit(
             [(f"{where}.{key}", e, e.realisations) for e in optimum_largest_jobs(search)], config, available
