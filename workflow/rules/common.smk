@@ -24,7 +24,7 @@ validate(config, str(SCHEMA))  # fills the schema's defaults
 
 from particle_entropy.core.case import Case, SettingError
 from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, code_version, simulation_code
-from particle_entropy.numerics.compiled import kernels_folder
+from particle_entropy.numerics.compiled import built_here, target_key
 from particle_entropy.pipeline.verify import (
     CORRUPT_SUFFIX,
     CRATE_DIR,
@@ -62,6 +62,12 @@ from particle_entropy.pipeline.crosschecks import check_memory, check_scene_memo
 from particle_entropy.experiments.scene import PECLET_PREFIX, SCENE_RUN_PATTERN, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
+
+# The kernels compiled ahead of time (numerics/compiled.py): one folder of a fixed name, rebuilt by
+# rule compile_kernels when the code, numba, CPU or numba's settings change (target_key). Its name,
+# not that target, is an input of the simulations: their results are the JIT's bits on any target.
+KERNELS = "results/kernels"
+KERNEL_TARGET = target_key()
 
 check_sweeps(config)
 # jobs run here: each must fit in this machine's memory (read once, for the sections and the searches)
@@ -147,7 +153,7 @@ def check_writable(look_only):
     here before this code's kernels are compiled, numba's cache (verify.numba_cache_folders; a
     cluster node has its own). Else every job fails on a traceback or an empty log."""
     problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
-    if not look_only and workflow.local_exec and not Path(kernels_folder()).is_dir():
+    if not look_only and workflow.local_exec and not built_here(KERNELS):
         # numba's cache is written while the kernels of this code are compiled (rule compile_kernels);
         # once they are, jobs load them and numba caches nothing
         problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
@@ -379,7 +385,6 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
-KERNELS = kernels_folder()  # the ahead-of-time kernels of this code, numba and CPU
 SUMMARY_CODE = code_version(
     "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
 )

@@ -1,14 +1,18 @@
 # One job per simulation case and block of seeds -> one tidy Parquet table (a `seed` column).
 # kind: runs = one row per time step; snapshots = the final particle or grid states (Fig. 7).
 # Each job loads the kernels compile_kernels built ahead of time for this code, numba and CPU
-# (numerics/compiled.py), so that it imports no numba: a small job costs what it computes.
+# (numerics/compiled.py), so that it imports no numba: a small job costs what it computes. They
+# are rebuilt when that target changes (params); a job never reruns for it (ancient), and one
+# whose module is not for its target, or fails its digest, runs numba's JIT: the same bits.
 
 
 rule compile_kernels:
     output:
         directory(KERNELS),
     log:
-        f"logs/compile_kernels/{Path(KERNELS).name}.log",
+        f"logs/compile_kernels/{KERNEL_TARGET}.log",
+    params:
+        target=KERNEL_TARGET,
     conda:
         "../../envs/particle-entropy.yaml"
     script:
@@ -17,7 +21,7 @@ rule compile_kernels:
 
 rule simulate:
     input:
-        kernels=ancient(KERNELS),  # built once per code version; its age reruns nothing
+        kernels=ancient(KERNELS),  # rebuilt per target; neither its age nor its target reruns a job
     output:
         RUN_PATTERN,
     log:
