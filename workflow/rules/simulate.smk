@@ -11,10 +11,10 @@ rule compile_kernels:
         directory(KERNELS),
     log:
         f"logs/compile_kernels/{KERNEL_TARGET}.log",
-    params:
-        target=KERNEL_TARGET,
     conda:
         "../../envs/particle-entropy.yaml"
+    params:
+        target=KERNEL_TARGET,
     script:
         "../scripts/compile_kernels.py"
 

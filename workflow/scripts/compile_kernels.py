@@ -1,6 +1,7 @@
 """Compile the simulation kernels ahead of time for this CPU (numerics/compiled.py), once per
-code version (a copy from the machine-wide cache where another working directory built them):
-every simulate job then loads them instead of starting numba's JIT. Where they
+target: code, numba, CPU and numba's settings (a copy from this user's machine-wide cache where
+another working directory built them, if that cache folder is sound and no one else can write
+it): every simulate job then loads them instead of starting numba's JIT. Where they
 cannot be built (no C compiler or Python headers in the job's environment), the folder is left
 without a module and the jobs run numba's JIT, as before: slower to start, the same results."""
 

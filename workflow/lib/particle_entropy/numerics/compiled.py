@@ -17,6 +17,7 @@ this numba, for this CPU and numba settings (``target()``); else the job runs th
 
 from __future__ import annotations
 
+import errno
 import functools
 import hashlib
 import importlib.machinery
@@ -214,8 +215,9 @@ def _from_cache(cache: Path) -> tuple[str, str | None, tuple[str, bytes, bytes] 
         fd = os.open(cache, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
     except FileNotFoundError:
         return "absent", None, None
-    except OSError:
-        return "untrusted", "is a symbolic link" if cache.is_symlink() else "is no folder", None
+    except OSError as e:
+        why = "is no folder" if e.errno in (errno.ELOOP, errno.ENOTDIR) else f"cannot be opened ({e.strerror})"
+        return "untrusted", "is a symbolic link" if cache.is_symlink() else why, None
     try:
         st = os.fstat(fd)
         if st.st_uid != os.getuid():
@@ -308,8 +310,8 @@ def provide(folder: str | os.PathLike) -> str:
     if state in ("absent", "stale"):
         _publish(cache, folder, replace=state == "stale")
     if why:
-        done = "replaced it" if state == "stale" else "left it alone"
-        print(f"kernel cache {cache} {why}: built the kernels in {folder} and {done}", file=sys.stderr)
+        done = "replaced the cache's copy" if state == "stale" else "left the cache alone"
+        print(f"kernel cache {cache}: {why}; built the kernels in {folder} and {done}", file=sys.stderr)
     return "built"
 
 
