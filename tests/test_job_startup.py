@@ -369,28 +369,41 @@ def test_cache_folders_are_private_whatever_the_umask(tmp_path, fake_build):
 
 
 # ------------------------------------------------------------------ the workflow's kernels
-RUN = "results/runs/fd/implicit/n~30/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact/seeds~0-0.parquet"
+RUN = "results/runs/fd/implicit/n~{n}/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact/seeds~0-0.parquet"
 
 
-def test_another_target_rebuilds_the_kernels_and_reruns_no_simulation(kernels, tmp_path):
-    """Another NUMBA_OPT, as another CPU or numba, is another target(): rule compile_kernels reruns
-    for it, a finished simulation does not (the module gives the JIT's bits: the target is no part
-    of a run's identity). The run takes the module from the cache, and its job loads it."""
-    cache = tmp_path / "cache" / compiled.target_key()
-    cache.mkdir(parents=True, mode=0o700)
-    for f in kernels.iterdir():
-        (cache / f.name).write_bytes(f.read_bytes())
-        (cache / f.name).chmod(0o600)
-    env = {**os.environ, compiled.CACHE_ENV: str(cache.parent)}
-    work = tmp_path / "work"
-    run_snakemake(work, RUN, configfile=TINY, env=env)
+def test_another_target_rebuilds_the_kernels_and_reruns_no_simulation(kernels, tmp_path, monkeypatch):
+    """Another NUMBA_OPT, as another CPU or numba, is another target(): compile_kernels reruns for
+    it, a finished simulation does not (the module gives the JIT's bits: the target is no part of
+    a run's identity), and a simulation still to make is made in the same run."""
+    other = "1" if os.environ.get("NUMBA_OPT") == "0" else "0"
+    record = json.loads((kernels / compiled.RECORD).read_text())
+    for opt in (os.environ.get("NUMBA_OPT"), other):  # the cache holds the module for both targets
+        with monkeypatch.context() as m:
+            m.delenv("NUMBA_OPT", raising=False) if opt is None else m.setenv("NUMBA_OPT", opt)
+            cache, here = tmp_path / "cache" / compiled.target_key(), compiled.target()
+        cache.mkdir(parents=True, mode=0o700)
+        for f in kernels.iterdir():
+            (cache / f.name).write_bytes(f.read_bytes())
+        (cache / compiled.RECORD).write_text(json.dumps({**record, "target": here}))
+        for f in cache.iterdir():
+            f.chmod(0o600)
+    env = {**os.environ, compiled.CACHE_ENV: str(tmp_path / "cache")}
+    work, first, second = tmp_path / "work", RUN.format(n=30), RUN.format(n=60)
+    run_snakemake(work, first, configfile=TINY, env=env)
     assert "copied" in next((work / "logs" / "compile_kernels").iterdir()).read_text()
     assert "JIT" not in next((work / "logs" / "simulate").rglob("*.log")).read_text()
 
     def plan(env):
-        proc = run_snakemake(work, RUN, dry_run=True, configfile=TINY, env=env)
-        return set(re.findall(r"^\s*(?:local)?rule (\w+):", proc.stdout + proc.stderr, flags=re.M))
+        proc = run_snakemake(work, first, dry_run=True, configfile=TINY, env=env)
+        return set(re.findall(r"^\s*(?:local)?(?:rule|checkpoint) (\w+):", proc.stdout + proc.stderr, flags=re.M))
 
     assert plan(env) == set()
-    other = "1" if os.environ.get("NUMBA_OPT") == "0" else "0"
-    assert plan({**env, "NUMBA_OPT": other}) == {"compile_kernels"}
+    env = {**env, "NUMBA_OPT": other}
+    assert plan(env) == {"compile_kernels"}
+    made = (work / first).stat().st_mtime_ns
+    run_snakemake(work, first, second, configfile=TINY, env=env)
+    assert (work / second).exists() and (work / first).stat().st_mtime_ns == made
+    assert json.loads((work / "results" / "kernels" / compiled.RECORD).read_text())["target"].endswith(
+        f"NUMBA_OPT={other}\n"
+    )

@@ -4,9 +4,12 @@
 # (numerics/compiled.py), so that it imports no numba: a small job costs what it computes. They
 # are rebuilt when that target changes (params); a job never reruns for it (ancient), and one
 # whose module is not for its target, or fails its digest, runs numba's JIT: the same bits.
+# A checkpoint, so that Snakemake judges the jobs after it again once it is done: while a job
+# reruns, Snakemake does not look at the jobs that take its output as `ancient` input, and would
+# end the run "100% done" without the simulations still to make.
 
 
-rule compile_kernels:
+checkpoint compile_kernels:
     output:
         directory(KERNELS),
     log:

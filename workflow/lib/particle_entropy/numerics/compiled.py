@@ -121,6 +121,11 @@ def target_key() -> str:
     return hashlib.sha256(here.encode()).hexdigest()[:16] if here else "unknown-cpu"
 
 
+def kernels_folder(root: str = "results/kernels") -> str:
+    """A folder of ``root`` named ``target_key()``, for a module built for ``target()``."""
+    return f"{root}/{target_key()}"
+
+
 def built_here(folder: str | os.PathLike) -> bool:
     """Whether ``folder``'s record says its module was built for ``target()`` (the digest is
     checked only when it is loaded: ``use``)."""
@@ -155,6 +160,16 @@ def _module_names() -> set[str]:
 
 def _words(key: str) -> tuple[int, ...]:
     return tuple(int(key[i : i + 8], 16) for i in range(0, len(key), 8))
+
+
+def _complete(folder: str | os.PathLike) -> bool:
+    """Whether ``folder`` holds a module built for ``target()`` whose SHA-256 is the one recorded."""
+    folder = Path(folder)
+    try:
+        _verified((folder / RECORD).read_bytes(), lambda name: (folder / name).read_bytes())
+    except (OSError, _Refused):
+        return False
+    return True
 
 
 def _verified(record: bytes | str, read) -> tuple[str, bytes]:
