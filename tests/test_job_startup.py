@@ -3,10 +3,14 @@ neither numba nor what numba pulls in (scipy), nor pandas; its kernels give the 
 
 from __future__ import annotations
 
+import hashlib
+import importlib.machinery
 import json
 import multiprocessing
 import os
+import re
 import shutil
+import stat
 import subprocess
 import sys
 import time
@@ -14,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, TINY, run_snakemake
 
 from particle_entropy.core.case import Case
 from particle_entropy.numerics import compiled, gauss
@@ -107,15 +111,76 @@ def test_without_its_module_a_job_runs_the_jit(tmp_path):
     assert "numba's JIT runs them" in log and "numba" in modules
 
 
-def test_a_module_built_for_another_target_is_refused(kernels, tmp_path):
-    other = tmp_path / "other"
-    other.mkdir()
-    for f in kernels.iterdir():
-        (other / f.name).write_bytes(f.read_bytes())
-    (other / compiled.TARGET_FILE).write_text((kernels / compiled.TARGET_FILE).read_text().replace("cpu ", "cpu x"))
-    code = f"from particle_entropy.numerics import compiled; print(compiled.use({str(other)!r}))"
+def _use(folder: Path, prelude: str = "") -> tuple[bool, str]:
+    """``compiled.use(folder)`` in a fresh process (after ``prelude``) -> (taken, its stderr)."""
+    code = f"from particle_entropy.numerics import compiled\n{prelude}\nprint(compiled.use({str(folder)!r}))"
     res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)
-    assert res.stdout.decode().strip() == "False" and b"other code, numba, CPU" in res.stderr
+    assert res.returncode == 0, res.stderr.decode()[-3000:]
+    return res.stdout.decode().split()[-1] == "True", res.stderr.decode()
+
+
+def _copy(kernels: Path, to: Path) -> tuple[Path, dict]:
+    """A copy of the built module's folder -> (the copy's module, its record)."""
+    to.mkdir()
+    for f in kernels.iterdir():
+        (to / f.name).write_bytes(f.read_bytes())
+    record = json.loads((to / compiled.RECORD).read_text())
+    return to / record["module"], record
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def test_a_module_built_for_another_target_is_refused(kernels, tmp_path):
+    _, record = _copy(kernels, tmp_path / "other")
+    record["target"] = record["target"].replace("cpu ", "cpu x")
+    (tmp_path / "other" / compiled.RECORD).write_text(json.dumps(record))
+    taken, err = _use(tmp_path / "other")
+    assert not taken and "other code, numba, CPU" in err
+
+
+def test_a_planted_file_beside_the_module_is_never_run(kernels, tmp_path):
+    """Only the file the build recorded is loaded: a .py named like the module (it sorts first)
+    is never executed, in the run's folder or the cache (provide copies only the module)."""
+    _copy(kernels, tmp_path / "k")
+    marker = tmp_path / "planted-code-ran"
+    (tmp_path / "k" / f"{compiled.MODULE}.a.py").write_text(f"open({str(marker)!r}, 'w').write('x')\n")
+    taken, err = _use(tmp_path / "k")
+    assert taken and not marker.exists(), err
+
+
+def test_a_foreign_module_under_a_copied_record_is_refused(kernels, tmp_path):
+    """A module of other bytes (here: the real one, one byte longer, which still loads) under this
+    build's record fails the SHA-256 the record binds to this target; and a record forged to match
+    it is caught by the code key the module carries (IDENTITY), checked after loading."""
+    module, record = _copy(kernels, tmp_path / "k")
+    module.write_bytes(module.read_bytes() + b"\0")
+    taken, err = _use(tmp_path / "k")
+    assert not taken and "fails the SHA-256" in err and "JIT runs them" in err
+    # a consistent record of a module built from other code: code_key() here is another one
+    record["sha256"] = _sha256(module.read_bytes())
+    (tmp_path / "k" / compiled.RECORD).write_text(json.dumps(record))
+    assert _use(tmp_path / "k")[0]  # a sound record: taken
+    other = "here = compiled.target()\ncompiled.code_key = lambda: 'f' * 64\ncompiled.target = lambda: here"
+    taken, err = _use(tmp_path / "k", other)
+    assert not taken and "built from other code" in err
+
+
+def test_a_module_that_does_not_import_leaves_the_jit(kernels, tmp_path):
+    module, record = _copy(kernels, tmp_path / "k")
+    module.write_bytes(os.urandom(4096))  # and a record that matches it: only the import fails
+    (tmp_path / "k" / compiled.RECORD).write_text(json.dumps({**record, "sha256": _sha256(module.read_bytes())}))
+    taken, err = _use(tmp_path / "k")
+    assert not taken and "does not load (ImportError" in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_a_truncated_module_of_the_run_runs_the_jit_and_the_job_succeeds(kernels, tmp_path):
+    module, _ = _copy(kernels, tmp_path / "k")
+    module.write_bytes(module.read_bytes()[:100_000])
+    modules, log = _job(CASES[2], tmp_path / "k", tmp_path)  # raises unless the job succeeds
+    assert "fails the SHA-256" in log and "numba's JIT runs them" in log and "numba" in modules
+    assert (tmp_path / "t.parquet").stat().st_size > 0
 
 
 def test_the_compiled_kernels_give_the_jits_bits(kernels):
@@ -197,6 +262,17 @@ print("ok")
 
 
 # ------------------------------------------------------------------ the machine-wide cache
+NAME = compiled.MODULE + importlib.machinery.EXTENSION_SUFFIXES[0]  # the module's one file name
+
+
+def _stand_in(folder: Path, data: bytes = b"a module", digest: str | None = None) -> None:
+    """A stand-in module and its record (SHA-256 ``digest``, else the data's) for this target."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / NAME).write_bytes(data)
+    record = {"module": NAME, "sha256": digest or _sha256(data), "target": compiled.target()}
+    (folder / compiled.RECORD).write_text(json.dumps(record))
+
+
 @pytest.fixture
 def fake_build(tmp_path, monkeypatch):
     """build() replaced by one that writes a stand-in module for this target; the cache in tmp_path."""
@@ -204,38 +280,154 @@ def fake_build(tmp_path, monkeypatch):
     builds = []
 
     def build(folder):
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / f"{compiled.MODULE}.so").write_bytes(b"a module")
-        (folder / compiled.TARGET_FILE).write_text(compiled.target())
-        builds.append(folder)
+        _stand_in(Path(folder))
+        builds.append(Path(folder))
 
     monkeypatch.setattr(compiled, "build", build)
     return builds
+
+
+def _cached(data: bytes, mode: int = 0o700) -> Path:
+    """The cache folder of this target, this user's, holding a stand-in of ``data``."""
+    cache = compiled.cache_folder()
+    _stand_in(cache, data)
+    cache.chmod(mode)
+    return cache
 
 
 def test_a_second_working_directory_copies_the_module_the_first_built(tmp_path, fake_build):
     assert compiled.provide(tmp_path / "a" / "kernels") == "built"
     assert compiled.provide(tmp_path / "b" / "kernels") == "copied"
     assert fake_build == [tmp_path / "a" / "kernels"]  # compiled once on this machine
-    for name in (f"{compiled.MODULE}.so", compiled.TARGET_FILE):
+    for name in (NAME, compiled.RECORD):
         assert (tmp_path / "b" / "kernels" / name).read_bytes() == (tmp_path / "a" / "kernels" / name).read_bytes()
     assert not list((tmp_path / "cache").glob(".*.tmp"))  # published whole, nothing left half-written
 
 
 def test_a_cached_module_of_another_target_is_not_taken(tmp_path, fake_build):
-    cache = compiled.cache_folder()
-    cache.mkdir(parents=True)
-    (cache / f"{compiled.MODULE}.so").write_bytes(b"old")
-    (cache / compiled.TARGET_FILE).write_text("code another\n")
+    cache = _cached(b"old")
+    record = json.loads((cache / compiled.RECORD).read_text())
+    (cache / compiled.RECORD).write_text(json.dumps({**record, "target": "code another\n"}))
     assert compiled.provide(tmp_path / "a") == "built"
-    assert (tmp_path / "a" / f"{compiled.MODULE}.so").read_bytes() == b"a module"
+    assert (tmp_path / "a" / NAME).read_bytes() == b"a module"
 
 
 def test_an_empty_cache_setting_keeps_no_copy(tmp_path, fake_build, monkeypatch):
     monkeypatch.setenv(compiled.CACHE_ENV, "")
     assert compiled.cache_folder() is None
     assert [compiled.provide(tmp_path / d) for d in "ab"] == ["built", "built"]
+
+
+@pytest.mark.parametrize("bad", [b"", b"random bytes \x00\xff", b"a modu"], ids=["empty", "random", "truncated"])
+def test_a_corrupt_cached_module_is_rebuilt_and_replaced_never_copied(tmp_path, fake_build, capsys, bad):
+    cache = _cached(b"a module")
+    (cache / NAME).write_bytes(bad)  # decayed after its record was written
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert (tmp_path / "a" / NAME).read_bytes() == b"a module"
+    assert "fails the SHA-256" in capsys.readouterr().err
+    assert (cache / NAME).read_bytes() == b"a module"  # repaired: the next directory copies it
+    assert compiled.provide(tmp_path / "b") == "copied" and len(fake_build) == 1
+
+
+def test_only_the_recorded_module_is_copied_from_the_cache(tmp_path, fake_build):
+    cache = _cached(b"a module")
+    (cache / f"{compiled.MODULE}.a.py").write_text("raise SystemExit('planted')\n")
+    assert compiled.provide(tmp_path / "a") == "copied"
+    assert sorted(f.name for f in (tmp_path / "a").iterdir()) == sorted([NAME, compiled.RECORD])
+
+
+def test_a_cache_folder_of_another_user_is_not_trusted(tmp_path, fake_build, monkeypatch, capsys):
+    cache = _cached(b"their module")
+    monkeypatch.setattr(os, "getuid", lambda: os.stat(cache).st_uid + 1)  # the folder is another's
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert (tmp_path / "a" / NAME).read_bytes() == b"a module"
+    err = capsys.readouterr().err
+    assert "belongs to uid" in err and "left the cache alone" in err and len(err.splitlines()) == 1
+    assert (cache / NAME).read_bytes() == b"their module"  # neither read nor replaced
+
+
+def test_a_cache_folder_others_can_write_is_not_read_but_replaced(tmp_path, fake_build, capsys):
+    cache = _cached(b"maybe someone else's", mode=0o770)
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert (tmp_path / "a" / NAME).read_bytes() == b"a module"
+    assert "can be written by others (mode 770)" in capsys.readouterr().err
+    assert (cache / NAME).read_bytes() == b"a module" and stat.S_IMODE(cache.stat().st_mode) == 0o700
+
+
+def test_a_group_writable_module_file_is_not_read(tmp_path, fake_build, capsys):
+    cache = _cached(b"maybe someone else's")
+    (cache / NAME).chmod(0o664)
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert f"its {NAME} can be written by others" in capsys.readouterr().err
+
+
+def test_a_cache_folder_that_is_a_link_is_not_followed(tmp_path, fake_build, capsys):
+    elsewhere = tmp_path / "elsewhere"
+    _stand_in(elsewhere, b"their module")
+    elsewhere.chmod(0o700)
+    cache = compiled.cache_folder()
+    cache.parent.mkdir(parents=True)
+    cache.symlink_to(elsewhere)
+    assert compiled.provide(tmp_path / "a") == "built"
+    assert "is a symbolic link" in capsys.readouterr().err
+    assert cache.is_symlink() and (elsewhere / NAME).read_bytes() == b"their module"
+
+
+def test_cache_folders_are_private_whatever_the_umask(tmp_path, fake_build):
+    old = os.umask(0o002)
+    try:
+        compiled.provide(tmp_path / "a")
+    finally:
+        os.umask(old)
+    cache = compiled.cache_folder()
+    for folder in (cache.parent, cache):
+        assert stat.S_IMODE(folder.stat().st_mode) == 0o700, folder
+    for f in cache.iterdir():
+        assert stat.S_IMODE(f.stat().st_mode) == 0o600, f
+
+
+# ------------------------------------------------------------------ the workflow's kernels
+RUN = "results/runs/fd/implicit/n~{n}/eta~1/trunc~none/growth~1/scheme~symmetric/grid~exact/seeds~0-0.parquet"
+
+
+def test_another_target_rebuilds_the_kernels_and_reruns_no_simulation(kernels, tmp_path, monkeypatch):
+    """Another NUMBA_OPT, as another CPU or numba, is another target(): the next job to run takes
+    its kernels, a finished simulation does not rerun (the module gives the JIT's bits: the target
+    is no part of a run's identity), and a simulation still to make is made in the same run."""
+    other = "1" if os.environ.get("NUMBA_OPT") == "0" else "0"
+    record = json.loads((kernels / compiled.RECORD).read_text())
+    for opt in (os.environ.get("NUMBA_OPT"), other):  # the cache holds the module for both targets
+        with monkeypatch.context() as m:
+            m.delenv("NUMBA_OPT", raising=False) if opt is None else m.setenv("NUMBA_OPT", opt)
+            cache, here = tmp_path / "cache" / compiled.target_key(), compiled.target()
+        cache.mkdir(parents=True, mode=0o700)
+        for f in kernels.iterdir():
+            (cache / f.name).write_bytes(f.read_bytes())
+        (cache / compiled.RECORD).write_text(json.dumps({**record, "target": here}))
+        for f in cache.iterdir():
+            f.chmod(0o600)
+    env = {**os.environ, compiled.CACHE_ENV: str(tmp_path / "cache")}
+    work, first, second = tmp_path / "work", RUN.format(n=30), RUN.format(n=60)
+    run_snakemake(work, first, configfile=TINY, env=env)
+    log = next((work / "logs" / "simulate").rglob("*.log")).read_text()
+    assert "copied the compiled kernels" in log and "JIT" not in log
+
+    def plan(env):
+        proc = run_snakemake(work, first, dry_run=True, configfile=TINY, env=env)
+        return set(re.findall(r"^\s*(?:local)?(?:rule|checkpoint) (\w+):", proc.stdout + proc.stderr, flags=re.M))
+
+    assert plan(env) == set()
+    env = {**env, "NUMBA_OPT": other}
+    assert plan(env) == set()
+    made = (work / first).stat().st_mtime_ns
+    run_snakemake(work, first, second, configfile=TINY, env=env)
+    assert (work / second).exists() and (work / first).stat().st_mtime_ns == made
+    with monkeypatch.context() as m:
+        m.setenv("NUMBA_OPT", other)
+        folder = work / compiled.kernels_folder()
+    assert json.loads((folder / compiled.RECORD).read_text())["target"].endswith(f"NUMBA_OPT={other}\n")
+    log = next(p for p in (work / "logs" / "simulate").rglob("*.log") if "n~60" in str(p)).read_text()
+    assert "copied the compiled kernels" in log and "JIT" not in log
 
 
 # ------------------------------------------------------------------ provided by the first job
@@ -250,10 +442,7 @@ def counted_build(tmp_path, monkeypatch):
         with open(calls, "a") as f:
             f.write(f"{folder}\n")
         time.sleep(0.5)  # long enough for a second job to arrive meanwhile
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / f"{compiled.MODULE}.so").write_bytes(b"a module")
-        (folder / compiled.TARGET_FILE).write_text(compiled.target())
+        _stand_in(Path(folder))
 
     monkeypatch.setattr(compiled, "build", build)
     monkeypatch.setattr(compiled, "use", lambda folder: compiled._complete(Path(folder)))
@@ -282,9 +471,9 @@ def test_a_kernels_folder_left_half_made_is_rebuilt(tmp_path, counted_build):
     root = tmp_path / "kernels"
     half = Path(compiled.kernels_folder(str(root)))
     half.mkdir(parents=True)
-    (half / f"{compiled.MODULE}.so").write_bytes(b"cut sh")  # killed before its target was written
+    (half / NAME).write_bytes(b"cut sh")  # killed before its record was written
     assert compiled.take(root)
-    assert len(_builds(counted_build)) == 1 and (half / f"{compiled.MODULE}.so").read_bytes() == b"a module"
+    assert len(_builds(counted_build)) == 1 and (half / NAME).read_bytes() == b"a module"
     assert compiled.take(root) and len(_builds(counted_build)) == 1  # then taken as it is
 
 

@@ -26,10 +26,17 @@ def _resolve(node: dict) -> dict:
     return _resolve(target)
 
 
+# objects that are a user's problem, not settings: their defaults are a scene's (what an unset key
+# means), and the shipped config writes its own problem there (the sweep's base scene)
+USER_OBJECTS = {("scenes_peclet", "base")}
+
+
 def _defaults(node: dict, path: tuple = ()) -> list[tuple[tuple, object]]:
     """(key path, default) of every property under ``node`` that declares a ``default`` itself
-    (beside its ``$ref``, if any); ``$ref``s are followed into nested objects."""
+    (beside its ``$ref``, if any); ``$ref``s are followed into nested objects, but for USER_OBJECTS."""
     out = []
+    if path in USER_OBJECTS:
+        return out
     for key, prop in node.get("properties", {}).items():
         if "default" in prop:
             out.append(((*path, key), prop["default"]))

@@ -747,7 +747,7 @@ def test_a_read_only_home_is_no_obstacle(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("XDG_CACHE_HOME", "XDG_CONFIG_HOME")} | {"HOME": str(home)}
     proc = run_snakemake(tmp_path, "figures/fig8.png", dry_run=True, configfile=TINY, env=env, check=False)
     assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr[-3000:]
-    assert "compile_kernels" in proc.stdout
+    assert "simulate" in proc.stdout  # the plan was made
 
 
 def test_a_failed_job_on_a_full_disk_is_named_on_the_terminal(tmp_path):
