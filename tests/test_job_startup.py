@@ -175,11 +175,24 @@ def test_a_module_that_does_not_import_leaves_the_jit(kernels, tmp_path):
     assert not taken and "does not load (ImportError" in err and len(err.strip().splitlines()) == 1, err
 
 
-def test_a_truncated_module_of_the_run_runs_the_jit_and_the_job_succeeds(kernels, tmp_path):
-    module, _ = _copy(kernels, tmp_path / "k")
+def test_a_truncated_module_of_the_run_is_replaced_whole_by_the_next_job(kernels, tmp_path):
+    module, record = _copy(kernels, tmp_path / "k")
     module.write_bytes(module.read_bytes()[:100_000])
     modules, log = _job(CASES[2], tmp_path / "k", tmp_path)  # raises unless the job succeeds
-    assert "fails the SHA-256" in log and "numba's JIT runs them" in log and "numba" in modules
+    assert "the compiled kernels into" in log and "JIT" not in log, log  # provided again, then taken
+    assert not {m.split(".")[0] for m in modules} & {"numba", "llvmlite"}
+    here = tmp_path / "work" / compiled.kernels_folder() / record["module"]
+    assert _sha256(here.read_bytes()) == record["sha256"]  # whole again
+    assert (tmp_path / "t.parquet").stat().st_size > 0
+
+
+def test_a_module_that_does_not_load_leaves_the_jit_and_the_job_succeeds(kernels, tmp_path):
+    module, record = _copy(kernels, tmp_path / "k")
+    junk = b"not an ELF file"  # a broken build, recorded as it was: the digest holds, the import fails
+    module.write_bytes(junk)
+    (module.parent / compiled.RECORD).write_text(json.dumps({**record, "sha256": _sha256(junk)}))
+    modules, log = _job(CASES[2], tmp_path / "k", tmp_path)
+    assert "does not load" in log and "numba's JIT runs them" in log and "numba" in modules, log
     assert (tmp_path / "t.parquet").stat().st_size > 0
 
 
