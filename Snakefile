@@ -44,7 +44,20 @@ rule all:
         all_targets(),
 
 
+# Each run of jobs records the commit it runs at, whether tracked files differed, and the config's
+# digest; the crate gives every job the record of the run it started in (pipeline/crate.py).
+onstart:
+    RUN_RECORDS.append(start_session(workflow.basedir, config))
+
+
+onsuccess:
+    for record in RUN_RECORDS:
+        end_session(record)
+
+
 onerror:
+    for record in RUN_RECORDS:
+        end_session(record)
     from particle_entropy.pipeline.verify import disk_space_problems
 
     for problem in disk_space_problems((".", "results", ".snakemake")):

@@ -7,7 +7,9 @@ rule crate:
     input:
         all_targets(),
     output:
-        f"{CRATE_DIR}/{CRATE_METADATA}",  # the crate's other files are links, kept where they hold
+        # update: Snakemake keeps the old metadata for the job, which keeps what a person added to it;
+        # the crate's other files are links, kept where they hold
+        update(f"{CRATE_DIR}/{CRATE_METADATA}"),
     log:
         "logs/crate.log",
     localrule: True
