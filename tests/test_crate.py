@@ -91,9 +91,8 @@ def run(tmp_path, checkout):
     work = tmp_path / "work"
     work.mkdir()
     start_session(checkout, CONFIG, work)
-    t = time.time()
-    _job(work, "simulate", [], ["results/runs/a.txt"], t)
-    _job(work, "plot_fig1", ["results/runs/a.txt"], ["figures/fig1.png", "results/figures/fig1.txt"], t + 0.1)
+    _job(work, "simulate", [], ["results/runs/a.txt"], time.time())
+    _job(work, "plot_fig1", ["results/runs/a.txt"], ["figures/fig1.png", "results/figures/fig1.txt"], time.time())
     start_session(checkout, {"scenes": "other"}, work)
     _job(work, "scene_run", [], ["results/scenes/other/x.txt"], time.time())
     return work
@@ -127,7 +126,7 @@ def test_each_job_names_the_commit_it_ran_at_not_the_one_the_crate_was_built_at(
     graph = graph_of(build(run, checkout))
     for action in actions(graph).values():
         assert f"ran at commit {first} (clean)" in action["description"], action
-        assert second not in action["description"]
+        assert second not in action["description"] and "another config" not in action["description"]
     assert f"commit {second}" in graph["#git"]["value"]  # the workflow's files in the crate are the new ones
     readme = (run / "results/ro-crate/README.md").read_text()
     assert f"commit {first} (clean) (2 jobs)" in readme
@@ -158,6 +157,14 @@ def test_a_figure_edited_after_its_job_is_not_described_as_its_output(run, check
     assert "exampleOfWork" not in graph["figures/fig1.png"]
     assert "figures/fig1.png" in (run / "results/ro-crate/README.md").read_text()
     assert verify_crate(run / "results/ro-crate") == []  # its digest is the edited file's, as it says
+    # the job's bytes and time put back (as a rerun of the job would): its output again, the old
+    # description not carried over as if a person had written it
+    end = (run / "results/figures/fig1.txt").stat().st_mtime
+    png.write_text("figures/fig1.png by plot_fig1\n")
+    os.utime(png, (end, end))
+    graph = graph_of(build(run, checkout))
+    assert {"@id": "figures/fig1.png"} in listed(actions(graph)["rule plot_fig1"], "result")
+    assert "description" not in graph["figures/fig1.png"]
 
 
 @pytest.mark.parametrize("record", [True, False], ids=["with the last build's record", "without"])

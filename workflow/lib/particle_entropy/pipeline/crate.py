@@ -81,7 +81,8 @@ GENERATED = ".snakemake/particle_entropy/crate_generated.json"  # the graph the 
 OWN = ("figures/", "results/", "workflow/")  # the crate's folders the workflow fills; the rest is the user's
 # ids the workflow writes (its files are below OWN or named above): any other id is a person's addition
 WORKFLOW_ID = re.compile(r"#(job|control|rule|step|param|software)-.*|#(git|python|snakemake|run|organize)")
-WORKFLOW_KEYS = {"exampleOfWork", "description", "softwareVersion", "citation", "identifier"}  # written at times
+# properties the workflow writes on some builds only: without a record of the last build, never kept
+WORKFLOW_KEYS = {"exampleOfWork", "description", "softwareVersion", "citation", "identifier", "object", "result"}
 
 
 class CrateError(Exception):
@@ -287,10 +288,11 @@ def _refs(value) -> list:
 
 def merge_additions(new: dict, old: dict, generated: dict | None) -> tuple[dict, set[str]]:
     """The metadata ``new`` (just built) with what a person added to ``old`` (the crate's metadata
-    before this build): with ``generated`` (the metadata the last build wrote), every entity it
-    lacked and every property whose value differs from it (a list gains the added items); without,
-    every entity whose id the workflow never writes and every property the new entity lacks.
-    Returns the merged metadata and the ids of the entities kept from ``old``."""
+    before this build). With ``generated`` (the metadata the last build wrote): every entity it
+    lacked, and every property whose value differs from it (a person's value wins; a list gains
+    the added items). Without: every entity whose id the workflow never writes, every property
+    the new entity lacks but the workflow never writes, and the items of a list that name a kept
+    entity. Returns the merged metadata and the ids of the entities kept from ``old``."""
     ids = lambda meta: {e["@id"]: e for e in meta.get("@graph", []) if isinstance(e, dict) and "@id" in e}  # noqa: E731
     old_g, new_g = ids(old), ids(new)
     gen_g = ids(generated) if generated is not None else None
@@ -298,42 +300,32 @@ def merge_additions(new: dict, old: dict, generated: dict | None) -> tuple[dict,
         added = {i for i in old_g if i not in gen_g}
     else:
         added = {i for i in old_g if i not in new_g and not WORKFLOW_ID.fullmatch(i) and not _own_path(i)}
-    graph = list(new.get("@graph", []))
-    for i in sorted(added - set(new_g)):
-        graph.append(old_g[i])
-    for i, entity in old_g.items():
-        if i not in new_g:
-            continue
+    graph = list(new.get("@graph", [])) + [old_g[i] for i in sorted(added - set(new_g))]
+    for i in set(old_g) & set(new_g):
         target, base = new_g[i], (gen_g or {}).get(i)
-        for key, value in entity.items():
-            if key == "@id":
-                continue
-            if base is not None:
-                before = base.get(key)
-                if value == before:
-                    continue  # as the last build wrote it
-                if key in target and isinstance(value, list | dict) and isinstance(target[key], list | dict):
-                    extra = [v for v in _refs(value) if v not in _refs(before) and v not in _refs(target[key])]
-                    target[key] = _one(_refs(target[key]) + extra) if extra else target[key]
-                else:
-                    target[key] = value  # a person's value wins over the workflow's
-            elif gen_g is not None or key not in WORKFLOW_KEYS:
-                if key not in target:
+        for key, value in old_g[i].items():
+            before = base.get(key) if base is not None else None
+            if key == "@id" or (base is not None and value == before):
+                continue  # as the last build wrote it
+            if key not in target:
+                if base is not None or key not in WORKFLOW_KEYS:
                     target[key] = value
-                elif isinstance(value, list | dict) and isinstance(target[key], list | dict):
-                    extra = [v for v in _refs(value) if isinstance(v, dict) and v.get("@id") in added]
-                    extra = [v for v in extra if v not in _refs(target[key])]
-                    target[key] = _one(_refs(target[key]) + extra) if extra else target[key]
+            elif isinstance(value, list | dict) and isinstance(target[key], list | dict):
+                mine = [v for v in _refs(value) if v not in _refs(target[key])]
+                if base is None:  # no record of what the workflow wrote: only links to kept entities
+                    mine = [v for v in mine if isinstance(v, dict) and v.get("@id") in added]
+                else:
+                    mine = [v for v in mine if v not in _refs(before)]
+                target[key] = _one(_refs(target[key]) + mine) if mine else target[key]
+            elif base is not None:
+                target[key] = value  # a person's value wins over the workflow's
     return {**new, "@graph": graph}, added
 
 
 def _own_path(entity_id: str) -> bool:
-    """Whether ``entity_id`` names a file the workflow writes into the crate."""
-    return (
-        entity_id.startswith(OWN)
-        or entity_id in {"Snakefile", CONFIG_AS_RUN, METADATA, README, "./"}
-        or (entity_id in {"requirements.lock", "CITATION.cff"})
-    )
+    """Whether ``entity_id`` names a file the workflow writes into the crate (or the root)."""
+    own = {"./", "Snakefile", CONFIG_AS_RUN, METADATA, README, "requirements.lock", "CITATION.cff"}
+    return entity_id.startswith(OWN) or entity_id in own
 
 
 class Digests:
