@@ -20,6 +20,7 @@ from particle_entropy.pipeline.crate import (
     CrateError,
     build_crate,
     crate_folder_problem,
+    provenance,
     start_session,
     verify_crate,
 )
@@ -233,3 +234,16 @@ def test_a_crate_folder_that_cannot_hold_it_is_refused_in_one_line(run, checkout
     (run / "results/ro-crate").mkdir()
     (run / "results/ro-crate" / METADATA).symlink_to(tmp_path / "elsewhere.json")
     assert "is a link" in crate_folder_problem(run)
+
+
+def test_the_report_names_the_commit_a_figure_was_drawn_at(run, checkout, monkeypatch):
+    """The report's label of a figure (crate.provenance): its job's commit, not the checkout's now."""
+    first = _head(checkout)
+    (checkout / "docs.md").write_text("docs, edited\n")
+    _git(checkout, "commit", "-qam", "docs only")
+    monkeypatch.chdir(run)
+    labels = provenance("figures/fig1.png", "plot_fig1", "m.py", "results/figures/fig1.txt", CONFIG, checkout)
+    assert labels["commit"] == first[:12]
+    shutil.rmtree(run / ".snakemake/metadata")  # no record of the figure's job: the checkout now, marked so
+    labels = provenance("figures/fig1.png", "plot_fig1", "m.py", "results/figures/fig1.txt", CONFIG, checkout)
+    assert labels["commit"] == _head(checkout)[:12] + " (the checkout now: no record of its run)"

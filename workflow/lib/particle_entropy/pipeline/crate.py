@@ -852,17 +852,38 @@ def _git_state_once(checkout: str) -> tuple[str, bool | None]:
     return git_state(Path(checkout))
 
 
+@functools.cache
+def _runs_once(workdir: str) -> tuple[dict, ...]:
+    return tuple(sessions(Path(workdir)))
+
+
+def output_run(output: str, workdir: str | os.PathLike = ".") -> dict | None:
+    """The recorded run of jobs (start_session) in which the job that wrote ``output`` started, by
+    Snakemake's record of it; None without one."""
+    key = base64.urlsafe_b64encode(str(output).encode()).decode()
+    try:
+        start = float(json.loads((Path(workdir) / ".snakemake" / "metadata" / key).read_bytes())["starttime"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return session_of(start, list(_runs_once(str(Path(workdir).resolve()))))
+
+
 def provenance(figure: str, rule: str, module: str, data: str, config: Mapping, checkout) -> dict[str, str]:
     """Where a figure came from, for its entry in the report (as showyourwork's margins): the
-    commit (and whether the tree was dirty), the config's digest, its rule and module, its source
-    data table and that table's SHA-256 as recorded beside it."""
-    commit, dirty = _git_state_once(str(checkout))
+    commit its job ran at (and whether the tree was dirty) as its run recorded it (else the
+    checkout's now, marked so), the config's digest, its rule and module, its source data table
+    and that table's SHA-256 as recorded beside it."""
+    run = output_run(figure)
+    if run is not None:
+        commit, dirty, now = run.get("commit") or "", run.get("dirty"), ""
+    else:
+        (commit, dirty), now = _git_state_once(str(checkout)), " (the checkout now: no record of its run)"
     recorded = recorded_digest(data) if data.endswith(".parquet") else None
     if recorded is None:
         recorded = file_sha256(data) if Path(data).is_file() else "not made yet"
     return {
         "figure": figure,
-        "commit": (commit[:12] or "not a git checkout") + (" (dirty)" if dirty else ""),
+        "commit": (commit[:12] or "not a git checkout") + (" (dirty)" if dirty else "") + now,
         "config sha256": config_digest(config)[:16],
         "rule": rule,
         "module": module,
