@@ -146,6 +146,15 @@ def test_a_job_of_a_run_with_another_config_is_not_an_action_of_this_one(run, ch
     assert not (run / "results/ro-crate/results/scenes").exists()
 
 
+def test_a_scene_outside_the_default_target_counts_where_a_run_of_this_config_made_it(run, checkout):
+    start_session(checkout, CONFIG, run)
+    _job(run, "plot_scene", [], ["figures/scene_mine.png"], time.time())
+    scenes = ["figures/scene_mine.png", "results/scenes/other/x.txt"]
+    build_crate(run, checkout, CONFIG, [], targets=TARGETS, optional=scenes)
+    graph = graph_of(json.loads((run / "results/ro-crate" / METADATA).read_text()))
+    assert set(actions(graph)) == {"rule simulate", "rule plot_fig1", "rule plot_scene"}
+
+
 def test_a_figure_edited_after_its_job_is_not_described_as_its_output(run, checkout):
     png = run / "figures/fig1.png"
     png.write_text("edited by hand\n")

@@ -17,6 +17,7 @@ try:
         out=Path(snakemake.output[0]).parent,
         progress=lambda line: print(line, file=sys.stderr),
         targets=list(snakemake.input),  # the jobs these needed: this config's run
+        optional=par.optional,  # its scenes and searches, where a run of this config made them
     )
 except CrateError as e:
     print(f"crate: {e}", file=sys.stderr)

@@ -180,28 +180,34 @@ def changed_outputs(workdir: Path, job: Job) -> list[str]:
     return out
 
 
-def start_session(checkout: str | os.PathLike, config: Mapping, workdir: str | os.PathLike = ".") -> Path:
+def start_session(checkout: str | os.PathLike, config: Mapping, workdir: str | os.PathLike = ".") -> Path | None:
     """Record, as a run of jobs starts (the Snakefile's onstart), the commit it runs at, whether
     tracked files differed from it and the config's digest (SESSIONS); the crate gives each job
-    the record of the run it started in. Returns the record's path."""
+    the record of the run it started in. Returns the record's path; None where it cannot be
+    written (a full disk): the run goes on, and its jobs' commit is unknown to the crate."""
     commit, dirty = git_state(Path(checkout))
     folder = Path(workdir) / SESSIONS
-    folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{time.time_ns()}-{os.getpid()}.json"
     record = {"start": time.time(), "commit": commit, "dirty": dirty, "config_sha256": config_digest(config)}
-    write_bytes_atomically(json.dumps(record).encode(), path, sync=False)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        write_bytes_atomically(json.dumps(record).encode(), path, sync=False)
+    except OSError:
+        return None
     return path
 
 
-def end_session(path: str | os.PathLike) -> None:
+def end_session(path: str | os.PathLike | None) -> None:
     """Add the end time to a run's record (the Snakefile's onsuccess and onerror)."""
+    if path is None:
+        return
     path = Path(path)
     try:
         record = json.loads(path.read_text())
-    except (OSError, ValueError):
+        record["end"] = time.time()
+        write_bytes_atomically(json.dumps(record).encode(), path, sync=False)
+    except (OSError, ValueError, TypeError):
         return
-    record["end"] = time.time()
-    write_bytes_atomically(json.dumps(record).encode(), path, sync=False)
 
 
 def sessions(workdir: Path) -> list[dict]:
@@ -493,18 +499,21 @@ def build_crate(
     out: str | os.PathLike = CRATE_DIR,
     progress=lambda line: None,
     targets: Iterable[str] | None = None,
+    optional: Iterable[str] = (),
 ) -> dict:
     """Write the crate of the finished run in ``workdir`` (code from ``checkout``, the config as run,
     ``coded``: the rules with a ``code`` parameter) into ``out``; returns a summary (files, jobs,
     files read to hash them). ``targets``: the config's targets; only the jobs they needed are
-    described (needed_jobs); None: every recorded job. CrateError: why it cannot be built."""
+    described (needed_jobs); None: every recorded job. ``optional``: the config's targets outside
+    the default one (scenes, searches), which the crate's own run does not bring up to date: each
+    counts where a run of this same config made it. CrateError: why it cannot be built."""
     try:
-        return _build_crate(workdir, checkout, config, coded, out, progress, targets)
+        return _build_crate(workdir, checkout, config, coded, out, progress, targets, optional)
     except ValueError as e:  # a table whose bytes differ from its recorded digest
         raise CrateError(str(e)) from None
 
 
-def _build_crate(workdir, checkout, config, coded, out, progress, targets) -> dict:
+def _build_crate(workdir, checkout, config, coded, out, progress, targets, optional) -> dict:
     from rocrate.model.contextentity import ContextEntity
     from rocrate.rocrate import ROCrate
 
@@ -518,9 +527,20 @@ def _build_crate(workdir, checkout, config, coded, out, progress, targets) -> di
     digests = Digests(workdir)
     digest = config_digest(config)
     jobs = [j for j in recorded_jobs(workdir, coded) if any(o.startswith(DESCRIBED) for o in j.outputs)]
-    if targets is not None:
-        jobs = needed_jobs(jobs, targets)
     runs = sessions(workdir)
+    if targets is not None:
+        maker = {o: j for j in jobs for o in j.outputs}
+        wanted = list(targets)
+        for rel in optional:
+            job, run = maker.get(rel), None
+            if job is not None:
+                run = session_of(job.start, runs)
+                if run is not None and run.get("config_sha256") == digest:
+                    wanted.append(rel)
+                else:
+                    why = "a run of another config" if run else "a run that recorded no config"
+                    progress(f"crate: {rel} left out: made by {why}")
+        jobs = needed_jobs(jobs, wanted)
     run_of = {j: session_of(j.start, runs) for j in jobs}
     changed = {o: j for j in jobs for o in changed_outputs(workdir, j)}
     progress(f"crate: {len(jobs)} recorded jobs")
