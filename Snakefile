@@ -53,6 +53,14 @@ onstart:
 onsuccess:
     for record in RUN_RECORDS:
         end_session(record)
+    # Snakemake can end a run "100% done" with a target unmade (a rerun job with an ancient output
+    # hides the jobs after it): a run exits 0 only when every requested target is there.
+    if unmade := unmade_targets():
+        raise WorkflowError(
+            f"the run ended without making {len(unmade)} of its targets: {', '.join(unmade[:5])}"
+            + (" ..." if len(unmade) > 5 else "")
+            + "; run the same command again"
+        )
 
 
 onerror:

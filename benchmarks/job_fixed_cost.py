@@ -7,7 +7,7 @@ stand-in ``snakemake`` object (wildcards, the paper config's settings, output, l
 case of each kind, and prints for each the least over ``--repeats`` of (process wall - sum of
 the table's wall_s): the issue's "job wall minus in-step wall", less Snakemake's own preamble
 (about 0.07 s, the same for any script). A checkout with numerics/compiled.py gets its kernels
-built ahead of time first, as the workflow's rule compile_kernels builds them; numba's cache is
+built ahead of time first, as the workflow's first simulation job builds them; numba's cache is
 filled by one untimed run of each case.
 ``--other`` times another checkout's script and library (e.g. ``git archive REV | tar -x -C
 DIR``) alternately with this one, so both see the same load on the machine.
@@ -68,7 +68,7 @@ def job_inputs(label: str, n: int, seeds: int) -> tuple[dict, dict]:
 
 def kernel_inputs(checkout: Path, tmp: Path) -> dict:
     """The job's ``kernels`` input, built by ``checkout``'s library (numerics/compiled.py) into
-    ``tmp``, as the workflow's rule compile_kernels builds it; none for a checkout without it."""
+    ``tmp``, as the workflow's first job builds it; none for a checkout without it."""
     lib = checkout / "workflow" / "lib"
     if not (lib / "particle_entropy" / "numerics" / "compiled.py").exists():
         return {}

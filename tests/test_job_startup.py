@@ -4,9 +4,12 @@ neither numba nor what numba pulls in (scipy), nor pandas; its kernels give the 
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
+import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -21,11 +24,11 @@ LIB = ROOT / "workflow" / "lib"
 # the job script run as Snakemake runs it, with a stand-in `snakemake`; prints the modules it imported
 JOB = """
 import json, runpy, sys, types
-w, settings, kernels, out, log = json.loads(sys.argv[1])
+w, settings, out, log = json.loads(sys.argv[1])
 class Wildcards(dict):
     __getattr__ = dict.__getitem__
 snakemake = types.SimpleNamespace(wildcards=Wildcards(w), params=types.SimpleNamespace(settings=settings),
-    input=types.SimpleNamespace(kernels=kernels), output=[out], log=[log])
+    output=[out], log=[log])
 runpy.run_path(sys.argv[2], init_globals={"snakemake": snakemake}, run_name="__main__")
 print(json.dumps(sorted(sys.modules)))
 """
@@ -59,10 +62,25 @@ def _job(
     config["numerics"] = {"loop_arithmetic": arithmetic}
     w = {**case.wildcards(), "kind": kind, "first": "0", "last": "1"}
     log = tmp_path / "job.log"
-    arg = json.dumps([w, run_settings(case, config), str(kernels), str(tmp_path / "t.parquet"), str(log)])
+    arg = json.dumps([w, run_settings(case, config), str(tmp_path / "t.parquet"), str(log)])
+    # the job takes the kernels of its working directory (compiled.take): these, or a record that
+    # they could not be built, so that it runs the JIT rather than build them
+    here = tmp_path / "work" / compiled.kernels_folder()
+    here.parent.mkdir(parents=True, exist_ok=True)
+    if kernels.is_dir():
+        shutil.copytree(kernels, here, dirs_exist_ok=True)
+    else:
+        Path(str(here) + compiled.FAILED_SUFFIX).write_text("no compiler\n")
     env = {**os.environ, "PYTHONPATH": str(LIB)}
     script = str(ROOT / "workflow" / "scripts" / "simulate.py")
-    res = subprocess.run([sys.executable, "-c", JOB, arg, script], env=env, capture_output=True, text=True, check=True)
+    res = subprocess.run(
+        [sys.executable, "-c", JOB, arg, script],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=here.parents[2],
+    )
     return set(json.loads(res.stdout.splitlines()[-1])), log.read_text()
 
 
@@ -218,3 +236,71 @@ def test_an_empty_cache_setting_keeps_no_copy(tmp_path, fake_build, monkeypatch)
     monkeypatch.setenv(compiled.CACHE_ENV, "")
     assert compiled.cache_folder() is None
     assert [compiled.provide(tmp_path / d) for d in "ab"] == ["built", "built"]
+
+
+# ------------------------------------------------------------------ provided by the first job
+@pytest.fixture
+def counted_build(tmp_path, monkeypatch):
+    """build() replaced by a slow stand-in that counts its calls in a file (forked jobs share it);
+    use() by one that only says whether the folder is complete (a stand-in module cannot load)."""
+    monkeypatch.setenv(compiled.CACHE_ENV, "")
+    calls = tmp_path / "builds.txt"
+
+    def build(folder):
+        with open(calls, "a") as f:
+            f.write(f"{folder}\n")
+        time.sleep(0.5)  # long enough for a second job to arrive meanwhile
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / f"{compiled.MODULE}.so").write_bytes(b"a module")
+        (folder / compiled.TARGET_FILE).write_text(compiled.target())
+
+    monkeypatch.setattr(compiled, "build", build)
+    monkeypatch.setattr(compiled, "use", lambda folder: compiled._complete(Path(folder)))
+    return calls
+
+
+def _builds(calls):
+    return calls.read_text().splitlines() if calls.exists() else []
+
+
+def test_jobs_that_start_together_build_the_kernels_once(tmp_path, counted_build):
+    root = tmp_path / "results" / "kernels"
+    fork = multiprocessing.get_context("fork")
+    jobs = [fork.Process(target=compiled.take, args=(root,)) for _ in range(3)]
+    for job in jobs:
+        job.start()
+    for job in jobs:
+        job.join(30)
+    assert [job.exitcode for job in jobs] == [0, 0, 0]
+    assert len(_builds(counted_build)) == 1  # the others waited for the first, then took its module
+    assert compiled._complete(Path(compiled.kernels_folder(str(root))))
+    assert not list(root.glob(".*.tmp"))  # built aside and renamed into place
+
+
+def test_a_kernels_folder_left_half_made_is_rebuilt(tmp_path, counted_build):
+    root = tmp_path / "kernels"
+    half = Path(compiled.kernels_folder(str(root)))
+    half.mkdir(parents=True)
+    (half / f"{compiled.MODULE}.so").write_bytes(b"cut sh")  # killed before its target was written
+    assert compiled.take(root)
+    assert len(_builds(counted_build)) == 1 and (half / f"{compiled.MODULE}.so").read_bytes() == b"a module"
+    assert compiled.take(root) and len(_builds(counted_build)) == 1  # then taken as it is
+
+
+def test_a_failed_build_is_recorded_once_and_the_jobs_run_the_jit(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv(compiled.CACHE_ENV, "")
+    calls = []
+
+    def build(folder):
+        calls.append(folder)
+        raise OSError("no C compiler")
+
+    monkeypatch.setattr(compiled, "build", build)
+    root = tmp_path / "kernels"
+    assert not compiled.take(root) and not compiled.take(root)  # the JIT runs, the job goes on
+    assert len(calls) == 1  # the second job read the record and did not try again
+    err = capsys.readouterr().err
+    assert "could not compile the kernels (OSError: no C compiler)" in err and "JIT" in err
+    failed = Path(compiled.kernels_folder(str(root)) + compiled.FAILED_SUFFIX)
+    assert "no C compiler" in failed.read_text()

@@ -72,7 +72,7 @@ def test_ladders_rise_by_about_two_and_fd_takes_even_grids():
         ({"candidates": [MTPT, {**MTPT, "advection": "upwind"}]}, "scenes.s.candidates[1].advection"),
         ({"candidates": [{**FD, "advection": "lax"}]}, "scenes.s.candidates[0].advection"),
         ({"candidates": [{**MTPT, "eta": 2.0}]}, "scenes.s.candidates[0].eta"),
-        ({"candidates": [FD, FD]}, "scenes.s.candidates"),
+        ({"candidates": [FD, FD]}, "scenes.s.candidates[1]"),
         ({"omega": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.omega"),
         ({"fd_length": 0.1, "source": {"kind": "gaussian", "x0": 0.0, "sd": 1.0}}, "scenes.s.fd_length"),
         ({"cost": {"fd": [1.0]}}, "scenes.s.cost.fd"),
@@ -128,9 +128,9 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
     base = spec()
     del base["v"]
     got = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01, 0.1]}})
-    assert list(got) == ["peclet_0", "peclet_1", "peclet_2"]
+    assert list(got) == list(got.sweep) == ["peclet-0", "peclet-1", "peclet-2"]
     assert [got[n].v for n in got] == [0.0, 0.01, 0.1]
-    assert got["peclet_2"].peclet == pytest.approx(0.1 * got["peclet_2"].fd_length / 1e-3)
+    assert got["peclet-2"].peclet == pytest.approx(0.1 * got["peclet-2"].fd_length / 1e-3)
     for bad, key in (
         ({"base": spec(), "v": [0.0, 1.0]}, "scenes_peclet.base.v"),
         ({"base": base, "v": [1.0, 0.5]}, "scenes_peclet.v"),
@@ -142,7 +142,10 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
 
 def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
     at_rest = Scene.from_config("s", spec(v=0.0, candidates=[FD, {**FD, "advection": "central"}, MTPT]))
-    assert [c.label for c in at_rest.candidates] == ["fd implicit dt=0.05", "mtpt collision eta=1"]
+    labels = ["fd implicit dt=0.05", "fd implicit dt=0.05", "mtpt collision eta=1"]
+    assert [c.label for c in at_rest.candidates] == labels  # one model, each at the index written
+    fd, central, _ = at_rest.candidates
+    assert at_rest.same_as(1) == 0 and at_rest.identity(central) == at_rest.identity(fd)
 
 
 def test_a_scene_at_rest_measures_over_its_own_window_and_the_paper_over_its_own():
@@ -238,3 +241,161 @@ def test_a_shared_run_is_the_paper_run_to_the_bit(which):
     timing = [c for c in mine.columns if c.startswith(("wall_", "peak_rss", "core_s"))]
     assert list(mine.columns) == list(theirs.columns)
     assert mine.drop(columns=timing).equals(theirs.drop(columns=timing))
+
+
+# --- issue 39: scenes at their edges --------------------------------------------------------------
+S_FD = {"method": "fd", "kernel": "implicit", "fd_dt": 0.5, "n_range": [16, 256]}
+S_PT = {"method": "pt", "kernel": "adaptive", "n_range": [30, 480]}
+
+
+def small(**over):
+    """The issue's small scene S: D 1e-3, v 0.01, t_final 50, FD implicit and PT adaptive, rmse 0.1."""
+    out = {"D": 1e-3, "v": 0.01, "t_final": 50.0, "target": {"value": 0.1}, "candidates": [S_FD, S_PT]}
+    out.update(over)
+    return out
+
+
+def _refused(spec_, name="s"):
+    with pytest.raises(SettingError) as err:
+        Scene.from_config(name, spec_)
+    return err.value
+
+
+def test_the_sweep_s_scenes_cannot_take_a_user_scene_s_name():
+    """Point 6: scenes.peclet_0, peclet_mine and peclet stay the user's; the sweep's names are its own."""
+    import re
+
+    base = {k: v for k, v in small().items() if k != "v"}
+    user = {"peclet_0": small(v=0.02), "peclet_mine": small(), "peclet": small(v=0.03)}
+    got = scenes({"scenes": user, "scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+    assert got["peclet_0"].v == 0.02 and got["peclet"].v == 0.03  # not replaced by the sweep's
+    assert set(user) < set(got) and len(got) == len(user) + 2
+    assert len(got.sweep) == 2 and not set(got.sweep) & set(user)
+    assert [got[n].v for n in got.sweep] == [0.0, 0.01]
+    for name in got.sweep:  # a name no user scene can have (the schema's pattern)
+        assert not re.fullmatch(r"[A-Za-z0-9_]+", name)
+
+
+def test_a_user_scene_named_like_the_sweep_is_refused():
+    base = {k: v for k, v in small().items() if k != "v"}
+    sweep = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01]}}).sweep
+    with pytest.raises(SettingError) as err:
+        scenes({"scenes": {sweep[0]: small()}, "scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+    assert err.value.name == f"scenes.{sweep[0]}"
+
+
+@pytest.mark.parametrize(
+    "typo, key, near",
+    [
+        ({"t_finall": 50.0}, "t_finall", "t_final"),
+        ({"budjet": 1.0}, "budjet", "budget"),
+        ({"target": {"value": 0.1, "valeu": 0.2}}, "target.valeu", "value"),
+    ],
+)
+def test_typos_under_the_peclet_base_are_refused_with_did_you_mean(typo, key, near):
+    """Point 7: the schema and the scene itself refuse them, naming scenes_peclet.base.<key>."""
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import check_config, check_schema, load_schema, load_yaml
+
+    base = {**{k: v for k, v in small().items() if k != "v"}, **typo}
+    with pytest.raises(SettingError) as err:
+        every = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+        every[every.sweep[0]]
+    assert err.value.name == f"scenes_peclet.base.{key}" and f"did you mean {near}" in err.value.allowed
+    with pytest.raises(SettingError) as err:  # the same typo under scenes.<name>, by the scene itself
+        Scene.from_config("s", {**small(), **typo})
+    assert err.value.name == f"scenes.s.{key}" and f"did you mean {near}" in err.value.allowed
+    config = dict(load_yaml(ROOT / "config.yaml"))
+    config["scenes_peclet"] = {"base": base, "v": [0.0, 0.01]}
+    for check in (lambda: check_schema(config, load_schema()), lambda: check_config(config)):  # at the parse
+        with pytest.raises(SettingError) as err:
+            check()
+        assert err.value.name == f"scenes_peclet.base.{key}" and f"did you mean {near}" in err.value.allowed
+
+
+def test_at_rest_fd_candidates_keep_the_user_s_indexes():
+    """Point 9b: at v = 0 two FD candidates that differ only in advection share their runs, but every
+    candidate keeps the index the user wrote, and a refusal names that index."""
+    at_rest = Scene.from_config("s", small(v=0.0, candidates=[S_FD, {**S_FD, "advection": "central"}, S_PT]))
+    assert [c.case.method for c in at_rest.candidates] == ["fd", "fd", "pt"]
+    assert at_rest.same_as(1) == 0 and at_rest.same_as(0) == 0 and at_rest.same_as(2) == 2
+    bad = _refused(small(v=0.0, candidates=[S_FD, {**S_FD, "advection": "central"}, {**S_FD, "fd_dt": 1e-9}]))
+    assert bad.name == "scenes.s.candidates[2].fd_dt"
+
+
+def test_a_velocity_that_carries_the_plume_beyond_double_precision_is_refused():
+    """Point 13: v = 1e300 overflowed FD's jobs (and v = 1e30 left no digit of a particle's position
+    within the plume): |x0 + v t_final| must keep the plume's width in half the digits of a double."""
+    err = _refused(small(v=1.0e300))
+    assert err.name == "scenes.s.v" and err.value == 1.0e300
+    assert "sqrt(2 D t_final)" in err.allowed and "[-" in err.allowed
+    err = _refused(small(v=-1.0e30))
+    assert err.name == "scenes.s.v"
+    Scene.from_config("s", small(v=1.0e4))  # the plume 500 window lengths away: still resolved
+    base = {k: v for k, v in small().items() if k != "v"}
+    every = scenes({"scenes_peclet": {"base": base, "v": [0.0, 1.0e300]}})
+    with pytest.raises(SettingError) as e:
+        every[every.sweep[1]]
+    assert e.value.name == "scenes_peclet.v[1]"
+
+
+def test_a_gaussian_too_narrow_for_its_variance_is_refused():
+    """Point 13: sd = 1e-300 has sd^2 = 0, a point source whose density FD's jobs could not take."""
+    err = _refused(small(source={"kind": "gaussian", "x0": 0.0, "sd": 1.0e-300}))
+    assert err.name == "scenes.s.source.sd" and "point" in err.allowed and "e-154" in err.allowed
+    Scene.from_config("s", small(source={"kind": "gaussian", "x0": 0.0, "sd": 1.0e-10}))
+
+
+@pytest.mark.parametrize(
+    "over, key",
+    [
+        ({"t_final": 1.0e308}, "scenes.s.t_final"),
+        ({"candidates": [{**S_FD, "n_range": [15, 64]}]}, "scenes.s.candidates[0].n_range"),
+        ({"candidates": [{**S_FD, "n_range": [16, 17]}]}, "scenes.s.candidates[0].n_range"),
+        ({"candidates": [S_FD, {**S_FD, "fd_dt": 1.0e-9}]}, "scenes.s.candidates[1].fd_dt"),
+        ({"D": 1e-6, "t_final": 1.0e6, "candidates": [{**S_FD, "fd_dt": 0.05}]}, "scenes.s.candidates[0].fd_dt"),
+        (
+            {"D": 1e-6, "t_final": 1.0e6, "candidates": [{k: v for k, v in S_FD.items() if k != "fd_dt"}]},
+            "scenes.s.t_final",
+        ),
+        ({"candidates": [S_PT, {"method": "fd", "kernel": "implicit", "ladder": [2, 64]}]}, None),
+        ({"candidates": [S_FD, S_PT, S_PT]}, "scenes.s.candidates[2]"),
+    ],
+)
+def test_every_refusal_names_a_key_the_user_wrote(over, key):
+    """Point 14: no candidates[0].dt0, no candidates[0].n, no message without a key."""
+    spec_ = small(**over)
+    if key is None:  # an FD rung of 2 intervals (fewer than its stencil needs): the ladder
+        key = "scenes.s.candidates[1].ladder"
+    err = _refused(spec_)
+    assert err.name == key, err
+
+
+def test_pt_candidates_that_differ_only_in_dt_growth_are_two_models():
+    """Point 14: they were refused as identical; their labels and runs differ."""
+    got = Scene.from_config("s", small(candidates=[S_PT, {**S_PT, "dt_growth": 1.1}]))
+    a, b = got.candidates
+    assert a.case != b.case and a.label != b.label
+
+
+def test_a_peclet_scene_s_refusals_name_the_sweep_s_keys():
+    """Point 14: scenes.peclet_0.candidates does not exist; scenes_peclet.base.candidates does."""
+    base = {k: v for k, v in small().items() if k != "v"}
+    base["candidates"] = [S_FD, S_FD]
+    every = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+    with pytest.raises(SettingError) as err:
+        every[every.sweep[1]]
+    assert err.value.name == "scenes_peclet.base.candidates[1]"
+    from particle_entropy.pipeline.crosschecks import check_scene_memory
+
+    base["candidates"] = [S_FD]
+    every = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+    with pytest.raises(SettingError) as err:
+        check_scene_memory(every[every.sweep[0]], available=1e6)
+    assert err.value.name == "scenes_peclet.base.candidates[0].n_range"
+    base["candidates"] = [{"method": "pt", "kernel": "adaptive", "ladder": [30, 100]}]
+    every = scenes({"scenes_peclet": {"base": base, "v": [0.0, 0.01]}})
+    with pytest.raises(SettingError) as err:
+        check_scene_memory(every[every.sweep[0]], available=1e3)
+    assert err.value.name == "scenes_peclet.base.candidates[0].ladder"

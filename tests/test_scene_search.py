@@ -224,3 +224,60 @@ def test_the_result_columns_are_the_documented_ones():
     scene = _scene(value=0.01)
     _, table, _ = _search(scene, lambda ci, n, seed: 1.0 / n)
     assert list(S.result(scene, table).columns) == list(S.RESULT_COLUMN_DOCS)
+
+
+def test_a_budget_below_every_first_rung_answers_over_budget():
+    """Issue 39, point 13: the table of a scene that ran nothing was a KeyError; docs/scenes.md
+    promises each candidate's "over budget"."""
+    tiny = Scene.from_config(
+        "s", {"v": 0.01, "t_final": 50.0, "budget": 1e-9, "target": {"value": 0.1}, "candidates": [FD, MTPT]}
+    )
+    plan = S.next_plan(tiny, None, None, 0)
+    assert plan["done"].all() and plan.empty
+    out = S.result(tiny, S.judged(tiny, S.read_runs(plan, [])))
+    assert list(out.columns) == list(S.RESULT_COLUMN_DOCS)
+    assert out["candidate"].tolist() == [0, 1] and (out["realisations"] == 0).all()
+    assert out["stopped"].str.startswith("over budget: n = ").all()
+    assert not out["meets"].any() and not out["recommended"].any() and not out["comic_best"].any()
+    assert out["cost_s"].tolist() == [tiny.run_cost(c, c.ladder()[0]) for c in tiny.candidates]
+    from particle_entropy.figures.scene import scene as draw
+
+    draw(out)  # the figure says so rather than failing
+
+
+def test_the_round_cap_follows_the_longest_ladder():
+    """Issue 39, point 13: a written-out ladder of 101 rungs, never met, stopped on "no finished plan
+    after 41 rounds"; the cap is the rounds its search can take."""
+    pt = {"method": "pt", "kernel": "adaptive", "ladder": list(range(30, 131))}  # 101 rungs
+
+    def rounds(scene, law):
+        plan, k = S.next_plan(scene, None, None, 0), 1
+        while not plan["done"].all():
+            plan = S.next_plan(scene, plan, _runs(plan, law), 0)
+            k += 1
+            assert k <= S.max_rounds(scene)
+        return k
+
+    never = _scene(value=1e-9, candidates=(FD, pt))
+    assert 41 < rounds(never, lambda ci, n, seed: 1.0 / n) == S.max_rounds(never) - 1  # the climb and the stop
+    at_top = _scene(value=0.5, candidates=(pt,))  # met at the top rung only: one bisection round more
+    assert rounds(at_top, lambda ci, n, seed: 0.1 if n == 130 else 1.0) == S.max_rounds(at_top)
+
+
+def test_at_rest_twin_candidates_run_once_and_keep_their_index():
+    """Issue 39, point 9b: at v = 0, FD upwind and central are one model; the second runs nothing, and
+    its rows are the first's under its own index, saying so."""
+    fd_central = {**FD, "advection": "central"}
+    scene = Scene.from_config(
+        "s", {"v": 0.0, "t_final": 50.0, "target": {"value": 0.01}, "candidates": [FD, fd_central, MTPT]}
+    )
+    plan, table, _ = _search(scene, lambda ci, n, seed: 1.0 / n)
+    assert set(plan["candidate"]) == {0, 2}  # the twin plans no run of its own
+    out = S.result(scene, table)
+    assert sorted(set(out["candidate"])) == [0, 1, 2]
+    first, twin = out[out["candidate"] == 0], out[out["candidate"] == 1]
+    assert twin["n"].tolist() == first["n"].tolist()
+    assert twin["error_mean"].tolist() == first["error_mean"].tolist()
+    assert (twin["stopped"] == "the same runs as candidates[0]: at v = 0 advection moves nothing").all()
+    assert out["recommended"].sum() == 1 and out.loc[out["recommended"], "candidate"].iloc[0] != 1
+    assert (out[out["candidate"] == 2]["method"] == "mtpt").all()

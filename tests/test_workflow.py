@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -22,6 +23,7 @@ from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, rows_o
 from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.figures import CASE_FIGURES, FIGURES
+from particle_entropy.numerics.compiled import CACHE_ENV
 from particle_entropy.pipeline.sweeps import (
     Ensemble,
     case_run_paths,
@@ -1071,7 +1073,11 @@ def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     from particle_entropy.experiments.scene import Scene
 
     work = tmp_path / "scenes"
-    run_snakemake(work, "scenes", "--configfile", TINY, SCENE_CONFIG)
+    # from an empty kernel cache: the first job compiles the kernels, and a run exiting 0 has made
+    # every target (issue 39: a compile job with an ancient output once hid the jobs after it)
+    empty_cache = {**os.environ, CACHE_ENV: str(tmp_path / "kernel-cache")}
+    run_snakemake(work, "scenes", "--configfile", TINY, SCENE_CONFIG, env=empty_cache)
+    assert (tmp_path / "kernel-cache").is_dir()  # the kernels were built in this run, not copied
     table = pd.read_parquet(work / "results/scenes/carried.parquet")
     heading, _, documented = _section_of("results/scenes/carried.parquet", _column_doc_sections())
     assert heading == SCENE_SECTION and set(table.columns) == documented  # docs/columns.md says what it holds
@@ -1156,3 +1162,31 @@ def test_a_run_table_decayed_on_the_disk_fails_its_reader_then_is_set_aside_and_
     assert f"corrupt table {rel}: its SHA-256" in again.stderr
     pd.testing.assert_frame_equal(pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS)), before)
     assert summary.exists()
+
+
+def test_user_scenes_named_peclet_are_their_own_and_the_sweep_draws_only_its_scenes(tmp_path):
+    """Issue 39, point 6: scenes.peclet_0 was replaced by the sweep's scene, peclet_mine was drawn in
+    figures/scenes_peclet.png and a scene named peclet never ran (its table was the sweep's)."""
+    scene = yaml.safe_load(SCENE_CONFIG.read_text())["scenes"]["carried"]
+    base = {k: v for k, v in scene.items() if k != "v"}
+    overlay = tmp_path / "peclet_names.yaml"
+    overlay.write_text(
+        yaml.safe_dump(
+            {
+                "scenes": {"peclet": scene, "peclet_0": {**scene, "v": 0.02}, "peclet_mine": scene},
+                "scenes_peclet": {"base": base, "v": [0.0, 0.01]},
+            }
+        )
+    )
+    work = tmp_path / "w"
+    sweep = planned_outputs(
+        run_snakemake(work, "figures/scenes_peclet.png", "--configfile", TINY, overlay, dry_run=True),
+        "results/scenes/",
+    )
+    rounds = {p.split("/")[2] for p in sweep if "/round~" in p}
+    assert rounds and not rounds & {"peclet", "peclet_0", "peclet_mine"}, rounds
+    mine = planned_outputs(
+        run_snakemake(work, "figures/scene_peclet.png", "--configfile", TINY, overlay, dry_run=True),
+        "results/scenes/",
+    )
+    assert "results/scenes/peclet/round~0.parquet" in mine, mine

@@ -65,7 +65,7 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 from particle_entropy.pipeline.crosschecks import check_memory, check_scene_memory, check_sweeps, optimum_searches
-from particle_entropy.experiments.scene import PECLET_PREFIX, SCENE_RUN_PATTERN, scenes
+from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
 
@@ -84,6 +84,8 @@ SCENES = scenes(
     None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE),
     paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
 )
+# A scene's name: a user's (the schema's pattern) or one of the Peclet sweep's, peclet-<k>.
+SCENE_NAME = rf"[A-Za-z0-9_]+|{SWEEP_PREFIX}[0-9]+"
 
 
 def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS):
@@ -154,7 +156,7 @@ def check_writable(look_only):
     cluster node has its own). Else every job fails on a traceback or an empty log."""
     problems = folder_problems([".snakemake"] if look_only else [".snakemake", "results"])
     if not look_only and workflow.local_exec and not Path(kernels_folder()).is_dir():
-        # numba's cache is written while the kernels of this code are compiled (rule compile_kernels);
+        # numba's cache is written while the first job compiles the kernels of this code (compiled.take);
         # once they are, jobs load them and numba caches nothing
         problems += [p for p in [numba_cache_problem(numba_cache_folders(LIB))] if p]
     if problems:
@@ -182,6 +184,16 @@ if workflow.is_main_process:
     check_writable(looks_only())
     check_crate_folder()
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
+
+
+def unmade_targets():
+    """The requested targets (a target rule's inputs where it has no output) that are not there
+    after a run; none to check under --until or --omit-from, which stop short of them on purpose."""
+    dag = workflow.dag
+    if dag.untilrules or dag.untilfiles or dag.omitrules or dag.omitfiles:
+        return []
+    files = {str(f) for job in dag.targetjobs for f in (job.output or job.input)}
+    return sorted(f for f in files if not Path(f).exists())
 
 
 def in_config(section):
@@ -365,16 +377,18 @@ def scene_round_inputs(wildcards):
 
 
 def scene_final_inputs(wildcards):
-    """The finished plan of a scene and its runs: rounds are requested one at a time."""
-    from particle_entropy.analysis.scene_search import MAX_ROUNDS, plan_paths
+    """The finished plan of a scene and its runs: rounds are requested one at a time, at most as
+    many as its search can take (scene_search.max_rounds: its longest ladder's)."""
+    from particle_entropy.analysis.scene_search import max_rounds, plan_paths
     from particle_entropy.core.io import read_parquet
 
-    for k in range(MAX_ROUNDS + 1):
+    rounds = max_rounds(SCENES[wildcards.name])
+    for k in range(rounds):
         path = checkpoints.scene_round.get(name=wildcards.name, k=str(k)).output[0]
         plan = read_parquet(path)  # every page checked (core.io)
         if plan["done"].all():
             return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
-    raise ValueError(f"scene {wildcards.name}: no finished plan after {MAX_ROUNDS + 1} rounds")
+    raise ValueError(f"scene {wildcards.name}: no finished plan after {rounds} rounds")
 
 
 def sim_mem_mb(wildcards):
@@ -403,7 +417,6 @@ def sim_settings(wildcards):
 # a rule reruns when, and only when, the content of its code changes (params rerun trigger).
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
-KERNELS = kernels_folder()  # the ahead-of-time kernels of this code, numba and CPU
 SUMMARY_CODE = code_version(
     "analysis.aggregate", files=[Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk"]
 )

@@ -5,8 +5,6 @@
 
 
 rule simulate_scene:
-    input:
-        kernels=ancient(KERNELS),
     output:
         SCENE_RUN_PATTERN,
     log:
@@ -32,7 +30,7 @@ checkpoint scene_round:
     log:
         "logs/scenes/{name}/round~{k}.log",
     wildcard_constraints:
-        name=r"[A-Za-z0-9_]+",
+        name=SCENE_NAME,
         k=r"\d+",
     localrule: True
     conda:
@@ -54,7 +52,7 @@ rule scene_table:
     log:
         "logs/scenes/{name}.log",
     wildcard_constraints:
-        name=r"[A-Za-z0-9_]+",
+        name=SCENE_NAME,
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
@@ -80,7 +78,7 @@ rule plot_scene:
     log:
         "logs/plot/scene_{name}.log",
     wildcard_constraints:
-        name=r"[A-Za-z0-9_]+",
+        name=SCENE_NAME,
     localrule: True
     conda:
         "../../envs/particle-entropy.yaml"
@@ -92,19 +90,20 @@ rule plot_scene:
         "../scripts/plot_scene.py"
 
 
-# Where particles overtake grids: the Peclet sweep's scenes side by side (config `scenes_peclet`).
+# Where particles overtake grids: the Peclet sweep's scenes (peclet-<k>, names no user scene has)
+# side by side (config `scenes_peclet`); its data beside no scene's table.
 rule plot_scenes_peclet:
     input:
-        [f"results/scenes/{name}.parquet" for name in SCENES if name.startswith(PECLET_PREFIX)],
+        [f"results/scenes/{name}.parquet" for name in SCENES.sweep],
     output:
         png=report(
             "figures/scenes_peclet.png",
             caption="../report/scenes_peclet.rst",
             category=FIGURE["scene"].category,
-            labels=figure_labels("scenes_peclet", "plot_scenes_peclet", "results/scenes/peclet.parquet"),
+            labels=figure_labels("scenes_peclet", "plot_scenes_peclet", "results/scenes_peclet.parquet"),
         ),
         pdf="figures/scenes_peclet.pdf",
-        data="results/scenes/peclet.parquet",
+        data="results/scenes_peclet.parquet",
     log:
         "logs/plot/scenes_peclet.log",
     localrule: True

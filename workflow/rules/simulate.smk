@@ -1,23 +1,11 @@
 # One job per simulation case and block of seeds -> one tidy Parquet table (a `seed` column).
 # kind: runs = one row per time step; snapshots = the final particle or grid states (Fig. 7).
-# Each job loads the kernels compile_kernels built ahead of time for this code, numba and CPU
-# (numerics/compiled.py), so that it imports no numba: a small job costs what it computes.
-
-
-rule compile_kernels:
-    output:
-        directory(KERNELS),
-    log:
-        f"logs/compile_kernels/{Path(KERNELS).name}.log",
-    conda:
-        "../../envs/particle-entropy.yaml"
-    script:
-        "../scripts/compile_kernels.py"
+# Each job loads the kernels compiled ahead of time for this code, numba and CPU, which the first
+# job to need them builds (numerics/compiled.take), so that it imports no numba: a small job costs
+# what it computes. They are no input: no simulation reruns when they are rebuilt.
 
 
 rule simulate:
-    input:
-        kernels=ancient(KERNELS),  # built once per code version; its age reruns nothing
     output:
         RUN_PATTERN,
     log:

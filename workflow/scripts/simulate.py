@@ -10,9 +10,9 @@ from particle_entropy.core.heap import keep_freed_pages
 from particle_entropy.core.io import write_parquet
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.models.simulate import run_seeds_arrow
-from particle_entropy.numerics.compiled import use
+from particle_entropy.numerics.compiled import take
 
-use(snakemake.input.kernels)  # the kernels compiled ahead of time: this job imports no numba
+take()  # the kernels compiled ahead of time (the first job builds them): this job imports no numba
 keep_freed_pages()  # steps reuse the pages of the last step's arrays
 w = snakemake.wildcards
 cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()

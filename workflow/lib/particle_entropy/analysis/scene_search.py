@@ -23,27 +23,29 @@ import pandas as pd
 from ..core.io import read_parquet
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 
-MAX_ROUNDS = 40  # a search's rounds at most: a ladder has at most ~40 rungs (ratio 2)
 CLIMB = 2  # rungs climbed a round while no rung passes
 PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
 NEGATIVE_TOLERANCE = 1e-12  # a node mass below -this (of unit total) is a negative concentration
 
 
 RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a finished scene
-    "candidate": "the candidate's index in `scenes.<name>.candidates` (a Peclet scene: in its base's)",
+    "candidate": "the candidate's index in `scenes.<name>.candidates` as written (a Peclet scene: in its base's; "
+    "at v = 0 an FD candidate that differs from an earlier one only in advection repeats its rows)",
     "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
     "method": "fd, pt or mtpt",
     "n": "the resolution: particles, or FD intervals",
-    "realisations": "runs averaged (FD: 1, deterministic)",
+    "realisations": "runs averaged (FD: 1, deterministic; 0: not run, its first rung over the budget)",
     "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
     "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
     "error_hi": "upper end of that interval",
     "error_upper95": "the mean's one-sided 95 % upper bound: the rung meets the target when it is <= `target`",
     "meets": "the rung is scored and `error_upper95` <= `target`",
-    "unscored": "why the rung cannot be judged (negative concentrations past grid Peclet 2), else empty",
+    "unscored": "why the rung cannot be judged (negative concentrations past grid Peclet 2; not run: over budget), "
+    "else empty",
     "steps": "time steps of a run",
     "work": "particle-steps (FD node-steps) of a run, MTPT substeps counted",
-    "cost_s": "the counted cost of one run: `steps` and `work` times the scene's `cost` [s]",
+    "cost_s": "the counted cost of one run: `steps` and `work` times the scene's `cost` (a rung not run: "
+    "Scene.run_cost) [s]",
     "core_s": "the measured core-seconds of one run (the sum of its steps' wall time) [s]",
     "COMIC_points": "mean COMIC (Eq. 43) at the common measurement points (NaN if unscored)",
     "scene": "the scene's name",
@@ -101,10 +103,16 @@ def seeds(scene: Scene, candidate: Candidate, base_seed: int) -> tuple[int, int]
     return base_seed, base_seed + count - 1
 
 
+JUDGED_COLUMNS = list(RESULT_COLUMN_DOCS)[: list(RESULT_COLUMN_DOCS).index("COMIC_points") + 1]
+
+
 def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
     """One row per (candidate, n) visited: error mean, its 95 % interval (two-sided, t) and upper
-    bound, whether it meets the target, why not scored, work and core-seconds, COMIC at the points."""
+    bound, whether it meets the target, why not scored, work and core-seconds, COMIC at the points
+    (no runs: no rows)."""
     rows = []
+    if runs.empty:
+        return pd.DataFrame(rows, columns=JUDGED_COLUMNS)
     for (ci, n), g in runs.groupby(["candidate", "n"], sort=True):
         cand = scene.candidates[ci]
         records = g.to_dict("records")
@@ -133,7 +141,20 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
                 "COMIC_points": float(g["COMIC_points"].mean()) if not reason else math.nan,
             }
         )
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=JUDGED_COLUMNS)
+
+
+def max_rounds(scene: Scene) -> int:
+    """The most plans a scene's search writes: round 0, a round per CLIMB rungs up the longest ladder,
+    the rounds that halve a gap of CLIMB rungs, and the round that finds every candidate stopped.
+    Each round visits a new rung of every candidate still searching (_next_rung), so no search
+    takes more; the workflow asks for this many rounds (common.smk)."""
+    longest = max(len(c.ladder()) for c in scene.candidates)
+    return 1 + math.ceil((longest - 1) / CLIMB) + math.ceil(math.log2(CLIMB)) + 1
+
+
+def _twin_reason(scene: Scene, ci: int) -> str:
+    return f"the same runs as candidates[{scene.same_as(ci)}]: at v = 0 advection moves nothing"
 
 
 def affordable(scene: Scene, candidate: Candidate) -> list[int]:
@@ -181,6 +202,8 @@ def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None
     first, _ = seeds(scene, scene.candidates[0], base_seed)
     added = False
     for ci, cand in enumerate(scene.candidates):
+        if scene.same_as(ci) != ci:  # its runs are an earlier candidate's (result copies its rows)
+            continue
         visited = table[table["candidate"] == ci] if len(table) else table
         n, _why = _next_rung(scene, cand, visited)
         if n is None:
@@ -195,7 +218,40 @@ def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None
 
 def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
     """Each candidate's reason to have stopped."""
-    return {ci: _next_rung(scene, cand, table[table["candidate"] == ci])[1] for ci, cand in enumerate(scene.candidates)}
+    return {
+        ci: _next_rung(scene, cand, table[table["candidate"] == ci])[1]
+        if scene.same_as(ci) == ci
+        else _twin_reason(scene, ci)
+        for ci, cand in enumerate(scene.candidates)
+    }
+
+
+def _unvisited(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of candidates the search never ran: an at-rest twin's are its first's (Scene.same_as),
+    a candidate whose first rung is over the budget has one row saying so (realisations 0, its
+    counted cost, no error)."""
+    visited, rows = set(table["candidate"]), []
+    for ci, cand in enumerate(scene.candidates):
+        if ci in visited:
+            continue
+        first = scene.same_as(ci)
+        if first != ci:
+            rows += table[table["candidate"] == first].assign(candidate=ci).to_dict("records")
+            continue
+        n = cand.ladder()[0]
+        row = dict.fromkeys(JUDGED_COLUMNS, math.nan)
+        row.update(
+            candidate=ci,
+            label=cand.label,
+            method=cand.case.method,
+            n=n,
+            realisations=0,
+            meets=False,
+            unscored="not run: over budget",
+            cost_s=scene.run_cost(cand, n),
+        )
+        rows.append(row)
+    return pd.DataFrame(rows, columns=JUDGED_COLUMNS)
 
 
 def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
@@ -204,7 +260,12 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     target (at most one row), ``n_below`` the highest failing rung visited below each row (the answer
     of a passing row lies in (n_below, n]), ``comic_best`` on the lowest COMIC_points of each candidate's passing
     or, if none passes, highest visited resolution; ``stopped`` says why each candidate stopped."""
-    out = table.copy()
+    extra = _unvisited(scene, table)
+    parts = [t for t in (table, extra) if len(t)]
+    out = pd.concat(parts, ignore_index=True) if parts else table.copy()
+    out = out.sort_values(["candidate", "n"], kind="stable").reset_index(drop=True)
+    out = out.astype({"candidate": int, "n": int, "realisations": int, "meets": bool})
+    own = np.array([scene.same_as(c) == c for c in out["candidate"]], dtype=bool)  # twins' rows are copies
     out["scene"] = scene.name
     reasons = stop_reasons(scene, table)
     out["stopped"] = [reasons[c] for c in out["candidate"]]
@@ -213,13 +274,13 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
         for c, n in zip(out["candidate"], out["n"])
     ]  # the highest visited rung below that fails: the answer lies in (n_below, n]
     out["recommended"] = False
-    meets = out[out["meets"]]
+    meets = out[out["meets"] & own]
     if len(meets):
         # per candidate its smallest passing rung; across candidates the cheapest of those
         firsts = meets.sort_values("n").groupby("candidate", sort=False).head(1)
         out.loc[firsts["cost_s"].idxmin(), "recommended"] = True
     out["comic_best"] = False
-    scored = out[np.isfinite(out["COMIC_points"])]
+    scored = out[np.isfinite(out["COMIC_points"].astype(float)) & own]
     if len(scored):
         out.loc[scored["COMIC_points"].idxmin(), "comic_best"] = True
     out["target"] = scene.value
@@ -254,6 +315,8 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     and its measured core-seconds (the sum of its steps' wall time)."""
     keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_min", "dV", "work"]
     rows = []
+    if plan.empty:  # every candidate over the budget: nothing ran
+        return pd.DataFrame(rows, columns=["candidate", "n", "seed", *keep, "steps", "core_s"])
     for r, path in zip(plan.itertuples(), paths):
         table = read_parquet(path)
         for seed, g in table.groupby("seed", sort=True):

@@ -74,6 +74,14 @@ def check_arithmetic(cfg: RunConfig) -> None:
                 f"a number with 2 D {name} a normal float (>= {tiny:.3g}): >= {tiny / (2 * cfg.D):.3g} "
                 f"for D = {cfg.D:g}",
             )
+    check_plume_width(cfg)
+    if (cfg.method, cfg.kernel) == ("pt", "fixed"):
+        _check_kernel_grid(cfg, plume_span(cfg))
+
+
+def check_plume_width(cfg) -> None:
+    """Refuse a t_final whose plume (plume_span; ``cfg``: anything with D, t_final and source, a
+    RunConfig or a scene) is wider than a grid of MAX_GRID_POINTS at spacing GRID_SPACING."""
     widest = MAX_GRID_POINTS * GRID_SPACING
     span = plume_span(cfg)
     if span > widest:
@@ -85,8 +93,6 @@ def check_arithmetic(cfg: RunConfig) -> None:
             f"sqrt(2 D t_final) wide at most {widest:g}, the {MAX_GRID_POINTS:,} points of a grid at spacing "
             f"{GRID_SPACING:g} (this one {span:.3g})",
         )
-    if (cfg.method, cfg.kernel) == ("pt", "fixed"):
-        _check_kernel_grid(cfg, span)
 
 
 def _check_kernel_grid(cfg: RunConfig, span: float) -> None:

@@ -375,7 +375,8 @@ SECTION_DOCS = {
     "the accuracy to reach.",
     "scenes.<name>.target": "The accuracy every candidate is held to at t_final.",
     "scenes_peclet": "Where particles overtake grids: one scene (`base`) at each velocity of `v`, searched as "
-    "scenes peclet_0, peclet_1, ... and drawn as figures/scenes_peclet.png (its own target).",
+    "scenes peclet-0, peclet-1, ... (names no scene of `scenes` can have) and drawn as "
+    "figures/scenes_peclet.png (its own target).",
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }

@@ -5,17 +5,20 @@ the ladder of resolutions its search may visit (analysis/scene_search.py)."""
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import json
 import math
+import re
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
-from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_setting
+from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_plume_width, check_setting
 from ..core.settings import BY_KEY, PAPER, SCENE, defaults
-from ..core.timegrid import time_steps
+from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -23,8 +26,28 @@ _DEFAULTS = defaults(SCENE)
 _TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
 
 
-def _key(name: str, key: str) -> str:
+SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
+USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (the schema's pattern)
+# Half the digits of a double: a plume whose centre lies further than its width over this from x = 0
+# has positions (particles', nodes', points') rounded to more than this fraction of the width.
+HALF_DIGITS = math.sqrt(sys.float_info.epsilon)
+MIN_SD = math.sqrt(sys.float_info.min)  # a Gaussian source's sd whose variance sd^2 is a normal float
+
+
+def key_path(name: str, key: str) -> str:
+    """The config key of ``key`` in scene ``name``: scenes.<name>.<key>; in a scene of the Peclet
+    sweep (peclet-<k>) its base's key, and its v: scenes_peclet.v[k]."""
+    if name.startswith(SWEEP_PREFIX):
+        return f"scenes_peclet.v[{name[len(SWEEP_PREFIX) :]}]" if key == "v" else f"scenes_peclet.base.{key}"
     return f"scenes.{name}.{key}"
+
+
+_key = key_path
+
+
+def _number(x: float) -> str:
+    """A number as short as it reads back exactly: 0.05, 1.1, 0.30000000000000004."""
+    return f"{x:g}" if float(f"{x:g}") == x else repr(x)
 
 
 @dataclass(frozen=True)
@@ -45,15 +68,24 @@ class Candidate:
         c = self.case
         if c.method == "fd":
             scheme = "" if self.advection == "none" else f" {self.advection}"
-            return f"fd {c.kernel}{scheme} dt={self.fd_dt:g}"
+            return f"fd {c.kernel}{scheme} dt={_number(self.fd_dt)}"
         words = [c.method, c.kernel]
         if c.method == "mtpt":
-            words.append(f"eta={c.eta:g}")
+            words.append(f"eta={_number(c.eta)}")
             if c.truncation is not None:
-                words.append(f"cut={c.truncation:g}")
+                words.append(f"cut={_number(c.truncation)}")
             if c.scheme != "symmetric":
                 words.append(c.scheme)
+        if c.dt_growth != PAPER["dt_growth"]:  # every dimension that tells two models apart
+            words.append(f"growth={_number(c.dt_growth)}")
+        if c.time_grid != PAPER["time_grid"]:
+            words.append(f"grid={c.time_grid}")
         return " ".join(words)
+
+    @property
+    def model(self) -> tuple:
+        """What makes two candidates the same model: the case, FD's scheme and step."""
+        return (self.case, self.advection, self.fd_dt)
 
     def ladder(self) -> list[int]:
         """The resolutions the search may visit: n_lo, n_lo r, n_lo r^2, ... up to n_hi (r = LADDER_RATIO,
@@ -105,6 +137,15 @@ class Scene:
         size = n + 1 if cfg.method == "fd" else n
         return self.cost_s(cfg.method, steps, steps * size)
 
+    def key(self, key: str) -> str:
+        """The config key path of ``key`` in this scene (key_path)."""
+        return key_path(self.name, key)
+
+    def same_as(self, i: int) -> int:
+        """The index of the first candidate equal to candidate i (i itself, unless at v = 0 two FD
+        candidates differ only in their advection scheme: their runs are one)."""
+        return self.candidates.index(self.candidates[i])
+
     @property
     def reference(self) -> Reference:
         """The exact solution at the observation time."""
@@ -148,6 +189,7 @@ class Scene:
     def from_config(cls, name: str, spec: Mapping, case_defaults: Mapping | None = None) -> Scene:
         """The scene at config key scenes.<name>; SettingError naming the key path of a bad value."""
         spec = dict(spec)
+        _known_keys(name, spec)
         D, v, t_final, margin, r = (
             _checked(name, k, spec.get(k, _DEFAULTS[k])) for k in ("D", "v", "t_final", "margin", "realisations")
         )
@@ -163,24 +205,113 @@ class Scene:
         if not isinstance(raw, list) or not raw:
             raise SettingError(_key(name, "candidates"), raw, "a list of at least one model")
         cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(raw))
-        labels = [c.label for c in cands]
-        if len(set(labels)) < len(labels):
-            raise SettingError(_key(name, "candidates"), labels, "models that differ (each once)")
-        if v == 0:  # nothing to advect: FD's scheme is no part of the runs (nor of its candidates: one each)
-            cands = tuple({replace(c, advection="none").label: replace(c, advection="none") for c in cands}.values())
+        _distinct(name, cands)
+        if v == 0:  # nothing to advect: FD's scheme is no part of the runs; twins keep their index (same_as)
+            cands = tuple(replace(c, advection="none") for c in cands)
         cost = _cost(name, spec.get("cost"))
         scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost, budget)
-        for i, c in enumerate(cands):  # every candidate's runs must fit their domains
-            try:
-                scene.run_config(c, c.n_lo)
-            except SettingError as e:
-                raise SettingError(
-                    _key(name, f"candidates[{i}].{e.name}" if e.name in _CAND_KEYS else e.name), e.value, e.allowed
-                ) from None
+        _check_reach(scene)
+        for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
+            for n in dict.fromkeys((c.n_lo, c.ladder()[-1])):
+                try:
+                    scene.run_config(c, n)
+                except SettingError as e:
+                    raise _candidate_error(scene, i, raw[i], e) from None
         return scene
 
 
-_CAND_KEYS = ("eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0", "ladder")
+def _known_keys(name: str, spec: Mapping) -> None:
+    """SettingError naming the first key of a scene (or of its target) that settings.SCENE does not
+    declare, with the nearest declared one (a typo is refused, not dropped)."""
+    declared = [s.key.split(".", 2)[2] for s in SCENE]  # 'D', 'target.measure', ...
+    for where, mapping in (("", spec), ("target.", spec.get("target"))):
+        if not isinstance(mapping, Mapping):
+            continue
+        known = list(dict.fromkeys(k[len(where) :].split(".")[0] for k in declared if k.startswith(where)))
+        for key in mapping:
+            if key not in known:
+                near = difflib.get_close_matches(str(key), known, n=1)
+                hint = f"; did you mean {near[0]}?" if near else ""
+                raise SettingError(
+                    _key(name, f"{where}{key}"), "(unknown key)", f"a known key: {', '.join(known)}{hint}"
+                )
+
+
+def _distinct(name: str, cands: tuple[Candidate, ...]) -> None:
+    """SettingError naming the second of two candidates that are the same model (Candidate.model)."""
+    seen: dict[tuple, int] = {}
+    for i, c in enumerate(cands):
+        if c.model in seen:
+            j = seen[c.model]
+            raise SettingError(
+                _key(name, f"candidates[{i}]"), c.label, f"a model other than candidates[{j}] ({c.label}): each once"
+            )
+        seen[c.model] = i
+
+
+def _check_reach(scene: Scene) -> None:
+    """SettingError unless the plume fits a grid at t_final (runconfig.check_plume_width) and its
+    centre then, x0 + v t_final, lies within its spread sqrt(2 D t_final) / HALF_DIGITS of x = 0:
+    further out a double rounds every position (particles, FD nodes, measurement points) by more
+    than HALF_DIGITS of the plume's width, and FD's grid, which spans the path, overflows (v = 1e300)."""
+    try:
+        check_plume_width(scene)
+    except SettingError as e:
+        raise SettingError(scene.key(e.name), e.value, e.allowed) from None
+    name, D, v, t_final, source = scene.name, scene.D, scene.v, scene.t_final, scene.source
+    spread = math.sqrt(2.0 * D * t_final)
+    reach = spread / HALF_DIGITS
+    x0 = source.centre
+    if abs(x0 + v * t_final) <= reach:
+        return
+    why = (
+        f"the plume's centre x0 + v t_final within sqrt(2 D t_final) / sqrt(eps) = {reach:.3g} of x = 0 "
+        f"(D = {D:g}, t_final = {t_final:g}, eps = {sys.float_info.epsilon:.3g}), where a double holds the "
+        "plume's width to half its digits"
+    )
+    if v != 0.0:
+        lo, hi = (-reach - x0) / t_final, (reach - x0) / t_final
+        raise SettingError(_key(name, "v"), v, f"a number in [{lo:.6g}, {hi:.6g}] [L/T]: {why}")
+    key = "source.x0" if source.kind != "box" else "source.a"
+    raise SettingError(
+        _key(name, key), getattr(source, key.split(".")[1]), f"a number in [{-reach:.6g}, {reach:.6g}]: {why}"
+    )
+
+
+_CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
+
+
+def _candidate_error(scene: Scene, i: int, spec: Mapping, e: SettingError) -> SettingError:
+    """A SettingError of candidate i's run, named by the key the user wrote: its n_range or ladder for
+    a resolution, its fd_dt or else the scene's t_final for a step count, its own dimension or else
+    case_defaults' for a case dimension, the scene's key for the physics."""
+    cand, where = scene.candidates[i], f"candidates[{i}]"
+    if e.name == "n":
+        key = "ladder" if cand.rungs else "n_range"
+        value = list(cand.rungs) if cand.rungs else [cand.n_lo, cand.n_hi]
+        return SettingError(scene.key(f"{where}.{key}"), value, e.allowed)
+    if e.name == "dt0" and cand.case.method == "fd" and "fd_dt" in spec:
+        return SettingError(scene.key(f"{where}.fd_dt"), e.value, e.allowed)
+    if e.name == "dt0":  # a step the scene does not set: the time it must reach is the key
+        g = cand.case.dt_growth
+        try:
+            most = e.value * MAX_STEPS if g == 1.0 else e.value * (g**MAX_STEPS - 1.0) / (g - 1.0)
+        except OverflowError:
+            most = math.inf
+        fd = cand.case.method == "fd"
+        hint = f"; or give {where} an fd_dt >= {max_first_step(scene.t_final, g):.3g}" if fd else ""
+        return SettingError(
+            scene.key("t_final"),
+            scene.t_final,
+            f"a number in (0, {most:.6g}] [T]: what {cand.label} ({where}) reaches in at most {MAX_STEPS:,} steps "
+            f"of its first step {e.value:g}{hint}",
+        )
+    if e.name in _CASE_DIMS:
+        key = scene.key(f"{where}.{e.name}") if e.name in spec else f"case_defaults.{e.name}"
+        return SettingError(key, e.value, e.allowed)
+    if e.name in ("advection", "fd_dt", "ladder"):
+        return SettingError(scene.key(f"{where}.{e.name}"), e.value, e.allowed)
+    return SettingError(scene.key(e.name), e.value, e.allowed)
 
 
 def _cost(name: str, spec) -> tuple:
@@ -225,6 +356,13 @@ def _source(name: str, spec) -> Source:
         if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)):
             raise SettingError(_key(name, f"source.{key}"), value, "a finite number [L]")
         values[key] = float(value)
+    if kind == "gaussian" and 0 < values["sd"] < MIN_SD:
+        raise SettingError(
+            _key(name, "source.sd"),
+            values["sd"],
+            f"a number >= {MIN_SD:.3g} [L]: its variance sd^2 a normal float (below, sd^2 rounds to 0 and the "
+            "Gaussian is a delta); for a narrower source write {kind: point, x0}",
+        )
     try:
         return Source(kind, **values)
     except ValueError as e:
@@ -260,6 +398,12 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     )
     if not ok:
         raise SettingError(_key(name, f"{where}.n_range"), n_range, "[low, high], integers with 2 <= low < high")
+    if spec.get("method") == "fd" and not rungs and any(n % 2 for n in n_range):
+        raise SettingError(
+            _key(name, f"{where}.n_range"),
+            n_range,
+            "for fd [low, high], even numbers of intervals (a node at x = 0) with 4 <= low < high",
+        )
     if advection not in ADVECTION_SCHEMES:
         raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
     if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
@@ -284,7 +428,16 @@ class Scenes(Mapping):
     one; a bad value is still refused before any of its jobs, naming its key path."""
 
     def __init__(self, config: Mapping, check=None, paper=None):
-        self._specs = {**dict(config.get("scenes") or {}), **peclet_scenes(config)}
+        user, sweep = dict(config.get("scenes") or {}), peclet_scenes(config)
+        for name in user:
+            if not (isinstance(name, str) and USER_NAME.fullmatch(name)):
+                raise SettingError(
+                    f"scenes.{name}",
+                    "(a scene)",
+                    f"a name of letters, digits and _ ({SWEEP_PREFIX}<k> names the scenes of scenes_peclet)",
+                )
+        self._specs = {**user, **sweep}
+        self.sweep = tuple(sweep)  # the Peclet sweep's scenes (figures/scenes_peclet.png draws these only)
         self._defaults = config.get("case_defaults", {})
         self._check = check  # a further check of each built scene (the workflow's memory check)
         self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
@@ -339,11 +492,9 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     return replace(scene, paper_runs=frozenset(shared), paper_pattern=pattern)
 
 
-PECLET_PREFIX = "peclet_"  # the scenes of the Peclet sweep: peclet_0, peclet_1, ...
-
-
 def peclet_scenes(config: Mapping) -> dict[str, dict]:
-    """The scenes of config `scenes_peclet`: its base at each velocity, named peclet_<k>; SettingError
+    """The scenes of config `scenes_peclet`: its base at each velocity, named peclet-<k> (SWEEP_PREFIX,
+    a name no scene of config `scenes` can have); SettingError
     naming the key when the velocities are not ascending numbers >= 0 or the base sets v."""
     sweep = config.get("scenes_peclet")
     if not sweep:
@@ -355,7 +506,7 @@ def peclet_scenes(config: Mapping) -> dict[str, dict]:
     ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < math.inf for v in vs)
     if not ok or any(b <= a for a, b in zip(vs, vs[1:])):
         raise SettingError("scenes_peclet.v", vs, "at least two numbers >= 0, ascending")
-    return {f"{PECLET_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
+    return {f"{SWEEP_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
 
 
 def scenes(config: Mapping, check=None, paper=None) -> Scenes:

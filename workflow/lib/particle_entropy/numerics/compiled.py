@@ -220,3 +220,46 @@ def build(folder: str | os.PathLike) -> Path:
         codegen.AOTCPUCodegen._customize_tm_features = aot_features
     (folder / TARGET_FILE).write_text(target(numba.__version__) or "")
     return next(folder.glob(MODULE + ".*"))
+
+
+FAILED_SUFFIX = ".failed"  # beside a target's folder: its build failed here (the JIT runs instead)
+
+
+def take(root: str | os.PathLike = "results/kernels") -> bool:
+    """In a job: use the module for ``target()`` under ``root``, provided once per working
+    directory -> whether it was taken. The first job to need it builds or copies it (``provide``)
+    while holding a lock, the others wait for that job, then load it. It is provided into a
+    temporary folder renamed into place, so a job killed meanwhile leaves nothing half-made. A
+    build that fails is said once on stderr and recorded beside the folder: every job then runs
+    numba's JIT, slower to start, the same bits (delete the record to try again).
+
+    This is no rule of the workflow on purpose: a Snakemake job whose output an ``ancient`` input
+    of every simulation names hides those simulations from the scheduler while it reruns, and the
+    run then ends with exit 0 having made none of its targets."""
+    import fcntl
+    import shutil
+
+    folder = Path(kernels_folder(str(root)))
+    failed = folder.with_name(folder.name + FAILED_SUFFIX)
+    if not _complete(folder) and not failed.exists():
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        with open(folder.with_name(f".{folder.name}.lock"), "a") as lock:
+            print(f"waiting for the compiled kernels in {folder} ...", file=sys.stderr)
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when this process ends, killed or not
+            if not _complete(folder) and not failed.exists():
+                tmp = folder.with_name(f".{folder.name}.{os.getpid()}.tmp")
+                shutil.rmtree(tmp, ignore_errors=True)
+                try:
+                    how = provide(tmp)
+                    shutil.rmtree(folder, ignore_errors=True)  # a folder of another build, unfinished
+                    os.rename(tmp, folder)
+                    print(f"{how} the compiled kernels into {folder}", file=sys.stderr)
+                except Exception as error:  # no C compiler or Python headers: the JIT runs
+                    shutil.rmtree(tmp, ignore_errors=True)
+                    failed.write_text(f"{target()}error {type(error).__name__}: {error}\n")
+                    print(
+                        f"could not compile the kernels ({type(error).__name__}: {error}); "
+                        f"every job runs numba's JIT (delete {failed} to try again)",
+                        file=sys.stderr,
+                    )
+    return use(folder)

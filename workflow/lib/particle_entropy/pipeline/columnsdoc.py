@@ -274,7 +274,7 @@ FIGURE_CONTENTS = (
     ),
     (
         "scenes_peclet",
-        "`results/scenes/peclet_<k>.parquet`, its source data `results/scenes/peclet.parquet`",
+        "`results/scenes/peclet-<k>.parquet`, its source data `results/scenes_peclet.parquet`",
         "one",
         "`peclet` → `cost_s` per `family` (grid, particles), bars down to `cost_lo`; the crossover shaded where "
         "`particles_cheaper` turns true",
@@ -501,7 +501,7 @@ def sections() -> list[Section]:
             "Scene results",
             ("results/scenes/<name>.parquet",),
             "One row per visited (candidate, resolution) of a finished scene `scenes.<name>` (or a scene of the "
-            "Peclet sweep, `peclet_<k>`); the scene-level columns repeat on every row. Written by rule "
+            "Peclet sweep, `peclet-<k>`); the scene-level columns repeat on every row. Written by rule "
             "`scene_table` (`scene_search.result`); docs/scenes.md explains the search.",
             (("scene_search.RESULT_COLUMN_DOCS", scene_search.RESULT_COLUMN_DOCS),),
         ),

@@ -405,7 +405,7 @@ def check_config(
     ``not_judged``, one that would be refused is not raised but said there, one line each, naming
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
-    from ..experiments.scene import PECLET_PREFIX, scenes
+    from ..experiments.scene import scenes
     from .crosschecks import check_memory, check_scene_memory, check_search, check_sweeps
 
     try:
@@ -432,7 +432,7 @@ def check_config(
         )
     every = scenes(config, None if available is None else lambda scene: check_scene_memory(scene, available))
     for name in every:  # builds and checks each scene
-        peclet = name.startswith(PECLET_PREFIX)
+        peclet = name in every.sweep
         judge(
             lambda name=name: every[name],
             f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",

@@ -200,14 +200,15 @@ def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
 
 def check_scene_memory(scene, available: float) -> None:
     """Every job a scene may run must fit in ``available`` bytes: each candidate's top resolution
-    with its realisations in one process (memory.estimate_mb); SettingError naming its n_range."""
+    with its realisations in one process (memory.estimate_mb); SettingError naming its n_range (or
+    ladder), under scenes_peclet.base for a scene of the Peclet sweep."""
     for i, c in enumerate(scene.candidates):
         runs = 1 if c.case.method == "fd" else scene.realisations
         need = estimate_mb(scene.run_config(c, c.n_hi), runs) * 2**20
         if need > available:
             raise SettingError(
-                f"scenes.{scene.name}.candidates[{i}].n_range",
-                [c.n_lo, c.n_hi],
+                scene.key(f"candidates[{i}].{'ladder' if c.rungs else 'n_range'}"),
+                list(c.rungs) if c.rungs else [c.n_lo, c.n_hi],
                 f"a range whose top job fits in this machine's memory: {c.label} at n = {c.n_hi:,} with "
                 f"{runs} realisations needs about {need / 1e9:.1f} GB, {available / 1e9:.1f} GB are available",
             )

@@ -5,7 +5,8 @@ The schema (workflow/schemas/config.schema.yaml) is hand-written except between 
 the declarations of core/settings.py, the registry and the list of figures (figures.FIGURES),
 the entries of physics, time, numerics and case_defaults, the $defs of the case dimensions and
 of a section of cases, and the whole objects of figures, tradeoff, mechanism, shear, an adaptive
-search and a `realisations` entry (type, range or enum, default, description, required keys).
+search, a scene, the Peclet sweep (its base a scene without v) and a `realisations` entry (type,
+range or enum, default, description, required keys).
 What stays hand-written is the frame: the top-level keys and the few rules between keys a schema
 can say (a search's budget and range). Snakemake reads the schema from a file, so the generated
 lines are committed; ``python -m particle_entropy.pipeline.schemagen --check`` (and
@@ -147,6 +148,16 @@ def figures_body() -> Block:
     return Block(type="object", description=SECTION_DOCS["figures"], additionalProperties=False, properties=props)
 
 
+def peclet_body() -> Block:
+    """The `scenes_peclet` object: its base is a scene's object without v (the sweep sets it), so
+    that a typo there is refused as it is under scenes.<name>."""
+    body = object_body("scenes_peclet", SCENES_PECLET)
+    base = object_body("scenes.<name>", [s for s in SCENE if s.name != "v"])
+    base["description"] = description(BY_KEY["scenes_peclet.base"])
+    body["properties"]["base"] = base
+    return body
+
+
 def blocks() -> dict[str, Block]:
     """Every generated block: its keys and their values, as the schema writes them."""
     out: dict[str, list[tuple[str, dict]]] = {"physics": [], "time": [], "numerics": [], "case_defaults": []}
@@ -219,7 +230,7 @@ def blocks() -> dict[str, Block]:
     generated["shear"] = object_body("shear", SHEAR)
     generated["search"] = object_body("optimum.<name>", SEARCH)
     generated["scene"] = object_body("scenes.<name>", SCENE)
-    generated["scenes_peclet"] = object_body("scenes_peclet", SCENES_PECLET)
+    generated["scenes_peclet"] = peclet_body()
     generated["realisations_entry"] = Block(items=object_body("realisations[]", REALISATIONS_ENTRY))
     return generated
 
