@@ -44,7 +44,15 @@ rule all:
         all_targets(),
 
 
+# Each run of jobs records the commit it runs at, whether tracked files differed, and the config's
+# digest; the crate gives every job the record of the run it started in (pipeline/crate.py).
+onstart:
+    RUN_RECORDS.append(start_session(workflow.basedir, config))
+
+
 onsuccess:
+    for record in RUN_RECORDS:
+        end_session(record)
     # Snakemake can end a run "100% done" with a target unmade (a rerun job with an ancient output
     # hides the jobs after it): a run exits 0 only when every requested target is there.
     if unmade := unmade_targets():
@@ -56,6 +64,8 @@ onsuccess:
 
 
 onerror:
+    for record in RUN_RECORDS:
+        end_session(record)
     from particle_entropy.pipeline.verify import disk_space_problems
 
     for problem in disk_space_problems((".", "results", ".snakemake")):

@@ -140,6 +140,17 @@ def test_one_figure_runs_only_its_jobs(tmp_path):
     assert "results/runs/mtpt" not in proc.stdout and "results/runs/pt" not in proc.stdout
 
 
+@pytest.mark.parametrize("target", ["crate", "results/ro-crate/ro-crate-metadata.json"])
+def test_a_file_where_the_crate_goes_is_refused_in_one_line_before_any_job(tmp_path, target):
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results/ro-crate").write_text("not a folder\n")
+    proc = run_snakemake(tmp_path, target, dry_run=True, check=False, configfile=TINY)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "results/ro-crate is a file, not a folder" in out, out[-1500:]
+    assert "Traceback" not in out and "Building DAG" not in out  # refused as the Snakefile is read
+    assert run_snakemake(tmp_path, dry_run=True, configfile=TINY).returncode == 0  # other targets are not refused
+
+
 def test_slurm_profile_parses(tmp_path):
     proc = run_snakemake(
         tmp_path,
@@ -410,6 +421,8 @@ def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_co
         return value if isinstance(value, list) else [value]
 
     work = tiny_run_copy
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True)
+    commit = head.stdout.strip()
     run_snakemake(work, "crate", configfile=TINY)
     crate = work / "results/ro-crate"
     graph = {e["@id"]: e for e in json.loads((crate / METADATA).read_text())["@graph"]}
@@ -422,7 +435,10 @@ def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_co
         (action,) = [e for e in made if e["@id"] != "#run"]  # the job; the run's action lists every figure
         assert graph[action["instrument"]["@id"]]["name"] == f"rule plot_{fig}"
         assert {"@id": f"results/figures/{fig}.parquet"} in listed(action, "result")
-        assert re.fullmatch(r"code hash [0-9a-f]{16}", action["description"])
+        # its code hash, and the commit it ran at as its run recorded it (the tiny run's, this checkout's)
+        ran = r"code hash [0-9a-f]{16}; ran at commit [0-9a-f]{40} \((clean|dirty: .*)\)"
+        assert re.fullmatch(ran, action["description"]), action["description"]
+        assert f"ran at commit {commit}" in action["description"]
     assert graph["config-as-run.yaml"]["sha256"] == file_sha256(crate / "config-as-run.yaml")
     assert graph["https://doi.org/10.1016/j.advwatres.2020.103509"]["@type"] == "ScholarlyArticle"
     assert (crate / "requirements.lock").read_bytes() == (ROOT / "requirements.lock").read_bytes()
@@ -430,10 +446,23 @@ def test_the_crate_of_a_run_is_valid_and_holds_what_made_each_figure(tiny_run_co
     assert "SHA-256 " + graph["config-as-run.yaml"]["sha256"] in (crate / "README.md").read_text()
     tools = [e for e in graph.values() if str(e["@id"]).startswith("#rule-plot_")]
     assert tools and all(re.fullmatch(r"[0-9a-f]{16}", t["softwareVersion"]) for t in tools)  # the code hash
+    # an author added by hand, as docs/deposit.md says, and a figure edited by hand since its job
+    meta = json.loads((crate / METADATA).read_text())
+    meta["@graph"].append({"@id": "https://orcid.org/0000-0002-1825-0097", "@type": "Person", "name": "J. Carberry"})
+    next(e for e in meta["@graph"] if e["@id"] == "./")["author"] = {"@id": "https://orcid.org/0000-0002-1825-0097"}
+    (crate / METADATA).write_text(json.dumps(meta))
+    with (work / "figures/fig2.png").open("ab") as f:
+        f.write(b"an edit")
     # the crate read no table the check had read, and the next check reads none again: the cache's
     # entries of the linked tables carry their new ctime; and the check skips the crate's links
     run_snakemake(work, "crate", "--forcerun", "crate", configfile=TINY)  # a rebuild keeps the links that hold
     assert "0 tables hashed" in (work / "logs/crate.log").read_text()
+    graph = {e["@id"]: e for e in json.loads((crate / METADATA).read_text())["@graph"]}
+    assert graph["./"]["author"] == {"@id": "https://orcid.org/0000-0002-1825-0097"}  # kept
+    assert graph["https://orcid.org/0000-0002-1825-0097"]["name"] == "J. Carberry"
+    made = [e for e in graph.values() if {"@id": "figures/fig2.png"} in listed(e, "result")]
+    assert made == [] and "changed since the job plot_fig2" in graph["figures/fig2.png"]["description"]
+    assert validate_crate(crate) == [] and verify_crate(crate) == []
     cache = cached_digests(work / DIGESTS)
     linked = [k for k in cache if (crate / "results" / k).is_file()]
     assert len(linked) > 50 and all(cache[k][:4] == stamp((work / "results" / k).stat()) for k in linked)

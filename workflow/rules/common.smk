@@ -36,7 +36,13 @@ from particle_entropy.pipeline.verify import (
     set_aside_corrupt,
     tables_below,
 )
-from particle_entropy.pipeline.crate import METADATA as CRATE_METADATA, provenance
+from particle_entropy.pipeline.crate import (
+    METADATA as CRATE_METADATA,
+    crate_folder_problem,
+    end_session,
+    provenance,
+    start_session,
+)
 from particle_entropy.pipeline.memory import available_bytes, estimate_mb
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import MAX_REALISATIONS, SHEAR
@@ -171,8 +177,26 @@ def hold_results():
         print(note, file=sys.stderr)
 
 
+def crate_requested(options):
+    """Whether the command line (``options``, snakemake_options) asks for the crate: its rule or a
+    path in its folder; an unknown command line (the API) may."""
+    if options is None:
+        return True
+    return any(t == "crate" or Path(t).as_posix().startswith(CRATE_DIR) for t in options.get("targets") or [])
+
+
+def check_crate_folder():
+    """Stop in one line, before any job, when the crate is asked for and cannot be written where
+    it goes (crate.crate_folder_problem): a file there, or a link out of results/."""
+    problem = crate_folder_problem(".") if crate_requested(snakemake_options(sys.argv)) else None
+    if problem:
+        raise WorkflowError(problem)
+
+
+RUN_RECORDS = []  # the record of this run of jobs (Snakefile: onstart), ended on success or error
 if workflow.is_main_process:
     check_writable(looks_only())
+    check_crate_folder()
     if not looks_only():
         hold_results()
 CORRUPT = set_aside_corrupt_tables(look_only=looks_only()) if workflow.is_main_process else []
