@@ -238,3 +238,37 @@ def test_a_shared_run_is_the_paper_run_to_the_bit(which):
     timing = [c for c in mine.columns if c.startswith(("wall_", "peak_rss", "core_s"))]
     assert list(mine.columns) == list(theirs.columns)
     assert mine.drop(columns=timing).equals(theirs.drop(columns=timing))
+
+
+def test_a_scene_runs_on_the_exact_time_grid_whatever_case_defaults_say():
+    """case_defaults' time_grid (the paper figures') would move particle runs past t_final, where a
+    scene is judged: the authors' whole growing steps end at t = 51.6 for t_final = 50."""
+    from particle_entropy.core.timegrid import time_steps
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    pt = {**PT, "n_range": [30, 480]}
+    scene = Scene.from_config("s", spec(candidates=[FD, pt]), {"time_grid": "authors", "dt_growth": 1.1})
+    cfg = scene.run_config(scene.candidates[1], 30)
+    assert cfg.time_grid == "exact" and cfg.dt_growth == 1.1  # the other case_defaults still apply
+    assert time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, "authors").sum() > 51.0  # what it would do
+    last = run_seeds_arrow(cfg, [0]).to_pandas()["time"].iloc[-1]
+    assert last == pytest.approx(50.0, rel=1e-12)
+    with pytest.raises(SettingError) as err:  # a candidate's own time_grid: refused, not ignored
+        Scene.from_config("s", spec(candidates=[FD, {**pt, "time_grid": "authors"}]))
+    assert err.value.name == "scenes.s.candidates[1].time_grid" and "t_final" in err.value.allowed
+
+
+def test_explicit_fd_in_a_flow_is_refused_not_run_implicit():
+    """Explicit FD has no advection term: at v != 0 it ran the implicit scheme under its own label
+    (tables bit-identical to the implicit candidate's). It is refused by key path; at rest it runs."""
+    from particle_entropy.core.runconfig import RunConfig
+
+    explicit = {"method": "fd", "kernel": "explicit", "fd_dt": 0.5, "n_range": [16, 256]}
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("s", spec(candidates=[MTPT, explicit]))
+    assert err.value.name == "scenes.s.candidates[1].kernel" and err.value.value == "explicit"
+    assert "implicit when v != 0" in err.value.allowed
+    with pytest.raises(SettingError, match="kernel"):  # the CLI's runs too
+        RunConfig.of(method="fd", kernel="explicit", n=16, v=0.01, dt0=0.5, fd_length=4.0).resolved()
+    at_rest = Scene.from_config("s", spec(v=0.0, candidates=[MTPT, explicit]))
+    assert at_rest.candidates[1].label == "fd explicit dt=0.5"

@@ -281,6 +281,13 @@ class RunConfig:
             raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
         self._check_resolution()
+        if self.method == "fd" and self.kernel == "explicit" and self.v != 0.0:
+            raise SettingError(
+                "kernel",
+                self.kernel,
+                f"implicit when v != 0 (v = {self.v:g}): explicit fd has no advection term (models/fd.py: "
+                "only the implicit scheme carries the plume)",
+            )
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2

@@ -19,6 +19,9 @@ from ..core.timegrid import time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
+# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
+# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
+SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 _DEFAULTS = defaults(SCENE)
 _TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
 
@@ -180,7 +183,7 @@ class Scene:
         return scene
 
 
-_CAND_KEYS = ("eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0", "ladder")
+_CAND_KEYS = ("kernel", "eta", "truncation", "dt_growth", "scheme", "advection", "fd_dt", "n", "dt0", "ladder")
 
 
 def _cost(name: str, spec) -> tuple:
@@ -264,6 +267,10 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
     if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
         raise SettingError(_key(name, f"{where}.fd_dt"), fd_dt, "a number > 0 [T]")
+    if spec.get("time_grid", "exact") != "exact":
+        raise SettingError(_key(name, f"{where}.time_grid"), spec["time_grid"], SCENE_TIME_GRID_TEXT)
+    # case_defaults' time_grid is the paper figures': a scene's runs end at t_final, where they are judged
+    case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
     try:
         case = Case.from_spec(spec, None, case_defaults)
     except SettingError as e:
