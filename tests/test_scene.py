@@ -315,7 +315,9 @@ def test_the_measurement_points_sample_the_plume_whatever_the_window():
     runs = run_seeds_arrow(rest.run_config(rest.candidates[0], 30, seed=0), range(3)).to_pandas()
     errors = [error(rest, g.iloc[-1]) for _, g in runs.groupby("seed")]
     assert min(errors) > 0.01
-    assert np.allclose(rest.run_config(rest.candidates[0], 30).points(50.0), M.measurement_points(2 * reach), atol=1e-12)
+    assert np.allclose(
+        rest.run_config(rest.candidates[0], 30).points(50.0), M.measurement_points(2 * reach), atol=1e-12
+    )
 
 
 def test_a_window_that_cannot_hold_the_plume_is_refused():
