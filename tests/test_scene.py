@@ -379,3 +379,5 @@ def test_a_run_that_lost_mass_is_unscored(tmp_path):
     assert row["unscored"].startswith("mass lost") and not row["meets"] and math.isnan(row["COMIC_points"])
     kept = runs.assign(mass_total=1.0 - 0.5 * S.MASS_LOSS_MAX)  # within the window's allowance: judged
     assert S.judged(scene, kept).iloc[0]["meets"]
+    gained = S.judged(scene, runs.assign(mass_total=1.01)).iloc[0]  # mass from nowhere: not judged either
+    assert gained["unscored"].startswith("mass gained: 0.01") and not gained["meets"]

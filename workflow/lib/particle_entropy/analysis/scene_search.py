@@ -88,7 +88,8 @@ def unscored(scene: Scene, row) -> str:
         return why + (" > 2" if peclet > 2 else "")
     lost = 1.0 - row["mass_total"]
     if not abs(lost) <= MASS_LOSS_MAX:
-        return f"mass lost through the window's ends: {lost:.3g} of 1 (at most {MASS_LOSS_MAX:g})"
+        what = "lost through the window's ends" if lost > 0 else "gained"
+        return f"mass {what}: {abs(lost):.3g} of 1 (at most {MASS_LOSS_MAX:g})"
     if not np.isfinite(row["SSE_points"]):
         return "SSE not finite"
     return ""

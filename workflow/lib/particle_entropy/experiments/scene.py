@@ -19,13 +19,13 @@ from ..core.timegrid import time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
-# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
-# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 # The 15 measurement points common to every model span the plume at t_final, its mean +- REACH
 # sqrt(2 variance) (+- 3 sqrt(4 D t) for a point: 4.24 standard deviations), as the paper's span
 # [-6, 6] its plume at t = 1000; they move with the plume and never depend on the FD window, which
 # must reach as far beyond the source (settings.SCENE_REACH).
 REACH = SCENE_REACH
+# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
+# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 _DEFAULTS = defaults(SCENE)
 _TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
@@ -202,7 +202,7 @@ _CAND_KEYS = ("kernel", "eta", "truncation", "dt_growth", "scheme", "advection",
 def _check_window(name: str, fd_length: float, source: Source, D: float, t_final: float) -> None:
     """SettingError naming scenes.<name>.fd_length unless the window reaches REACH sqrt(4 D t_final)
     beyond the source's extent on either side, as the paper's [-6, 6] at t = 1000: its zero ends then
-    absorb at most 2 erfc(3) = 4.4e-5 of the mass by t_final (an upper bound, v > 0 only lowers it);
+    absorb at most 2 erfc(3) = 4.4e-5 of the mass by t_final (an upper bound: a flow only lowers it);
     a window of +- 1 sqrt(2 D t_final) lost a third."""
     need = 2.0 * (source.half_width + REACH * math.sqrt(4.0 * D * t_final))
     if fd_length < need * (1.0 - 1e-12):  # the paper's own 12 is the bound at its D, t_final
