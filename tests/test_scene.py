@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from particle_entropy.core.case import SettingError
@@ -107,12 +108,12 @@ def test_a_bad_value_is_refused_naming_its_key_path(over, key):
 
 def test_a_plume_carried_100_windows_fits_the_fd_grid_and_moves_the_particles():
     """v large enough for the plume to travel 100 window lengths: the grid holds the path."""
-    scene = Scene.from_config("far", spec(v=100 * 1.0 / 50.0, fd_length=1.0, omega=1.0, t_final=50.0))
+    scene = Scene.from_config("far", spec(v=100 * 3.0 / 50.0, fd_length=3.0, omega=3.0, t_final=50.0))
     cfg = scene.run_config(scene.candidates[0], 1000)
     lo, length = cfg.fd_span()
-    assert length == pytest.approx(1.0 + 100.0) and lo == pytest.approx(-0.5)
-    assert scene.reference.centre == pytest.approx(100.0)
-    assert cfg.points(50.0).min() > 99.5  # the sensors moved with the plume
+    assert length == pytest.approx(3.0 + 300.0) and lo == pytest.approx(-1.5)
+    assert scene.reference.centre == pytest.approx(300.0)
+    assert abs(cfg.points(50.0) - 300.0).max() < 1.5  # the sensors moved with the plume, within the window
 
 
 def test_every_scene_of_a_config():
@@ -231,7 +232,7 @@ def test_the_paper_scene_runs_are_the_paper_run_s_own_files():
     )
     assert run_path(scene, fd, 30, 0, 0).startswith("results/runs/fd/implicit/n~30/")
     # any difference of physics, step or points keeps a scene's runs its own
-    for over in ({"D": 2e-3}, {"v": 1e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
+    for over in ({"D": 5e-4}, {"v": 1e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
         other, _ = _with_paper({**PAPER, **over})
         assert other.paper_runs == frozenset(), over
         assert run_path(other, other.candidates[1], 100, 0, 19).startswith("results/scenes/")
@@ -414,3 +415,145 @@ def test_a_peclet_scene_s_refusals_name_the_sweep_s_keys():
     with pytest.raises(SettingError) as err:
         check_scene_memory(every[every.sweep[0]], available=1e3)
     assert err.value.name == "scenes_peclet.base.candidates[0].ladder"
+
+
+def test_a_scene_runs_on_the_exact_time_grid_whatever_case_defaults_say():
+    """case_defaults' time_grid (the paper figures') would move particle runs past t_final, where a
+    scene is judged: the authors' whole growing steps end at t = 51.6 for t_final = 50."""
+    from particle_entropy.core.timegrid import time_steps
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    pt = {**PT, "n_range": [30, 480]}
+    scene = Scene.from_config("s", spec(candidates=[FD, pt]), {"time_grid": "authors", "dt_growth": 1.1})
+    cfg = scene.run_config(scene.candidates[1], 30)
+    assert cfg.time_grid == "exact" and cfg.dt_growth == 1.1  # the other case_defaults still apply
+    assert time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, "authors").sum() > 51.0  # what it would do
+    last = run_seeds_arrow(cfg, [0]).to_pandas()["time"].iloc[-1]
+    assert last == pytest.approx(50.0, rel=1e-12)
+    with pytest.raises(SettingError) as err:  # a candidate's own time_grid: refused, not ignored
+        Scene.from_config("s", spec(candidates=[FD, {**pt, "time_grid": "authors"}]))
+    assert err.value.name == "scenes.s.candidates[1].time_grid" and "t_final" in err.value.allowed
+
+
+def test_explicit_fd_in_a_flow_is_refused_not_run_implicit():
+    """Explicit FD has no advection term: at v != 0 it ran the implicit scheme under its own label
+    (tables bit-identical to the implicit candidate's). It is refused by key path; at rest it runs."""
+    from particle_entropy.core.runconfig import RunConfig
+
+    explicit = {"method": "fd", "kernel": "explicit", "fd_dt": 0.5, "n_range": [16, 256]}
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("s", spec(candidates=[MTPT, explicit]))
+    assert err.value.name == "scenes.s.candidates[1].kernel" and err.value.value == "explicit"
+    assert "implicit when v != 0" in err.value.allowed
+    with pytest.raises(SettingError, match="kernel"):  # the CLI's runs too
+        RunConfig.of(method="fd", kernel="explicit", n=16, v=0.01, dt0=0.5, fd_length=4.0).resolved()
+    at_rest = Scene.from_config("s", spec(v=0.0, candidates=[MTPT, explicit]))
+    assert at_rest.candidates[1].label == "fd explicit dt=0.5"
+
+
+S_SMALL = {  # the issue's small scene S
+    "D": 1e-3,
+    "v": 0.01,
+    "t_final": 50.0,
+    "target": {"measure": "rmse", "value": 0.1},
+    "candidates": [
+        {"method": "fd", "kernel": "implicit", "fd_dt": 0.5, "n_range": [16, 256]},
+        {"method": "pt", "kernel": "adaptive", "n_range": [30, 480]},
+    ],
+}
+
+
+def test_the_measurement_points_sample_the_plume_whatever_the_window():
+    """The 15 points span the plume's mean +- 3 sqrt(4 D t_final), never the FD window: at
+    fd_length 1e6 they spanned the window, none was near the plume, and every model scored 0."""
+    from particle_entropy.analysis.scene_search import error
+    from particle_entropy.core import measures as M
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    wide = Scene.from_config("s", {**S_SMALL, "fd_length": 1.0e6})
+    default = Scene.from_config("s", S_SMALL)
+    fd, pt = wide.candidates
+    pts = wide.run_config(pt, 30).points(50.0)
+    assert pts.tobytes() == default.run_config(default.candidates[1], 30).points(50.0).tobytes()
+    reach = 3.0 * math.sqrt(4e-3 * 50.0)  # 1.342: +- 4.24 standard deviations around x = v t = 0.5
+    assert np.allclose(pts, M.measurement_points(2 * reach) + 0.5, rtol=0, atol=1e-12)
+    assert 0.5 - reach <= pts.min() and pts.max() <= 0.5 + reach
+    for scene in (wide, default):  # FD and particles measure at the same points
+        assert scene.run_config(scene.candidates[0], 16).points(50.0).tobytes() == pts.tobytes()
+    # FD on the 1e6 window puts the plume on one node: its error is the exact plume's own RMSE there
+    exact = wide.reference.density(pts)
+    table = run_seeds_arrow(wide.run_config(fd, 16), [0]).to_pandas()
+    last = table.iloc[-1]
+    assert error(wide, last) == pytest.approx(math.sqrt(np.mean(exact**2)), rel=1e-3)
+    assert error(wide, last) > 0.5  # before: 5e-6, "met" at rmse 0.1
+    # at rest with particles only, too: PT n = 30 is judged against the plume, not 0
+    rest = Scene.from_config("r", {**S_SMALL, "v": 0.0, "fd_length": 1.0e6, "candidates": [S_SMALL["candidates"][1]]})
+    runs = run_seeds_arrow(rest.run_config(rest.candidates[0], 30, seed=0), range(3)).to_pandas()
+    errors = [error(rest, g.iloc[-1]) for _, g in runs.groupby("seed")]
+    assert min(errors) > 0.01
+    assert np.allclose(
+        rest.run_config(rest.candidates[0], 30).points(50.0), M.measurement_points(2 * reach), atol=1e-12
+    )
+
+
+def test_a_window_that_cannot_hold_the_plume_is_refused():
+    """margin 1 (+- 1 sqrt(2 D t_final)) was accepted and its FD runs lost a third of the mass. The
+    window must reach 3 sqrt(4 D t_final) beyond the source, as the paper's [-6, 6] at t = 1000."""
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("s", {**S_SMALL, "margin": 1.0})
+    assert err.value.name == "scenes.s.margin" and err.value.value == 1.0
+    assert "4.24264, 100]" in err.value.allowed
+    need = 2 * 3 * math.sqrt(4e-3 * 50.0)  # 2.683
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("s", {**S_SMALL, "fd_length": 0.99 * need})
+    assert err.value.name == "scenes.s.fd_length" and f"{need:.6g}" in err.value.allowed
+    box = {"kind": "box", "a": -0.5, "b": 0.5}
+    with pytest.raises(SettingError, match=r"scenes.s.fd_length=3.6 .*extent 1 \+"):
+        Scene.from_config("s", {**S_SMALL, "source": box, "fd_length": 3.6})  # < 1 + 2.683
+    assert Scene.from_config("s", {**S_SMALL, "source": box, "fd_length": 3.7}).fd_length == 3.7
+    assert Scene.from_config("s", {**S_SMALL, "margin": 3 * math.sqrt(2)}).fd_length == pytest.approx(need)
+    # the paper's own window is the bound at its D and t_final
+    paper = Scene.from_config("p", {**PAPER, "candidates": PAPER["candidates"][:1]})
+    assert paper.fd_length == 12.0
+
+
+def test_the_smallest_window_loses_what_the_paper_s_does():
+    """At rest, FD on the smallest window (ends 3 sqrt(4 D t_final) from the point) loses the
+    exact 2 erfc(3) = 4.4e-5 by t_final, within MASS_LOSS_MAX; the search still scores it."""
+    from particle_entropy.analysis.scene_search import MASS_LOSS_MAX
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    fine = {**S_SMALL["candidates"][0], "fd_dt": 0.01}  # backward Euler's tails converge with dt and dx
+    scene = Scene.from_config("s", {**S_SMALL, "v": 0.0, "margin": 3 * math.sqrt(2), "candidates": [fine]})
+    last = run_seeds_arrow(scene.run_config(scene.candidates[0], 256), [0]).to_pandas().iloc[-1]
+    lost = 1.0 - last["mass_total"]
+    assert lost == pytest.approx(math.erfc(3.0) * 2, rel=0.03)  # 4.51e-5
+    coarse = Scene.from_config("s", {**S_SMALL, "v": 0.0, "margin": 3 * math.sqrt(2)})  # fd_dt 0.5, n = 16
+    last = run_seeds_arrow(coarse.run_config(coarse.candidates[0], 16), [0]).to_pandas().iloc[-1]
+    assert lost < 1.0 - last["mass_total"] < MASS_LOSS_MAX  # its own discretisation on top: still judged
+
+
+def test_a_run_that_lost_mass_is_unscored(tmp_path):
+    """H_C and E are computed on the mass left: a run that lost more than MASS_LOSS_MAX of its mass
+    is never judged (nor chosen), whatever its error. At v = 0.05, S's upwind grid n = 32 spreads the
+    plume by numerical dispersion (v dx / 2 = 5 D) through the window's ends."""
+    import pandas as pd
+
+    from particle_entropy.analysis import scene_search as S
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.models.simulate import run_seeds_arrow
+
+    scene = Scene.from_config("s", {**S_SMALL, "v": 0.05, "target": {"measure": "entropy", "value": 1.0}})
+    plan = pd.DataFrame([{"candidate": 0, "label": "", "n": 32, "first": 0, "last": 0, "round": 0}])
+    path = tmp_path / "fd32.parquet"
+    write_parquet(run_seeds_arrow(scene.run_config(scene.candidates[0], 32), [0]), path)
+    runs = S.read_runs(plan, [str(path)])
+    lost = 1.0 - runs["mass_total"].iloc[0]
+    assert 0.01 < lost < 0.05  # 0.023
+    row = S.judged(scene, runs).iloc[0]
+    assert S.error(scene, runs.iloc[0]) < 1.0  # its entropy of what is left would meet the target (0.85)
+    assert row["unscored"].startswith("mass lost") and not row["meets"] and math.isnan(row["COMIC_points"])
+    kept = runs.assign(mass_total=1.0 - 0.5 * S.MASS_LOSS_MAX)  # within the window's allowance: judged
+    assert S.judged(scene, kept).iloc[0]["meets"]
+    gained = S.judged(scene, runs.assign(mass_total=1.01)).iloc[0]  # mass from nowhere: not judged either
+    assert gained["unscored"].startswith("mass gained: 0.01") and not gained["meets"]

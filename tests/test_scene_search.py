@@ -40,6 +40,7 @@ def _runs(plan: pd.DataFrame, law, negative=lambda ci, n: False) -> pd.DataFrame
                     "E": 1.0,
                     "E_analytic": 1.0,
                     "mass_min": -0.1 if negative(r.candidate, r.n) else 0.0,
+                    "mass_total": 1.0,
                     "dV": 0.1,
                     "work": 100.0 * r.n,
                     "steps": 100.0,

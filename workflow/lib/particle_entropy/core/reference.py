@@ -186,7 +186,7 @@ class Reference:
 
     def points(self, length: float | None = None) -> np.ndarray:
         """The measurement points common to every model (measures.measurement_points: 15 points on
-        [-L/2, L/2], L the paper's fd_length or ``length``, a scene's window), carried with the
+        [-L/2, L/2], L the paper's fd_length or ``length``, a scene's span), carried with the
         plume by x0 + v t: sensors that follow the plume, so that a scene measures it where it is [L]."""
         points = M.measurement_points() if length is None else M.measurement_points(length)
         move = self.source.x0 + self.shift if self.source.kind != "box" else self.centre

@@ -162,7 +162,7 @@ class RunConfig:
     source: Source = PAPER_SOURCE
     v: float = 0.0
     advection: str = "upwind"
-    window: float | None = None  # the measurement points' window: None = the paper's (at rest) or fd_length
+    window: float | None = None  # the measurement points' span: None = the paper's (at rest) or fd_length
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
@@ -223,8 +223,9 @@ class RunConfig:
 
     def points(self, t: float) -> np.ndarray:
         """The measurement points at time t: the paper's 15 (measures.measurement_points), or a
-        scene's over its FD window, carried with the plume (Reference.points) [L]."""
-        if self.window is not None:  # a scene's: its FD window, whatever its source and v
+        scene's over the span ``window`` around its plume (Scene.points_span), carried with the
+        plume (Reference.points) [L]."""
+        if self.window is not None:  # a scene's: its plume's span, whatever its source, v and window
             return self.reference(t).points(self.window)
         return self.reference(t).points(None if self.at_rest else self.fd_length)
 
@@ -287,6 +288,13 @@ class RunConfig:
             raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
         self._check_resolution()
+        if self.method == "fd" and self.kernel == "explicit" and self.v != 0.0:
+            raise SettingError(
+                "kernel",
+                self.kernel,
+                f"implicit when v != 0 (v = {self.v:g}): explicit fd has no advection term (models/fd.py: "
+                "only the implicit scheme carries the plume)",
+            )
         if self.method == "fd" and self.kernel == "explicit":
             dx = self.fd_length / self.n
             r = self.D * self.dt0 / dx**2

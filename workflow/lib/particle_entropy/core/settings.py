@@ -757,6 +757,11 @@ CANDIDATE_SHAPE = {
         "oneOf": [{"required": ["n_range"]}, {"required": ["ladder"]}],
     },
 }
+# A scene's reach around its plume at t_final, in sqrt(4 D t_final): the paper's fd_length [-6, 6]
+# at t = 1000, whose 15 measurement points span it and whose zero ends absorb 2 erfc(3) = 4.4e-5 of
+# the mass by then. A scene's points span its plume this far, and its FD window reaches at least as far.
+SCENE_REACH = 3.0
+SCENE_MIN_MARGIN = SCENE_REACH * math.sqrt(2.0)  # the same in the margin's unit sqrt(2 D t_final): 4.24
 SCENE = (
     Setting("D", "scenes.<name>.D", 1e-3, "dispersion coefficient", "L^2/T", 0.0, open_low=True),
     Setting("v", "scenes.<name>.v", 0.0, "uniform velocity", "L/T", -math.inf, range_text="a finite number"),
@@ -776,8 +781,11 @@ SCENE = (
         6.0,
         "the domains follow as the source's extent plus this many sqrt(2 D t_final) on either side: the "
         "particles' Omega and the FD window (the FD grid adds the path v t_final)",
-        low=1.0,
+        low=SCENE_MIN_MARGIN,
         high=100.0,
+        range_text=f"a number in [3 sqrt 2 = {SCENE_MIN_MARGIN:.6g}, 100]: the window must reach 3 sqrt(4 D t_final) "
+        "beyond the source, as the paper's [-6, 6] at t = 1000 (its zero ends absorb 2 erfc(3) = 4.4e-5 of the "
+        "mass by then); a narrower one loses the plume through them",
     ),
     Setting("omega", "scenes.<name>.omega", NO_DEFAULT, "particle domain (instead of margin)", "L", 0.0, open_low=True),
     Setting(
@@ -788,6 +796,8 @@ SCENE = (
         "L",
         0.0,
         open_low=True,
+        range_text="a number >= the source's extent + 2 x 3 sqrt(4 D t_final), the paper's reach (its [-6, 6] at "
+        "t = 1000)",
     ),
     Setting(
         "measure",

@@ -17,11 +17,19 @@ from dataclasses import dataclass, replace
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
 from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_plume_width, check_setting
-from ..core.settings import BY_KEY, PAPER, SCENE, defaults
+from ..core.settings import BY_KEY, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
+# The 15 measurement points common to every model span the plume at t_final, its mean +- REACH
+# sqrt(2 variance) (+- 3 sqrt(4 D t) for a point: 4.24 standard deviations), as the paper's span
+# [-6, 6] its plume at t = 1000; they move with the plume and never depend on the FD window, which
+# must reach as far beyond the source (settings.SCENE_REACH).
+REACH = SCENE_REACH
+# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
+# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
+SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 _DEFAULTS = defaults(SCENE)
 _TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
 
@@ -152,6 +160,12 @@ class Scene:
         return Reference(self.source, self.D, self.v, self.t_final)
 
     @property
+    def points_span(self) -> float:
+        """The width the measurement points span: 2 REACH sqrt(2 variance) of the exact plume at
+        t_final, whatever the FD window (the paper's 12 at its t = 1000) [L]."""
+        return 2.0 * REACH * math.sqrt(2.0 * self.reference.variance)
+
+    @property
     def peclet(self) -> float:
         """v L / D with L the FD window: how far advection outruns dispersion over the scene [-]."""
         return abs(self.v) * self.fd_length / self.D
@@ -165,7 +179,7 @@ class Scene:
             "fd_length": self.fd_length,
             "source": {k: v for k, v in vars(self.source).items()},
             "v": self.v,
-            "window": self.fd_length,  # the measurement points span the FD window, at rest too
+            "window": self.points_span,  # the measurement points span the plume, at rest too
         }
         if candidate.case.method == "fd":
             out["dt0"] = candidate.fd_dt
@@ -198,6 +212,8 @@ class Scene:
         span = 2.0 * (source.half_width + margin * math.sqrt(2.0 * D * t_final))
         omega = _checked(name, "omega", spec.get("omega", span))
         fd_length = _checked(name, "fd_length", spec.get("fd_length", span))
+        if "fd_length" in spec:  # from the margin it holds the plume by the margin's range
+            _check_window(name, fd_length, source, D, t_final)
         target = {**_TARGET, **dict(spec.get("target") or {})}
         measure = _checked(name, "target.measure", target.get("measure"))
         value = _checked(name, "target.value", target.get("value"))
@@ -309,9 +325,26 @@ def _candidate_error(scene: Scene, i: int, spec: Mapping, e: SettingError) -> Se
     if e.name in _CASE_DIMS:
         key = scene.key(f"{where}.{e.name}") if e.name in spec else f"case_defaults.{e.name}"
         return SettingError(key, e.value, e.allowed)
-    if e.name in ("advection", "fd_dt", "ladder"):
+    if e.name in ("kernel", "advection", "fd_dt", "ladder"):
         return SettingError(scene.key(f"{where}.{e.name}"), e.value, e.allowed)
     return SettingError(scene.key(e.name), e.value, e.allowed)
+
+
+def _check_window(name: str, fd_length: float, source: Source, D: float, t_final: float) -> None:
+    """SettingError naming scenes.<name>.fd_length unless the window reaches REACH sqrt(4 D t_final)
+    beyond the source's extent on either side, as the paper's [-6, 6] at t = 1000: its zero ends then
+    absorb at most 2 erfc(3) = 4.4e-5 of the mass by t_final (an upper bound: a flow only lowers it);
+    a window of +- 1 sqrt(2 D t_final) lost a third."""
+    need = 2.0 * (source.half_width + REACH * math.sqrt(4.0 * D * t_final))
+    if fd_length < need * (1.0 - 1e-12):  # the paper's own 12 is the bound at its D, t_final
+        extent = f"the source's extent {2.0 * source.half_width:.6g} + " if source.half_width else ""
+        raise SettingError(
+            _key(name, "fd_length"),
+            fd_length,
+            f"a window >= {extent}2 x {REACH:g} sqrt(4 D t_final) = {need:.6g} for D = {D:g}, t_final = {t_final:g} "
+            f"(the paper's [-6, 6] at t = 1000, whose zero ends absorb 2 erfc(3) = 4.4e-5 of the mass by then): "
+            "a narrower window loses the plume through its ends",
+        )
 
 
 def _cost(name: str, spec) -> tuple:
@@ -331,10 +364,11 @@ def _cost(name: str, spec) -> tuple:
 def _checked(name: str, key: str, value):
     """``value`` of scenes.<name>.<key> as its declaration (settings.SCENE) allows it (check_setting: a
     number as a float), else SettingError naming the key path."""
+    setting = BY_KEY[f"scenes.<name>.{key}"]
     try:
-        return check_setting(BY_KEY[f"scenes.<name>.{key}"], value)
+        return check_setting(setting, value)
     except SettingError as e:
-        raise SettingError(_key(name, key), value, e.allowed) from None
+        raise SettingError(_key(name, key), value, setting.range_text or e.allowed) from None
 
 
 def _source(name: str, spec) -> Source:
@@ -408,6 +442,10 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
     if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
         raise SettingError(_key(name, f"{where}.fd_dt"), fd_dt, "a number > 0 [T]")
+    if spec.get("time_grid", "exact") != "exact":
+        raise SettingError(_key(name, f"{where}.time_grid"), spec["time_grid"], SCENE_TIME_GRID_TEXT)
+    # case_defaults' time_grid is the paper figures': a scene's runs end at t_final, where they are judged
+    case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
     try:
         case = Case.from_spec(spec, None, case_defaults)
     except SettingError as e:

@@ -65,6 +65,8 @@ def solver(cfg: RunConfig, dt: float, dx: float):
     advection term when v != 0 (implicit only)."""
     r = cfg.D * dt / dx**2
     if cfg.v != 0.0:
+        if cfg.kernel != "implicit":  # RunConfig.check refuses it: never run another scheme than named
+            raise ValueError(f"fd kernel {cfg.kernel!r} has no advection term: implicit when v != 0")
         return AdvectionSolver(cfg.n - 1, r, cfg.v * dt / dx, cfg.advection)
     return (ExplicitSolver if cfg.kernel == "explicit" else ImplicitSolver)(cfg.n - 1, r)
 
