@@ -447,7 +447,8 @@ def test_explicit_fd_in_a_flow_is_refused_not_run_implicit():
     assert "implicit when v != 0" in err.value.allowed
     with pytest.raises(SettingError, match="kernel"):  # the CLI's runs too
         RunConfig.of(method="fd", kernel="explicit", n=16, v=0.01, dt0=0.5, fd_length=4.0).resolved()
-    at_rest = Scene.from_config("s", spec(v=0.0, candidates=[MTPT, explicit]))
+    stable = {**explicit, "n_range": [16, 64]}  # r = D dt / dx^2 < 1/2 up to its ladder's top
+    at_rest = Scene.from_config("s", spec(v=0.0, candidates=[MTPT, stable]))
     assert at_rest.candidates[1].label == "fd explicit dt=0.5"
 
 
