@@ -468,6 +468,16 @@ def coded_rules(rules):
     return sorted(r.name for r in rules if "code" in r.params.keys())
 
 
+def beyond_default_target():
+    """This config's targets outside the default one (its scenes and optimum searches, the
+    mechanism figure): the crate describes those a run of this same config made."""
+    by_name = {r.name: r for r in workflow.rules}
+    found = [str(f) for name in ("scenes", "optimum") if name in by_name for f in by_name[name].input]
+    if "plot_fig9_mechanism" in by_name:
+        found += [str(f) for f in by_name["plot_fig9_mechanism"].output]
+    return found
+
+
 def figure_labels(figure, rule, data, drawn_by=None):
     """The report's labels of a figure: where it came from (pipeline/crate.provenance), worked out
     when the report is built; ``data`` is its source-data table's path pattern, ``drawn_by`` the

@@ -3,16 +3,6 @@
 # the default target.
 
 
-def beyond_default_target():
-    """This config's targets outside the default one (its scenes and optimum searches, the
-    mechanism figure): the crate describes those a run of this same config made."""
-    by_name = {r.name: r for r in workflow.rules}
-    found = [str(f) for name in ("scenes", "optimum") if name in by_name for f in by_name[name].input]
-    if "plot_fig9_mechanism" in by_name:
-        found += [str(f) for f in by_name["plot_fig9_mechanism"].output]
-    return found
-
-
 rule crate:
     input:
         all_targets(),
