@@ -272,7 +272,7 @@ EOF
 # One simulation, submitted with PE_SLURM_TEST_FAIL set: its SLURM job exits non-zero on the node
 # (the srun above). With accounting off, Snakemake can only learn that from squeue, and must stop.
 # (A broken particle_entropy first on PYTHONPATH would not do: common.smk puts workflow/lib first.)
-TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | sort | head -n 1)
+TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | LC_ALL=C sort | awk 'NR == 1')  # awk reads all: no SIGPIPE
 say "failure run: $TARGET, its SLURM job made to fail (limit ${FAIL_LIMIT_S} s)"
 t0=$(ms)
 fail_rc=0
