@@ -23,7 +23,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 PathLike = str | os.PathLike
-TAIL_LINES = 40  # lines of each log shown: the error is at the end
+TAIL_LINES = 80  # lines of each log shown: the error is at its end; a SLURM log of one job is about 50
 TAIL_BYTES = 64 * 1024  # at most this much of a log is read
 
 # "    log: a.log, b.log (check log file(s) for error details)": the logs of a failed job or group
