@@ -4,11 +4,10 @@
 # Starts munged, slurmctld and slurmd on localhost from a configuration written to a temporary
 # directory (accounting off, as on the cluster of the issue), runs the tiny config once on this
 # machine and once through SLURM, compares every results/**/*.parquet table of the two runs
-# (identical apart from timing columns), then makes submitted jobs fail (the first job of a run,
-# and a simulation's group job) and checks that Snakemake notices, stops within FAIL_LIMIT_S
-# seconds and shows the job's own error. Prints both wall times and the number of SLURM jobs.
-# Everything it starts is stopped by PID on exit and the temporary directory is removed (KEEP=1
-# keeps it).
+# (identical apart from timing columns), then makes a submitted simulation fail (on its own and in
+# its group) and checks that Snakemake notices, stops within FAIL_LIMIT_S seconds and shows the
+# job's own error. Prints both wall times and the number of SLURM jobs. Everything it starts is
+# stopped by PID on exit and the temporary directory is removed (KEEP=1 keeps it).
 #
 # Needs root (slurmd launches jobs; missing Debian packages slurm-wlm and munge are installed with
 # apt-get) and about five minutes on two cores. Not collected by pytest. Run from any clone:
@@ -273,41 +272,44 @@ EOF
 # Runs for one simulation's table with PE_SLURM_TEST_FAIL set: every job they submit exits non-zero
 # on the node (the srun above), whichever rule it runs. With accounting off, Snakemake can only
 # learn that from squeue, and must stop, and show the job's own error (the srun's message, in
-# SLURM's log of the job). Two runs, for the two ways a job is submitted: from an empty folder the
-# first job fails, a job of its own (compile_kernels, which every simulation needs); in a copy of
-# the SLURM run without that table, the simulation's group job fails. Snakemake lists SLURM's log
-# after an empty job log for the first and before the members' logs for the second.
+# SLURM's log of the job). Each runs in a copy of the SLURM run without that table, so that the
+# simulation is the one job to run, whatever rule would come first in an empty folder. Two runs,
+# for the two ways a job is submitted: on its own (`--groups` on the command line replaces the
+# profile's groups, so the simulation is in none), where Snakemake lists SLURM's log after the
+# job's own, missing, log; and in its group, where SLURM's log comes first.
 # (A broken particle_entropy first on PYTHONPATH would not do: common.smk puts workflow/lib first.)
 TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | LC_ALL=C sort | awk 'NR == 1')  # awk reads all: no SIGPIPE
 [[ -n $TARGET ]] || die "the local run made no results/runs table"
 
-fail_run() {  # fail_run NAME DIR: a run for TARGET in DIR; sets FAIL_RC, FAIL_MS and FAILED_RULES
-    local name=$1 dir=$2 log=$TMP/fail-$1.log t0
+fail_run() {  # fail_run NAME [ARGS...]: a run for TARGET; sets FAIL_RC, FAIL_MS and FAILED_RULES
+    local name=$1 dir=$TMP/fail-$1 log=$TMP/fail-$1.log t0
+    shift
+    cp -a "$TMP/slurm" "$dir"
+    rm -f "$dir/$TARGET" "$dir/$TARGET.sha256"
     say "failure run ($name): $TARGET in $dir, every SLURM job made to fail (limit ${FAIL_LIMIT_S} s)"
     t0=$(ms)
     FAIL_RC=0
     PE_SLURM_TEST_FAIL=1 run_logged "$log" timeout -k 30 "$((FAIL_LIMIT_S + 60))" \
         "$PYTHON" -m snakemake --workflow-profile "$PROFILE" -s "$REPO/Snakefile" -d "$dir" \
-        "$TARGET" --configfile "$CONFIG" || FAIL_RC=$?
+        "$TARGET" "$@" --configfile "$CONFIG" || FAIL_RC=$?
     FAIL_MS=$(($(ms) - t0))
     FAILED_RULES=$(grep -oE "Error in rule [A-Za-z0-9_]+" "$log" | awk '{print $4}' | sort -u | paste -sd, -)
     ((FAIL_RC != 0)) || die "the run with a failing job ($name) exited 0"
     ((FAIL_RC != 124)) || die "the run with a failing job ($name) did not stop within $((FAIL_LIMIT_S + 60)) s"
     ((FAIL_MS <= FAIL_LIMIT_S * 1000)) || die "the failing job ($name) was noticed after $(secs "$FAIL_MS") s"
     grep -q "has been submitted with SLURM jobid" "$log" || { tail -n 40 "$log"; die "$name: no job was submitted"; }
-    [[ -n $FAILED_RULES ]] || { tail -n 40 "$log"; die "$name: Snakemake named no failed rule"; }
+    [[ ,$FAILED_RULES, == *,simulate,* ]] ||
+        { tail -n 40 "$log"; die "the failure run ($name) failed in '$FAILED_RULES', not in the simulation"; }
     grep -q "made to fail on purpose" "$log" ||
         { tail -n 40 "$log"; die "the failure run ($name) ended without showing the job's own error"; }
 }
 
-fail_run first "$TMP/fail"
-FIRST_RC=$FAIL_RC FIRST_MS=$FAIL_MS FIRST_RULES=$FAILED_RULES
+fail_run alone --groups fd_domain=sims  # any RULE=GROUP pair that leaves simulate out
+! grep -q "Group job" "$TMP/fail-alone.log" || die "the failure run (alone) submitted a group job"
+ALONE_RC=$FAIL_RC ALONE_MS=$FAIL_MS ALONE_RULES=$FAILED_RULES
 
-cp -a "$TMP/slurm" "$TMP/fail-sim"
-rm -f "$TMP/fail-sim/$TARGET" "$TMP/fail-sim/$TARGET.sha256"
-fail_run sim "$TMP/fail-sim"
-[[ ,$FAILED_RULES, == *,simulate,* ]] ||
-    die "the failure run (sim) failed in $FAILED_RULES, not in the simulation of $TARGET"
+fail_run group
+grep -q "Group job" "$TMP/fail-group.log" || die "the failure run (group) submitted no group job"
 
 FAILED=$(squeue -h --states=all -o "%i %T" | awk '$2 == "FAILED"' | wc -l)
 ((FAILED >= 2)) || die "$FAILED FAILED jobs in squeue after the two failure runs (expected 2 or more)"
@@ -315,6 +317,6 @@ FAILED=$(squeue -h --states=all -o "%i %T" | awk '$2 == "FAILED"' | wc -l)
 # ---------------------------------------------------------------- report
 say "local run:  $(secs "$LOCAL_MS") s"
 say "SLURM run:  $(secs "$SLURM_MS") s, $SUBMITTED SLURM jobs submitted ($ACCEPTED accepted by slurmctld), ${JOBS_DONE:-?}"
-say "failing first job ($FIRST_RULES) noticed and its error shown, Snakemake exited $FIRST_RC after $(secs "$FIRST_MS") s"
-say "failing simulation ($FAILED_RULES) noticed and its error shown, Snakemake exited $FAIL_RC after $(secs "$FAIL_MS") s"
+say "failing job on its own ($ALONE_RULES) noticed, its error shown; Snakemake exited $ALONE_RC after $(secs "$ALONE_MS") s"
+say "failing job in a group ($FAILED_RULES) noticed, its error shown; Snakemake exited $FAIL_RC after $(secs "$FAIL_MS") s"
 say "PASS"
