@@ -276,7 +276,8 @@ EOF
 # simulation is the one job to run, whatever rule would come first in an empty folder. Two runs,
 # for the two ways a job is submitted: on its own (`--groups` on the command line replaces the
 # profile's groups, so the simulation is in none), where Snakemake lists SLURM's log after the
-# job's own, missing, log; and in its group, where SLURM's log comes first.
+# job's own log, missing here (the copy has no logs/) and so ending Snakemake's report; and in its
+# group, where SLURM's log comes first.
 # (A broken particle_entropy first on PYTHONPATH would not do: common.smk puts workflow/lib first.)
 TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | LC_ALL=C sort | awk 'NR == 1')  # awk reads all: no SIGPIPE
 [[ -n $TARGET ]] || die "the local run made no results/runs table"
@@ -285,7 +286,7 @@ fail_run() {  # fail_run NAME [ARGS...]: a run for TARGET; sets FAIL_RC, FAIL_MS
     local name=$1 dir=$TMP/fail-$1 log=$TMP/fail-$1.log t0
     shift
     cp -a "$TMP/slurm" "$dir"
-    rm -f "$dir/$TARGET" "$dir/$TARGET.sha256"
+    rm -rf "$dir/$TARGET" "$dir/$TARGET.sha256" "$dir/logs"  # no job log from the SLURM run
     say "failure run ($name): $TARGET in $dir, every SLURM job made to fail (limit ${FAIL_LIMIT_S} s)"
     t0=$(ms)
     FAIL_RC=0
@@ -306,6 +307,8 @@ fail_run() {  # fail_run NAME [ARGS...]: a run for TARGET; sets FAIL_RC, FAIL_MS
 
 fail_run alone --groups fd_domain=sims  # any RULE=GROUP pair that leaves simulate out
 ! grep -q "Group job" "$TMP/fail-alone.log" || die "the failure run (alone) submitted a group job"
+grep -qE "^Logfile logs/[^ ]+( not found\.|: empty file)$" "$TMP/fail-alone.log" ||
+    die "the failure run (alone) did not show its job's own log as missing or empty, before SLURM's"
 ALONE_RC=$FAIL_RC ALONE_MS=$FAIL_MS ALONE_RULES=$FAILED_RULES
 
 fail_run group
