@@ -66,7 +66,11 @@ onsuccess:
 onerror:
     for record in RUN_RECORDS:
         end_session(record)
+    from particle_entropy.pipeline.joblogs import unshown_job_logs
     from particle_entropy.pipeline.verify import disk_space_problems
 
+    # Snakemake's report stops at a failed job's first empty log: a SLURM job's error may follow it.
+    for line in unshown_job_logs(log):
+        print(line, file=sys.stderr)
     for problem in disk_space_problems((".", "results", ".snakemake")):
         print(problem, file=sys.stderr)

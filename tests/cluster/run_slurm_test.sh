@@ -4,10 +4,10 @@
 # Starts munged, slurmctld and slurmd on localhost from a configuration written to a temporary
 # directory (accounting off, as on the cluster of the issue), runs the tiny config once on this
 # machine and once through SLURM, compares every results/**/*.parquet table of the two runs
-# (identical apart from timing columns), then makes one submitted job fail and checks that
-# Snakemake notices and stops within FAIL_LIMIT_S seconds. Prints both wall times and the number
-# of SLURM jobs. Everything it starts is stopped by PID on exit and the temporary directory is
-# removed (KEEP=1 keeps it).
+# (identical apart from timing columns), then makes a submitted simulation fail (on its own and in
+# its group) and checks that Snakemake notices, stops within FAIL_LIMIT_S seconds and shows the
+# job's own error. Prints both wall times and the number of SLURM jobs. Everything it starts is
+# stopped by PID on exit and the temporary directory is removed (KEEP=1 keeps it).
 #
 # Needs root (slurmd launches jobs; missing Debian packages slurm-wlm and munge are installed with
 # apt-get) and about five minutes on two cores. Not collected by pytest. Run from any clone:
@@ -269,27 +269,57 @@ sys.exit(1 if problems or not names else 0)
 EOF
 
 # ---------------------------------------------------------------- a failing job is noticed
-# One simulation, submitted with PE_SLURM_TEST_FAIL set: its SLURM job exits non-zero on the node
-# (the srun above). With accounting off, Snakemake can only learn that from squeue, and must stop.
+# Runs for one simulation's table with PE_SLURM_TEST_FAIL set: every job they submit exits non-zero
+# on the node (the srun above), whichever rule it runs. With accounting off, Snakemake can only
+# learn that from squeue, and must stop, and show the job's own error (the srun's message, in
+# SLURM's log of the job). Each runs in a copy of the SLURM run without that table, so that the
+# simulation is the one job to run, whatever rule would come first in an empty folder. Two runs,
+# for the two ways a job is submitted: on its own (`--groups` on the command line replaces the
+# profile's groups, so the simulation is in none), where Snakemake lists SLURM's log after the
+# job's own log, missing here (the copy has no logs/) and so ending Snakemake's report; and in its
+# group, where SLURM's log comes first.
 # (A broken particle_entropy first on PYTHONPATH would not do: common.smk puts workflow/lib first.)
-TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | sort | head -n 1)
-say "failure run: $TARGET, its SLURM job made to fail (limit ${FAIL_LIMIT_S} s)"
-t0=$(ms)
-fail_rc=0
-PE_SLURM_TEST_FAIL=1 run_logged "$TMP/fail.log" timeout -k 30 "$((FAIL_LIMIT_S + 60))" \
-    "$PYTHON" -m snakemake --workflow-profile "$PROFILE" -s "$REPO/Snakefile" -d "$TMP/fail" \
-    "$TARGET" --configfile "$CONFIG" || fail_rc=$?
-FAIL_MS=$(($(ms) - t0))
-((fail_rc != 0)) || die "the run with a failing job exited 0"
-((fail_rc != 124)) || die "the run with a failing job did not stop within $((FAIL_LIMIT_S + 60)) s"
-((FAIL_MS <= FAIL_LIMIT_S * 1000)) || die "the failing job was noticed after $(secs "$FAIL_MS") s"
-grep -q "made to fail on purpose" "$TMP/fail.log" ||
-    { tail -n 40 "$TMP/fail.log"; die "the failure run ended without showing the job's own error"; }
+TARGET=$(cd "$TMP/local" && find results/runs -name '*.parquet' | LC_ALL=C sort | awk 'NR == 1')  # awk reads all: no SIGPIPE
+[[ -n $TARGET ]] || die "the local run made no results/runs table"
+
+fail_run() {  # fail_run NAME [ARGS...]: a run for TARGET; sets FAIL_RC, FAIL_MS and FAILED_RULES
+    local name=$1 dir=$TMP/fail-$1 log=$TMP/fail-$1.log t0
+    shift
+    cp -a "$TMP/slurm" "$dir"
+    rm -rf "$dir/$TARGET" "$dir/$TARGET.sha256" "$dir/logs"  # no job log from the SLURM run
+    say "failure run ($name): $TARGET in $dir, every SLURM job made to fail (limit ${FAIL_LIMIT_S} s)"
+    t0=$(ms)
+    FAIL_RC=0
+    PE_SLURM_TEST_FAIL=1 run_logged "$log" timeout -k 30 "$((FAIL_LIMIT_S + 60))" \
+        "$PYTHON" -m snakemake --workflow-profile "$PROFILE" -s "$REPO/Snakefile" -d "$dir" \
+        "$TARGET" "$@" --configfile "$CONFIG" || FAIL_RC=$?
+    FAIL_MS=$(($(ms) - t0))
+    FAILED_RULES=$(grep -oE "Error in rule [A-Za-z0-9_]+" "$log" | awk '{print $4}' | sort -u | paste -sd, -)
+    ((FAIL_RC != 0)) || die "the run with a failing job ($name) exited 0"
+    ((FAIL_RC != 124)) || die "the run with a failing job ($name) did not stop within $((FAIL_LIMIT_S + 60)) s"
+    ((FAIL_MS <= FAIL_LIMIT_S * 1000)) || die "the failing job ($name) was noticed after $(secs "$FAIL_MS") s"
+    grep -q "has been submitted with SLURM jobid" "$log" || { tail -n 40 "$log"; die "$name: no job was submitted"; }
+    [[ ,$FAILED_RULES, == *,simulate,* ]] ||
+        { tail -n 40 "$log"; die "the failure run ($name) failed in '$FAILED_RULES', not in the simulation"; }
+    grep -q "made to fail on purpose" "$log" ||
+        { tail -n 40 "$log"; die "the failure run ($name) ended without showing the job's own error"; }
+}
+
+fail_run alone --groups fd_domain=sims  # any RULE=GROUP pair that leaves simulate out
+! grep -q "Group job" "$TMP/fail-alone.log" || die "the failure run (alone) submitted a group job"
+grep -qE "^Logfile logs/[^ ]+( not found\.|: empty file)$" "$TMP/fail-alone.log" ||
+    die "the failure run (alone) did not show its job's own log as missing or empty, before SLURM's"
+ALONE_RC=$FAIL_RC ALONE_MS=$FAIL_MS ALONE_RULES=$FAILED_RULES
+
+fail_run group
+grep -q "Group job" "$TMP/fail-group.log" || die "the failure run (group) submitted no group job"
+
 FAILED=$(squeue -h --states=all -o "%i %T" | awk '$2 == "FAILED"' | wc -l)
-((FAILED >= 1)) || die "no FAILED job in squeue after the failure run"
+((FAILED >= 2)) || die "$FAILED FAILED jobs in squeue after the two failure runs (expected 2 or more)"
 
 # ---------------------------------------------------------------- report
 say "local run:  $(secs "$LOCAL_MS") s"
 say "SLURM run:  $(secs "$SLURM_MS") s, $SUBMITTED SLURM jobs submitted ($ACCEPTED accepted by slurmctld), ${JOBS_DONE:-?}"
-say "failing job noticed, Snakemake exited $fail_rc after $(secs "$FAIL_MS") s"
+say "failing job on its own ($ALONE_RULES) noticed, its error shown; Snakemake exited $ALONE_RC after $(secs "$ALONE_MS") s"
+say "failing job in a group ($FAILED_RULES) noticed, its error shown; Snakemake exited $FAIL_RC after $(secs "$FAIL_MS") s"
 say "PASS"
