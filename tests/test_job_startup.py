@@ -484,10 +484,13 @@ def test_a_kernels_folder_left_half_made_is_rebuilt(tmp_path, counted_build):
     root = tmp_path / "kernels"
     half = Path(compiled.kernels_folder(str(root)))
     half.mkdir(parents=True)
+    killed = half.with_name(f".{half.name}.99999999.tmp")  # a job killed while it built
+    killed.mkdir()
     (half / NAME).write_bytes(b"cut sh")  # killed before its record was written
     assert compiled.take(root)
     assert len(_builds(counted_build)) == 1 and (half / NAME).read_bytes() == b"a module"
     assert compiled.take(root) and len(_builds(counted_build)) == 1  # then taken as it is
+    assert not killed.exists()  # what a killed build left is cleared by the next one
 
 
 def test_a_failed_build_is_recorded_once_and_the_jobs_run_the_jit(tmp_path, monkeypatch, capsys):

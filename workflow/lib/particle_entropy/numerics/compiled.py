@@ -435,8 +435,9 @@ def take(root: str | os.PathLike = "results/kernels") -> bool:
             print(f"waiting for the compiled kernels in {folder} ...", file=sys.stderr)
             fcntl.flock(lock, fcntl.LOCK_EX)  # released when this process ends, killed or not
             if not _complete(folder) and not failed.exists():
+                for left in folder.parent.glob(f".{folder.name}.*.tmp"):  # of a job killed while building
+                    shutil.rmtree(left, ignore_errors=True)  # (no other can build it: we hold the lock)
                 tmp = folder.with_name(f".{folder.name}.{os.getpid()}.tmp")
-                shutil.rmtree(tmp, ignore_errors=True)
                 try:
                     how = provide(tmp)
                     shutil.rmtree(folder, ignore_errors=True)  # a folder of another build, unfinished
