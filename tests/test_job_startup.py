@@ -509,3 +509,42 @@ def test_a_failed_build_is_recorded_once_and_the_jobs_run_the_jit(tmp_path, monk
     assert "could not compile the kernels (OSError: no C compiler)" in err and "JIT" in err
     failed = Path(compiled.kernels_folder(str(root)) + compiled.FAILED_SUFFIX)
     assert "no C compiler" in failed.read_text()
+
+
+def test_an_unknown_cpu_runs_the_jit_without_building(tmp_path, counted_build, monkeypatch):
+    monkeypatch.setattr(compiled, "_cpu", lambda: None)  # no /proc/cpuinfo (macOS), or none of its fields
+    assert not compiled.take(tmp_path / "kernels") and not compiled.take(tmp_path / "kernels")
+    assert _builds(counted_build) == []  # a module built for no target could never be taken
+
+
+def test_a_file_system_without_locks_still_provides_the_kernels(tmp_path, counted_build, monkeypatch, capsys):
+    import errno
+
+    def no_locks(fd, op):
+        raise OSError(errno.ENOSYS, os.strerror(errno.ENOSYS))
+
+    monkeypatch.setattr("fcntl.flock", no_locks)
+    assert compiled.take(tmp_path / "kernels")  # built aside and renamed, not a failed job
+    assert len(_builds(counted_build)) == 1 and "no file lock" in capsys.readouterr().err
+
+
+def test_the_run_s_kernels_folders_are_not_group_writable_whatever_the_umask(tmp_path, counted_build):
+    old = os.umask(0o002)
+    try:
+        assert compiled.take(tmp_path / "kernels")
+    finally:
+        os.umask(old)
+    folder = Path(compiled.kernels_folder(str(tmp_path / "kernels")))
+    for f in (folder.parent, folder):
+        assert not stat.S_IMODE(f.stat().st_mode) & 0o022, f
+
+
+def test_no_home_folder_keeps_no_cache_copy(monkeypatch):
+    monkeypatch.delenv(compiled.CACHE_ENV, raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+
+    def homeless():
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.setattr(Path, "home", staticmethod(homeless))
+    assert compiled.cache_folder() is None

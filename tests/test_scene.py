@@ -558,3 +558,18 @@ def test_a_run_that_lost_mass_is_unscored(tmp_path):
     assert S.judged(scene, kept).iloc[0]["meets"]
     gained = S.judged(scene, runs.assign(mass_total=1.01)).iloc[0]  # mass from nowhere: not judged either
     assert gained["unscored"].startswith("mass gained: 0.01") and not gained["meets"]
+
+
+def test_a_wide_box_s_points_stay_on_its_plume_and_inside_the_window():
+    """A box's variance (b - a)^2 / 12 overstates its reach: [-5, 5] at D = 1e-3, t_final = 50 put its
+    points out to +- 12.3, 6 of 15 outside the FD grid, where every model scores 0 error."""
+    box = {**S_SMALL, "v": 0.0, "source": {"kind": "box", "a": -5.0, "b": 5.0}, "candidates": [S_FD]}
+    scene = Scene.from_config("b", box)
+    pts = scene.run_config(scene.candidates[0], 16).points(50.0)
+    reach = 5.0 + 3.0 * math.sqrt(4e-3 * 50.0)  # the box's edge plus 3 sqrt(4 D t_final)
+    from particle_entropy.core import measures as M
+
+    assert np.allclose(pts, M.measurement_points(2 * reach), rtol=0, atol=1e-12)  # the paper's 15, on that span
+    assert np.all(np.abs(pts) <= scene.fd_length / 2)  # every point on the FD grid
+    exact = scene.reference.density(pts)
+    assert exact.min() > 1e-6 * exact.max()  # and on the plume

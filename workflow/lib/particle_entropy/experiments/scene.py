@@ -161,9 +161,13 @@ class Scene:
 
     @property
     def points_span(self) -> float:
-        """The width the measurement points span: 2 REACH sqrt(2 variance) of the exact plume at
-        t_final, whatever the FD window (the paper's 12 at its t = 1000) [L]."""
-        return 2.0 * REACH * math.sqrt(2.0 * self.reference.variance)
+        """The width the measurement points span, whatever the FD window: 2 REACH sqrt(2 variance)
+        of the exact plume at t_final (the paper's 12 at its t = 1000), or the source's extent
+        widened by REACH sqrt(4 D t_final) each side where that is less (a wide box, whose variance
+        overstates its reach) [L]."""
+        by_variance = REACH * math.sqrt(2.0 * self.reference.variance)
+        by_extent = self.source.half_width + REACH * math.sqrt(4.0 * self.D * self.t_final)
+        return 2.0 * min(by_variance, by_extent)
 
     @property
     def peclet(self) -> float:

@@ -145,12 +145,16 @@ def cache_folder() -> Path | None:
     """The machine-wide copy of the module built for ``target()``, which every working directory
     of this user shares (as numba shares its own cache): under $PARTICLE_ENTROPY_KERNEL_CACHE, else
     $XDG_CACHE_HOME or ~/.cache + particle-entropy/kernels, a folder named ``target_key()``;
-    None where that variable is set empty or the CPU is unknown."""
+    None where that variable is set empty, the CPU is unknown or the user has no home folder."""
     root = os.environ.get(CACHE_ENV)
     if target() is None or root == "":
         return None
     if root is None:
-        root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "particle-entropy" / "kernels"
+        try:
+            home = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+        except RuntimeError:  # no HOME and no passwd entry: keep no machine-wide copy
+            return None
+        root = Path(home) / "particle-entropy" / "kernels"
     return Path(root) / target_key()
 
 
@@ -426,29 +430,57 @@ def take(root: str | os.PathLike = "results/kernels") -> bool:
     run then ends with exit 0 having made none of its targets."""
     import fcntl
     import shutil
+    import socket
 
     folder = Path(kernels_folder(str(root)))
+    if target() is None:  # no CPU to build for (no /proc/cpuinfo): nothing could ever be taken
+        print("compiled kernels: this CPU is unknown; numba's JIT runs them", file=sys.stderr)
+        return False
     failed = folder.with_name(folder.name + FAILED_SUFFIX)
     if not _complete(folder) and not failed.exists():
-        folder.parent.mkdir(parents=True, exist_ok=True)
+        _private_run_folder(folder.parent)
         with open(folder.with_name(f".{folder.name}.lock"), "a") as lock:
             print(f"waiting for the compiled kernels in {folder} ...", file=sys.stderr)
-            fcntl.flock(lock, fcntl.LOCK_EX)  # released when this process ends, killed or not
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX)  # released when this process ends, killed or not
+                locked = True
+            except OSError as error:  # a file system without locks (ENOSYS, ENOLCK): build aside
+                print(f"no file lock in {folder.parent} ({error.strerror}): building without one", file=sys.stderr)
+                locked = False
             if not _complete(folder) and not failed.exists():
-                for left in folder.parent.glob(f".{folder.name}.*.tmp"):  # of a job killed while building
-                    shutil.rmtree(left, ignore_errors=True)  # (no other can build it: we hold the lock)
-                tmp = folder.with_name(f".{folder.name}.{os.getpid()}.tmp")
-                try:
-                    how = provide(tmp)
-                    shutil.rmtree(folder, ignore_errors=True)  # a folder of another build, unfinished
-                    os.rename(tmp, folder)
-                    print(f"{how} the compiled kernels into {folder}", file=sys.stderr)
-                except Exception as error:  # no C compiler or Python headers: the JIT runs
-                    shutil.rmtree(tmp, ignore_errors=True)
-                    failed.write_text(f"{target()}error {type(error).__name__}: {error}\n")
-                    print(
-                        f"could not compile the kernels ({type(error).__name__}: {error}); "
-                        f"every job runs numba's JIT (delete {failed} to try again)",
-                        file=sys.stderr,
-                    )
+                if locked:  # what a job killed while building left (no other builds it: we hold the lock)
+                    for left in folder.parent.glob(f".{folder.name}.*.tmp"):
+                        shutil.rmtree(left, ignore_errors=True)
+                tmp = folder.with_name(f".{folder.name}.{socket.gethostname()}-{os.getpid()}.tmp")
+                _provide_into(folder, tmp, failed)
     return use(folder)
+
+
+def _private_run_folder(path: Path) -> None:
+    """``path`` made, writable by this user alone whatever the umask (others may read it)."""
+    path.mkdir(parents=True, exist_ok=True)
+    if path.stat().st_mode & 0o022 and path.stat().st_uid == os.getuid():
+        path.chmod(0o755)
+
+
+def _provide_into(folder: Path, tmp: Path, failed: Path) -> None:
+    """``provide`` into ``tmp``, then renamed to ``folder`` whole; a failure recorded in ``failed``."""
+    import shutil
+
+    try:
+        how = provide(tmp)
+        tmp.chmod(0o755)
+        shutil.rmtree(folder, ignore_errors=True)  # a folder of another build, unfinished or corrupt
+        os.rename(tmp, folder)
+        print(f"{how} the compiled kernels into {folder}", file=sys.stderr)
+    except Exception as error:  # no C compiler or Python headers: the JIT runs
+        shutil.rmtree(tmp, ignore_errors=True)
+        try:
+            failed.write_text(f"{target()}error {type(error).__name__}: {error}\n")
+            again = f" (delete {failed} to try again)"
+        except OSError:  # the record itself cannot be written: the next job tries again
+            again = ""
+        print(
+            f"could not compile the kernels ({type(error).__name__}: {error}); numba's JIT runs them{again}",
+            file=sys.stderr,
+        )
