@@ -127,15 +127,6 @@ def kernels_folder(root: str = "results/kernels") -> str:
     return f"{root}/{target_key()}"
 
 
-def built_here(folder: str | os.PathLike) -> bool:
-    """Whether ``folder``'s record says its module was built for ``target()`` (the digest is
-    checked only when it is loaded: ``use``)."""
-    try:
-        return json.loads((Path(folder) / RECORD).read_text())["target"] == target()
-    except (OSError, ValueError, KeyError, TypeError):
-        return False
-
-
 CACHE_ENV = "PARTICLE_ENTROPY_KERNEL_CACHE"  # the machine-wide copies' folder; empty: keep none
 RECORD = "module.json"  # beside the module, written last: its one file name, SHA-256 and target()
 IDENTITY = "code_key_words"  # a function of the module: the code_key() it was built from, in 8 words
