@@ -40,6 +40,9 @@ def _runs(plan: pd.DataFrame, law, negative=lambda ci, n: False) -> pd.DataFrame
                     "E": 1.0,
                     "E_analytic": 1.0,
                     "mass_min": -0.1 if negative(r.candidate, r.n) else 0.0,
+                    "negative_step": 3 if negative(r.candidate, r.n) else -1,
+                    "negative_t": 3.0 if negative(r.candidate, r.n) else math.nan,
+                    "negative_dt": 1.0 if negative(r.candidate, r.n) else math.nan,
                     "mass_total": 1.0,
                     "dV": 0.1,
                     "work": 100.0 * r.n,
@@ -109,7 +112,7 @@ def test_the_recommendation_is_the_cheapest_first_passing_rung_and_unscored_runs
     assert out["recommended"].sum() == 1
     best = out[out["recommended"]].iloc[0]
     assert best["method"] == "mtpt"
-    assert (out[out["candidate"] == 0]["unscored"].str.startswith("negative concentrations: grid Peclet")).all()
+    assert (out[out["candidate"] == 0]["unscored"].str.startswith("negative concentrations from step 3")).all()
     assert not out[out["candidate"] == 0]["meets"].any()
     assert out[out["comic_best"]].iloc[0]["method"] == "mtpt"
     assert out.loc[out["candidate"] == 0, "stopped"].iloc[0] == "not met within n_range"
@@ -282,3 +285,46 @@ def test_at_rest_twin_candidates_run_once_and_keep_their_index():
     assert (twin["stopped"] == "the same runs as candidates[0]: at v = 0 advection moves nothing").all()
     assert out["recommended"].sum() == 1 and out.loc[out["recommended"], "candidate"].iloc[0] != 1
     assert (out[out["candidate"] == 2]["method"] == "mtpt").all()
+
+
+def test_a_run_negative_mid_way_is_unscored_though_it_ends_positive(tmp_path):
+    """FD central at grid Peclet 2.75 (v 0.03, D 1e-4, n 512 on the Peclet sweep's window) goes
+    negative at its first step (-0.030 of the mass) and has smoothed it out by t_final (-3e-38): the
+    last step alone would score it. Caught at every step, it is unscored, naming the first step, the
+    minimum, the grid Peclet and Courant numbers."""
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.models.simulate import run
+
+    central = {"method": "fd", "kernel": "implicit", "advection": "central", "fd_dt": 1.0, "n_range": [64, 65536]}
+    spec = {"D": 1e-4, "v": 0.03, "t_final": 100.0, "target": {"value": 0.05}, "candidates": [central]}
+    scene = Scene.from_config("s", spec)
+    cfg = scene.run_config(scene.candidates[0], 512)
+    table, _ = run(cfg)
+    assert table["mass_min"].iloc[-1] > -S.NEGATIVE_TOLERANCE  # t_final alone looks clean
+    path = tmp_path / "runs.parquet"
+    write_parquet(table, path)
+    plan = pd.DataFrame([{"candidate": 0, "label": "", "n": 512, "first": 0, "last": 0, "round": 0}])
+    runs = S.read_runs(plan, [str(path)])
+    row = runs.iloc[0]
+    assert row["negative_step"] == 1 and row["negative_t"] == 1.0 and row["mass_min"] < -0.01
+    judged = S.judged(scene, runs).iloc[0]
+    assert not judged["meets"]
+    dx = cfg.fd_span()[1] / 512
+    assert judged["unscored"] == (
+        f"negative concentrations from step 1 (t = 1): minimum {row['mass_min']:.3g} of the total; "
+        f"grid Peclet {0.03 * dx / 1e-4:.3g} > 2, Courant {0.03 * 1.0 / dx:.3g}"
+    )
+
+
+def test_a_run_that_never_goes_negative_has_no_negative_step():
+    table = pd.DataFrame(
+        {"step": [0, 1, 2], "time": [0.0, 1.0, 2.0], "dt": [0.0, 1.0, 1.0], "mass_min": [0.0, -1e-13, 0.0]}
+    ).assign(mass_total=1.0)
+    assert S.negative_steps(table) == (
+        -1,
+        pytest.approx(math.nan, nan_ok=True),
+        pytest.approx(math.nan, nan_ok=True),
+        -1e-13,
+    )
+    table.loc[2, "mass_min"] = -2e-12
+    assert S.negative_steps(table)[:3] == (2, 2.0, 1.0)

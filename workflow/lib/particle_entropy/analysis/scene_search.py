@@ -25,7 +25,7 @@ from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 
 CLIMB = 2  # rungs climbed a round while no rung passes
 PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
-NEGATIVE_TOLERANCE = 1e-12  # a node mass below -this (of unit total) is a negative concentration
+NEGATIVE_TOLERANCE = 1e-12  # a node or particle mass below -this of the total, at any step, is a negative concentration
 # The most of its unit mass a run may lose (FD: through its window's zero ends) and still be judged.
 # H_C and E are computed on the mass left: a Gaussian that lost 1e-3 of its tails has an entropy
 # 0.007 nats (E 0.7 %) below the whole's, 1e-2 already 0.048. The window lets at most 2 erfc(3) =
@@ -48,7 +48,8 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "error_hi": "upper end of that interval",
     "error_upper95": "the mean's one-sided 95 % upper bound: the rung meets the target when it is <= `target`",
     "meets": "the rung is scored and `error_upper95` <= `target`",
-    "unscored": "why the rung cannot be judged (negative concentrations past grid Peclet 2; more than 1e-3 of "
+    "unscored": "why the rung cannot be judged (a concentration below -1e-12 of the total at any step: its "
+    "first such step, the minimum and, for FD in a flow, the grid Peclet and Courant numbers; more than 1e-3 of "
     "the mass lost through the FD window's ends, or gained; not run: over budget), else empty",
     "steps": "time steps of a run",
     "work": "particle-steps (FD node-steps) of a run, MTPT substeps counted",
@@ -78,15 +79,21 @@ def error(scene: Scene, row: pd.Series | dict) -> float:
 
 
 def unscored(scene: Scene, row) -> str:
-    """Why a run cannot be judged ('' if it can): negative concentrations (an FD central scheme past
-    grid Peclet 2) have no entropy, and a run whose mass at t_final is off its unit initial mass by
-    more than MASS_LOSS_MAX (a plume that left its FD window) has H_C and E of a remnant: neither is
-    ever chosen."""
-    if row["mass_min"] < -NEGATIVE_TOLERANCE:
-        dx = row["dV"]
-        peclet = abs(scene.v) * dx / scene.D
-        why = f"negative concentrations: grid Peclet {peclet:.3g}"
-        return why + (" > 2" if peclet > 2 else "")
+    """Why a run cannot be judged ('' if it can): a concentration below -NEGATIVE_TOLERANCE of the
+    total at any step (an unstable or oscillating scheme, e.g. FD central past grid Peclet 2: such a
+    state has no entropy, even if later steps smooth it out; read_runs finds the first), and a run
+    whose mass at t_final is off its unit initial mass by more than MASS_LOSS_MAX (a plume that left
+    its FD window) has H_C and E of a remnant: neither is ever chosen."""
+    if row["negative_step"] >= 0:
+        why = (
+            f"negative concentrations from step {int(row['negative_step']):,} (t = {row['negative_t']:.4g}): "
+            f"minimum {row['mass_min']:.3g} of the total"
+        )
+        if scene.candidates[int(row["candidate"])].case.method == "fd" and scene.v != 0.0:
+            dx = row["dV"]
+            peclet, courant = abs(scene.v) * dx / scene.D, abs(scene.v) * row["negative_dt"] / dx
+            why += f"; grid Peclet {peclet:.3g}{' > 2' if peclet > 2 else ''}, Courant {courant:.3g}"
+        return why
     lost = 1.0 - row["mass_total"]
     if not abs(lost) <= MASS_LOSS_MAX:
         what = "lost through the window's ends" if lost > 0 else "gained"
@@ -324,24 +331,44 @@ def plan_paths(scene: Scene, plan: pd.DataFrame) -> list[str]:
     ]
 
 
+def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
+    """(first step, its time and dt, smallest node or particle mass over every step) of one run's
+    table: the first step whose smallest mass is below -NEGATIVE_TOLERANCE of that step's total
+    (-1, NaN, NaN if none), so that a state that went negative and recovered by t_final is caught."""
+    low = table["mass_min"].to_numpy() < -NEGATIVE_TOLERANCE * table["mass_total"].abs().to_numpy()
+    smallest = float(table["mass_min"].min())
+    if not low.any():
+        return -1, math.nan, math.nan, smallest
+    first = table.iloc[int(np.argmax(low))]
+    return int(first["step"]), float(first["time"]), float(first["dt"]), smallest
+
+
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
-    """One row per run of a plan (``paths`` in its order): the last step's measures, the run's work
-    and its measured core-seconds (the sum of its steps' wall time)."""
-    keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_min", "mass_total"]
+    """One row per run of a plan (``paths`` in its order): the last step's measures, the smallest
+    mass over every step and its first negative step (negative_steps), the run's work and its
+    measured core-seconds (the sum of its steps' wall time)."""
+    keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_total"]
     keep += ["dV", "work"]
+    columns = ["candidate", "n", "seed", *keep, "mass_min", "negative_step", "negative_t", "negative_dt"]
     rows = []
     if plan.empty:  # every candidate over the budget: nothing ran
-        return pd.DataFrame(rows, columns=["candidate", "n", "seed", *keep, "steps", "core_s"])
+        return pd.DataFrame(rows, columns=[*columns, "steps", "core_s"])
     for r, path in zip(plan.itertuples(), paths):
         table = read_parquet(path)
         for seed, g in table.groupby("seed", sort=True):
-            last = g.loc[g["step"].idxmax()]
+            g = g.sort_values("step")
+            last = g.iloc[-1]
+            step, t, dt, smallest = negative_steps(g)
             rows.append(
                 {
                     "candidate": int(r.candidate),
                     "n": int(r.n),
                     "seed": int(seed),
                     **{k: float(last[k]) for k in keep},
+                    "mass_min": smallest,
+                    "negative_step": step,
+                    "negative_t": t,
+                    "negative_dt": dt,
                     "steps": float(last["step"]),
                     "core_s": float(g["wall_s"].sum()),
                 }
