@@ -40,10 +40,6 @@ def main(workdir: Path) -> None:
     print(f"snakemake -j2 scenes: {wall:.1f} s wall; {len(bench)} simulation jobs on record, {seconds:.1f} job-s")
     for table in sorted((workdir / "results/scenes").glob("*.parquet")):
         t = pd.read_parquet(table)
-        if table.stem == "peclet":  # the sweep's table (scene_search.peclet_table)
-            cross = crossover(t)
-            print(f"  Peclet sweep: particles overtake the grid at Pe in {cross}" if cross else "  no crossover")
-            continue
         best, comic = t[t["recommended"]], t[t["comic_best"]]
         head = f"{table.stem}: Peclet {t['peclet'].iloc[0]:,.0f}, {t['measure'].iloc[0]} <= {t['target'].iloc[0]:g}"
         if len(best):
@@ -54,7 +50,12 @@ def main(workdir: Path) -> None:
         c = comic.iloc[0] if len(comic) else None
         tail = f"; COMIC-best {c['label']}, n = {c['n']}" if c is not None else ""
         print(f"  {head}: {answer}{tail}")
-
+    sweep = workdir / "results/scenes_peclet.parquet"  # the sweep's table (scene_search.peclet_table)
+    if sweep.exists():
+        t = pd.read_parquet(sweep)
+        print(t.to_string())
+        cross = crossover(t)
+        print(f"  Peclet sweep: particles overtake the grid at Pe in {cross}" if cross else "  no crossover")
 
 if __name__ == "__main__":
     main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("scenes_run"))
