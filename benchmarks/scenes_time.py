@@ -57,5 +57,6 @@ def main(workdir: Path) -> None:
         cross = crossover(t)
         print(f"  Peclet sweep: particles overtake the grid at Pe in {cross}" if cross else "  no crossover")
 
+
 if __name__ == "__main__":
     main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("scenes_run"))
