@@ -573,3 +573,71 @@ def test_a_wide_box_s_points_stay_on_its_plume_and_inside_the_window():
     assert np.all(np.abs(pts) <= scene.fd_length / 2)  # every point on the FD grid
     exact = scene.reference.density(pts)
     assert exact.min() > 1e-6 * exact.max()  # and on the plume
+
+
+# --- issue 40: tvd advection and a step that follows the grid (courant) -----------------------------
+S_TVD = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.5, "n_range": [16, 256]}
+
+
+def test_identities_of_candidates_without_courant_are_unchanged():
+    """Digests of spec()'s candidates taken at 77a862f, before courant existed: frozen, since a run's
+    file is keyed by them."""
+    moving = Scene.from_config("s", spec(candidates=[FD, {**FD, "advection": "central", "fd_dt": 0.1}, MTPT]))
+    assert [moving.identity(c) for c in moving.candidates] == ["c7b20328ac6c", "d3855894c74e", "1f90db7bbccc"]
+    at_rest = Scene.from_config("s", spec(v=0.0))
+    assert [at_rest.identity(c) for c in at_rest.candidates] == ["a61c6cc525bb", "39998f06084d"]
+    assert all("courant" not in moving.settings(c) for c in moving.candidates)
+
+
+def test_a_courant_candidate_steps_with_its_grid():
+    got = Scene.from_config("s", small(candidates=[S_TVD, {**S_FD, "courant": 4.0}, S_FD]))
+    tvd, upwind, fixed = got.candidates
+    assert tvd.label == "fd implicit tvd Cr=0.5" and upwind.label == "fd implicit upwind Cr=4"
+    assert fixed.label == "fd implicit upwind dt=0.5"
+    assert got.settings(tvd)["courant"] == 0.5 and "dt0" not in got.settings(tvd)
+    assert len({got.identity(c) for c in got.candidates}) == 3
+    for n in (16, 32):
+        cfg = got.run_config(tvd, n)
+        assert cfg.dt0 == pytest.approx(0.5 * cfg.fd_span()[1] / n / 0.01)
+        assert cfg.courant_number() == pytest.approx(0.5)
+    # twice the intervals, twice the steps, four times the node-steps (fd cost: 3.85e-5 s a step, 1.72e-8 a node)
+    a, b = got.run_cost(tvd, 16), got.run_cost(tvd, 32)
+    steps = lambda n: math.ceil(50.0 / got.run_config(tvd, n).dt0 - 1e-9)  # noqa: E731
+    assert a == pytest.approx(3.85e-5 * steps(16) + 1.72e-8 * steps(16) * 17)
+    assert steps(32) == 2 * steps(16) and b > 1.9 * a
+
+
+def test_at_rest_a_courant_candidate_is_its_fd_dt_twin():
+    """Nothing to advect: courant is dropped, the step is fd_dt (its own or the default)."""
+    got = Scene.from_config("s", small(v=0.0, candidates=[S_FD, {**S_TVD, "fd_dt": 0.5}, {**S_TVD}]))
+    fd, tvd, default_step = got.candidates
+    assert tvd.courant is None and got.same_as(1) == 0 and got.identity(tvd) == got.identity(fd)
+    assert default_step.fd_dt == 0.05 and got.same_as(2) == 2 and default_step.label == "fd implicit dt=0.05"
+
+
+@pytest.mark.parametrize(
+    "candidate, key, says",
+    [
+        ({**S_PT, "courant": 0.5}, "scenes.s.candidates[0].courant", "fd candidates only"),
+        ({**S_TVD, "courant": 0.0}, "scenes.s.candidates[0].courant", "> 0"),
+        ({**S_FD, "courant": -1.0}, "scenes.s.candidates[0].courant", "> 0"),
+        ({**S_TVD, "courant": 1.01}, "scenes.s.candidates[0].courant", "<= 1 for advection tvd"),
+        ({**S_FD, "courant": 1e-9}, "scenes.s.candidates[0].courant", "10,000,000 steps"),
+        # fd_dt 0.5 at v 0.01: Cr = 0.005 / dx, above 1 once dx < 0.005, i.e. on the top rung of 1024
+        ({**S_FD, "advection": "tvd", "n_range": [16, 1024]}, "scenes.s.candidates[0].fd_dt", "at n = 1024"),
+        (
+            {k: v for k, v in S_TVD.items() if k != "courant"} | {"n_range": [16, 16384]},  # fd_dt 0.05
+            "scenes.s.candidates[0].fd_dt",
+            "<= 1",
+        ),
+    ],
+)
+def test_a_courant_number_a_candidate_cannot_take_is_refused_by_its_key(candidate, key, says):
+    err = _refused(small(candidates=[candidate]))
+    assert err.name == key and says in err.allowed, err
+
+
+def test_tvd_with_a_step_fixed_in_time_is_taken_while_its_courant_number_is_at_most_1():
+    got = Scene.from_config("s", small(candidates=[{**S_FD, "advection": "tvd", "n_range": [16, 512]}]))
+    top = got.run_config(got.candidates[0], 512)
+    assert 0.5 < top.courant_number() <= 1.0

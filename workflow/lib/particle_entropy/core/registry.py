@@ -90,6 +90,11 @@ TIME_GRIDS = ("exact", "authors")  # last step shortened to end at t_final, or w
 TRANSFER_METHODS = ("auto", "direct", "fgt", "taylor")
 LOOP_ARITHMETICS = ("fused", "exact")  # the authors' loop: fused multiply-adds, or bit for bit as before issue 20
 SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
+# FD's advection term in a flow (models/fd.py): implicit first-order upwind, implicit central, or
+# Leonard's explicit ULTIMATE-QUICKEST (tvd), which is stable and monotone only at a Courant number
+# |v| dt / dx of at most COURANT_LIMIT (the implicit two take any).
+ADVECTION_SCHEMES = ("upwind", "central", "tvd")
+COURANT_LIMIT = {"tvd": 1.0}
 # what an adaptive search minimises over N (aggregate.CONVENTIONS) and where it takes SSE (optimum.MEASURES)
 CONVENTION_NAMES = ("mean_COMIC", "COMIC_of_mean_SSE")
 MEASURE_NAMES = ("own", "points")

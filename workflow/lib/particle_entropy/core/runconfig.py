@@ -13,16 +13,18 @@ import numpy as np
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
 from .reference import Reference, Source
-from .registry import DEFAULT_KERNEL
+from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_KERNEL
 from .settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
 PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
-ADVECTION_SCHEMES = ("upwind", "central")  # FD's advection term (models/fd.py)
 # FD's fewest intervals: a node at the source's x = 0 (an even number) whose 3-point stencil reaches
 # an interior node on either side. With 2 the one interior node's neighbours are both zero ends: its
 # mass only drains into them (5 % by t = 1000 at the paper's settings) and never spreads (H_C stays 0).
 FD_MIN_INTERVALS = 4
+# a Courant number within this relative round-off of its limit is the limit: courant dx / |v| read
+# back as |v| dt / dx may differ from courant by an ulp or two
+COURANT_SLACK = 1e-12
 
 
 def check_setting(setting: Setting, value):
@@ -163,6 +165,8 @@ class RunConfig:
     v: float = 0.0
     advection: str = "upwind"
     window: float | None = None  # the measurement points' span: None = the paper's (at rest) or fd_length
+    # FD in a flow: the step that follows the grid, dt0 = courant dx / |v| (resolved()); None: dt0 as given
+    courant: float | None = None
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
@@ -241,9 +245,22 @@ class RunConfig:
         """A particle's sampling volume dV = Omega / N (the Delta V of Eqs. 5-9; the bin width of Eq. 11)."""
         return self.omega / self.n
 
+    @property
+    def fd_dx(self) -> float:
+        """The FD grid's spacing: fd_length / N at rest, else the span's length / N (grid) [L]."""
+        return (self.fd_length if self.at_rest else self.fd_span()[1]) / self.n
+
+    def courant_number(self) -> float:
+        """|v| dt0 / dx on the FD grid: the cells the plume crosses in the largest step (FD's step is
+        fixed; the exact grid only shortens the last) [-]."""
+        return abs(self.v) * self.dt0 / self.fd_dx
+
     def resolved(self) -> RunConfig:
-        """Fill the first step (first_step) and check every setting."""
-        if self.dt0 is None:
+        """Fill the first step (first_step; FD with a courant: courant dx / |v|) and check every setting."""
+        if self.courant is not None:
+            self._check_courant()
+            cfg = replace(self, dt0=self.courant * self.fd_dx / abs(self.v))
+        elif self.dt0 is None:
             dt0 = first_step(self.method, self.dt_growth)
             cfg = replace(self, dt0=dt0)
         else:
@@ -269,6 +286,15 @@ class RunConfig:
                 "seed", self.seed, f"an integer in [0, 2^63 - 1 = {MAX_SEED}] (tables store it as int64)"
             )
         steps = step_count(self.t_final, self.dt0, self.dt_growth)
+        if steps > MAX_STEPS and self.courant is not None:
+            self._check_courant()
+            least = max_first_step(self.t_final, 1.0) * abs(self.v) / self.fd_dx
+            raise SettingError(
+                "courant",
+                self.courant,
+                f"a Courant number >= {least:.3g} at n = {self.n}: a step courant dx / |v| reaching t_final = "
+                f"{self.t_final:g} in at most {MAX_STEPS:,} steps (this one needs {count_text(steps)})",
+            )
         if steps > MAX_STEPS:
             raise SettingError(
                 "dt0",
@@ -288,6 +314,9 @@ class RunConfig:
             raise SettingError("advection", self.advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
         self._check_reference()
         self._check_resolution()
+        if self.courant is not None:
+            self._check_courant()
+        self._check_courant_limit()
         if self.method == "fd" and self.kernel == "explicit" and self.v != 0.0:
             raise SettingError(
                 "kernel",
@@ -312,6 +341,41 @@ class RunConfig:
                 self.transfer_method,
                 "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)",
             )
+
+    def _check_courant(self) -> None:
+        """Refuse a courant outside FD in a flow, or not a number > 0."""
+        ok = isinstance(self.courant, (int, float)) and not isinstance(self.courant, bool)
+        if not (ok and 0.0 < self.courant < math.inf):
+            raise SettingError("courant", self.courant, "a number > 0: the step's Courant number |v| dt / dx")
+        if self.method != "fd" or self.v == 0.0:
+            raise SettingError(
+                "courant",
+                self.courant,
+                f"no courant for {self.method} at v = {self.v:g}: fd in a flow (v != 0) only, its step following "
+                "its grid",
+            )
+
+    def _check_courant_limit(self) -> None:
+        """Refuse an FD step beyond its advection scheme's Courant limit (registry.COURANT_LIMIT: the
+        explicit tvd scheme's |v| dt / dx <= 1, to round-off), naming courant, or else fd_dt."""
+        limit = COURANT_LIMIT.get(self.advection)
+        if self.method != "fd" or self.v == 0.0 or limit is None:
+            return
+        cr = self.courant_number()
+        if cr <= limit or math.isclose(cr, limit, rel_tol=COURANT_SLACK):
+            return
+        why = (
+            f"advection {self.advection} is explicit: stable and monotone only at a Courant number |v| dt / dx "
+            f"<= {limit:g}"
+        )
+        if self.courant is not None:
+            raise SettingError("courant", self.courant, f"a number in (0, {limit:g}]: {why}")
+        raise SettingError(
+            "fd_dt",
+            self.dt0,
+            f"a step <= {limit * self.fd_dx / abs(self.v):.6g} at n = {self.n} (dx = {self.fd_dx:.6g}, |v| = "
+            f"{abs(self.v):g}): {why}, and this one gives {cr:.6g}; or set courant instead of fd_dt",
+        )
 
     def _check_reference(self) -> None:
         """Refuse settings under which the Gaussian reference (Eq. 2) cannot be computed or an FD

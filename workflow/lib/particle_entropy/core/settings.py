@@ -22,7 +22,9 @@ import math
 from dataclasses import dataclass
 
 from .registry import (
+    ADVECTION_SCHEMES,
     CONVENTION_NAMES,
+    COURANT_LIMIT,
     FGT_TOLERANCE,
     FGT_TOLERANCE_RANGE,
     LOOP_ARITHMETICS,
@@ -749,8 +751,9 @@ CANDIDATE_SHAPE = {
             "truncation": _ref("truncation"),
             "dt_growth": _ref("dt_growth"),
             "scheme": _ref("scheme"),
-            "advection": {"type": "string", "enum": ["upwind", "central"]},
+            "advection": {"type": "string", "enum": list(ADVECTION_SCHEMES)},
             "fd_dt": {"type": "number", "exclusiveMinimum": 0},
+            "courant": {"type": "number", "exclusiveMinimum": 0},
             "n_range": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2, "maxItems": 2},
             "ladder": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2},
         },
@@ -860,8 +863,11 @@ SCENE = (
         "scenes.<name>.candidates",
         NO_DEFAULT,
         "the models to compare: method, kernel and case dimensions, n_range [low, high] (particles or FD "
-        "intervals) or a ladder of its own [n1, n2, ...]; FD candidates may set advection (upwind, central) "
-        "and fd_dt",
+        f"intervals) or a ladder of its own [n1, n2, ...]; FD candidates may set advection "
+        f"({', '.join(ADVECTION_SCHEMES)}) and a step fixed in time, fd_dt, or, in a flow, one that follows the "
+        "grid, courant (dt = courant dx / |v|, > 0; "
+        + ", ".join(f"<= {limit:g} for {scheme}" for scheme, limit in COURANT_LIMIT.items())
+        + "; at v = 0 fd_dt is used)",
         kind="shape",
         shape=CANDIDATE_SHAPE,
         range_text="a list of models, each with 2 <= n_range low < high, or a ladder of ascending integers >= 2",

@@ -16,7 +16,8 @@ from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
-from ..core.runconfig import ADVECTION_SCHEMES, RunConfig, check_plume_width, check_setting
+from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT
+from ..core.runconfig import RunConfig, check_plume_width, check_setting
 from ..core.settings import BY_KEY, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
@@ -61,7 +62,7 @@ def _number(x: float) -> str:
 @dataclass(frozen=True)
 class Candidate:
     """One model a scene compares: a case without N, its resolution range, and FD's advection scheme
-    and time step."""
+    and time step: fixed (fd_dt) or following the grid (courant: dt = courant dx / |v|, in a flow)."""
 
     case: Case
     n_lo: int
@@ -69,6 +70,7 @@ class Candidate:
     advection: str = "upwind"  # "none" in a scene without flow
     fd_dt: float = PAPER["fd_dt"]
     rungs: tuple[int, ...] = ()  # a ladder written out (config `ladder`) instead of n_range's
+    courant: float | None = None  # FD in a flow: the step's Courant number instead of fd_dt
 
     @property
     def label(self) -> str:
@@ -76,7 +78,8 @@ class Candidate:
         c = self.case
         if c.method == "fd":
             scheme = "" if self.advection == "none" else f" {self.advection}"
-            return f"fd {c.kernel}{scheme} dt={_number(self.fd_dt)}"
+            step = f"dt={_number(self.fd_dt)}" if self.courant is None else f"Cr={_number(self.courant)}"
+            return f"fd {c.kernel}{scheme} {step}"
         words = [c.method, c.kernel]
         if c.method == "mtpt":
             words.append(f"eta={_number(c.eta)}")
@@ -93,7 +96,7 @@ class Candidate:
     @property
     def model(self) -> tuple:
         """What makes two candidates the same model: the case, FD's scheme and step."""
-        return (self.case, self.advection, self.fd_dt)
+        return (self.case, self.advection, self.fd_dt, self.courant)
 
     def ladder(self) -> list[int]:
         """The resolutions the search may visit: n_lo, n_lo r, n_lo r^2, ... up to n_hi (r = LADDER_RATIO,
@@ -186,7 +189,10 @@ class Scene:
             "window": self.points_span,  # the measurement points span the plume, at rest too
         }
         if candidate.case.method == "fd":
-            out["dt0"] = candidate.fd_dt
+            if candidate.courant is None:
+                out["dt0"] = candidate.fd_dt
+            else:  # only when set: the runs of a candidate without it keep their identity
+                out["courant"] = candidate.courant
             if self.v != 0.0:
                 out["advection"] = candidate.advection
         return out
@@ -226,8 +232,9 @@ class Scene:
             raise SettingError(_key(name, "candidates"), raw, "a list of at least one model")
         cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(raw))
         _distinct(name, cands)
-        if v == 0:  # nothing to advect: FD's scheme is no part of the runs; twins keep their index (same_as)
-            cands = tuple(replace(c, advection="none") for c in cands)
+        if v == 0:  # nothing to advect: FD's scheme and Courant number are no part of the runs (the step is
+            # fd_dt, its own or the default); twins keep their index (same_as)
+            cands = tuple(replace(c, advection="none", courant=None) for c in cands)
         cost = _cost(name, spec.get("cost"))
         scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost, budget)
         _check_reach(scene)
@@ -310,6 +317,8 @@ def _candidate_error(scene: Scene, i: int, spec: Mapping, e: SettingError) -> Se
         key = "ladder" if cand.rungs else "n_range"
         value = list(cand.rungs) if cand.rungs else [cand.n_lo, cand.n_hi]
         return SettingError(scene.key(f"{where}.{key}"), value, e.allowed)
+    if e.name == "courant":
+        return SettingError(scene.key(f"{where}.courant"), e.value, e.allowed)
     if e.name == "dt0" and cand.case.method == "fd" and "fd_dt" in spec:
         return SettingError(scene.key(f"{where}.fd_dt"), e.value, e.allowed)
     if e.name == "dt0":  # a step the scene does not set: the time it must reach is the key
@@ -413,7 +422,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     if not isinstance(spec, Mapping):
         raise SettingError(_key(name, where), spec, "a model: method, kernel, n_range and its dimensions")
     spec = dict(spec)
-    fd_only = [k for k in ("advection", "fd_dt") if k in spec]
+    fd_only = [k for k in ("advection", "fd_dt", "courant") if k in spec]
     if "ladder" in spec:
         rungs = spec.pop("ladder")
         ok = isinstance(rungs, list) and len(rungs) >= 2 and "n_range" not in spec
@@ -428,6 +437,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     n_range = spec.pop("n_range", None)
     advection = spec.pop("advection", "upwind")
     fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
+    courant = spec.pop("courant", None)
     ok = (
         isinstance(n_range, list)
         and len(n_range) == 2
@@ -446,6 +456,14 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
     if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
         raise SettingError(_key(name, f"{where}.fd_dt"), fd_dt, "a number > 0 [T]")
+    if courant is not None:
+        ok = isinstance(courant, (int, float)) and not isinstance(courant, bool)
+        limit = COURANT_LIMIT.get(advection, math.inf)
+        if not (ok and 0 < courant < math.inf and courant <= limit):
+            most = "" if limit == math.inf else f" and <= {limit:g} for advection {advection} (explicit)"
+            raise SettingError(
+                _key(name, f"{where}.courant"), courant, f"a number > 0{most}: the step's Courant number |v| dt / dx"
+            )
     if spec.get("time_grid", "exact") != "exact":
         raise SettingError(_key(name, f"{where}.time_grid"), spec["time_grid"], SCENE_TIME_GRID_TEXT)
     # case_defaults' time_grid is the paper figures': a scene's runs end at t_final, where they are judged
@@ -456,12 +474,12 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
         raise SettingError(_key(name, f"{where}.{e.name}"), e.value, e.allowed) from None
     if case.method != "fd" and fd_only:
         key = fd_only[0]
-        raise SettingError(
-            _key(name, f"{where}.{key}"), advection if key == "advection" else fd_dt, "fd candidates only"
-        )
+        value = {"advection": advection, "fd_dt": fd_dt, "courant": courant}[key]
+        raise SettingError(_key(name, f"{where}.{key}"), value, "fd candidates only")
     if case.method == "fd" and any(n % 2 for n in rungs):
         raise SettingError(_key(name, f"{where}.ladder"), rungs, "for fd even numbers of intervals")
-    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt), tuple(rungs))
+    courant = None if courant is None else float(courant)
+    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt), tuple(rungs), courant)
 
 
 class Scenes(Mapping):
