@@ -14,12 +14,13 @@ from ..numerics.kernels import h_de
 
 
 def reconstruction_width(cfg: RunConfig, t: float) -> float:
-    """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23)."""
+    """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23) of the plume's
+    variance (the source's plus 2 D t)."""
     if cfg.kernel == "bins":
         return cfg.dV
     if cfg.kernel == "fixed":
         return math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
-    return h_de(cfg.n, cfg.D, t)
+    return h_de(cfg.n, cfg.reference(t).variance)
 
 
 def bin_density(x: np.ndarray, dx: float, origin: float):
