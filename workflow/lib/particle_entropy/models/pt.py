@@ -62,7 +62,7 @@ def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
     if cfg.kernel == "bins":
         pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         return pts, f, h, h
-    if h == 0.0:  # adaptive kernel at t = 0: the reconstruction is the particles' delta
+    if h == 0.0:  # a point's adaptive kernel at t = 0: the reconstruction is the particles' delta
         return np.zeros(1), np.ones(1), 1.0, 0.0
     pts, spacing = kernel_grid(x_sorted, h, cfg.D, t)
     return pts, kernel_density(pts, x_sorted, h), spacing, h

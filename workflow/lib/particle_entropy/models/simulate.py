@@ -69,9 +69,9 @@ def warm_up(cfg: RunConfig) -> None:
     if key not in _WARM:
         _model(cfg.method).warm_up(cfg)
         _WARM.add(key)
-    if cfg.source.kind not in _WARM:
+    if ("reference", cfg.source.kind) not in _WARM:
         reference.warm_up(cfg.source)
-        _WARM.add(cfg.source.kind)
+        _WARM.add(("reference", cfg.source.kind))
 
 
 def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:
