@@ -181,3 +181,161 @@ def test_source_masses_sum_to_one_and_a_narrow_box_takes_one_node():
 def test_bad_sources_are_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
         Source(**kwargs)
+
+
+# box_entropy at main 77a862f (its Gauss-Legendre quadrature in x, rebuilt every call), rows: width
+_OLD_WIDTHS = (1e-300, 1e-16, 1e-8, 1e-3, 0.1, 0.5, 1.0, 3.0, 1e3, 1e100)
+_OLD_DTS = (1e-300, 1e-30, 1e-12, 1e-6, 1e-3, 0.05, 1.0, 1e3, 1e12, 1e300)
+_OLD_BOX_ENTROPY = (
+    (
+        -343.6222518256222,
+        -32.77326427142604,
+        -12.049998434479628,
+        -5.142243155497491,
+        -1.6883655160064226,
+        0.26764598670764994,
+        1.7655121234846451,
+        5.219389762975714,
+        15.581022681448918,
+        347.15327607259144,
+    ),
+    (
+        -36.841361487904734,
+        -32.773055981483424,
+        -12.049998434479628,
+        -5.142243155497491,
+        -1.6883655160064228,
+        0.26764598670764994,
+        1.7655121234846451,
+        5.219389762975714,
+        15.581022681448918,
+        347.15327607259144,
+    ),
+    (
+        -18.420680743952367,
+        -18.4206804884896,
+        -12.049996351150634,
+        -5.142243155495407,
+        -1.6883655160064208,
+        0.26764598670764994,
+        1.7655121234846454,
+        5.219389762975714,
+        15.581022681448918,
+        347.15327607259144,
+    ),
+    (
+        -6.907755278982137,
+        -6.9077552789795815,
+        -6.905200651280638,
+        -5.1218322352991885,
+        -1.6883446831071056,
+        0.2676464033741429,
+        1.765512144317978,
+        5.2193897629965464,
+        15.581022681448916,
+        347.15327607259144,
+    ),
+    (
+        -2.3025850929940455,
+        -2.30258509299402,
+        -2.302559546717031,
+        -2.2770388159790516,
+        -1.5144697306455075,
+        0.27179538797502384,
+        1.7657204134272515,
+        5.219389971309003,
+        15.581022681448918,
+        347.15327607259144,
+    ),
+    (
+        -0.6931471805599453,
+        -0.6931471805599401,
+        -0.6931420713045422,
+        -0.6880379251569465,
+        -0.5315783383499665,
+        0.3622390358554223,
+        1.770693516663467,
+        5.219394971281919,
+        15.581022681448921,
+        347.15327607259144,
+    ),
+    (
+        0.0,
+        2.55565521443195e-15,
+        2.5546277015012013e-06,
+        0.002554627701499429,
+        0.08078442110498946,
+        0.5689953126499911,
+        1.7859230436829483,
+        5.219410595875031,
+        15.581022681448939,
+        347.15327607259144,
+    ),
+    (
+        1.0986122886681098,
+        1.0986122886681107,
+        1.098613140210677,
+        1.0994638312352762,
+        1.1255404290364397,
+        1.2890229952597918,
+        1.9245518078651367,
+        5.219577227828249,
+        15.581022681449106,
+        347.15327607259144,
+    ),
+    (
+        6.907755278982137,
+        6.907755278982137,
+        6.907755281536764,
+        6.907757833609839,
+        6.907836063403242,
+        6.908326511101912,
+        6.910309906683636,
+        6.988539700087126,
+        15.581022702282251,
+        347.15327607259144,
+    ),
+    (
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        230.25850929940458,
+        347.15327607259144,
+    ),
+)
+
+
+@pytest.mark.parametrize("i, width", list(enumerate(_OLD_WIDTHS)))
+def test_box_entropy_equals_the_old_quadrature_to_round_off(i, width):
+    """The rule built once in u = x / s, and the closed form of a box many s wide, give the old
+    values to 1e-13 of the terms summed (|H| + |ln width|), from dt = 1e-300 to 1e300 and widths
+    1e-300 to 1e100; 1e-16 absolute where the old nodes in x could not resolve s at the box's edge
+    (width 1, dt <= 1e-12: the old was off by ~1e-18, the closed form is exact)."""
+    for dt, old in zip(_OLD_DTS, _OLD_BOX_ENTROPY[i]):
+        new = box_entropy(width, dt)
+        assert abs(new - old) <= 1e-13 * (abs(old) + abs(math.log(width))) + 1e-16, (width, dt, old, new)
+
+
+def test_a_box_many_widths_of_spread_wide_gains_k_s_over_width():
+    """Where the edges spread apart (h = width / (2 s) >= 12, s = sqrt(4 D t)) the entropy is
+    ln(width) + K s / width, K = integral of -erfc ln erfc + 2 ln 2 [v < 0] dv (scipy's quad here),
+    and the quadrature just below h = 12 agrees with it."""
+
+    def inner(v):
+        e = math.erfc(v)
+        return -e * math.log(e) + 2.0 * math.log(2.0)
+
+    K = quad(inner, -np.inf, 0.0)[0] + quad(lambda v: -math.erfc(v) * math.log(math.erfc(v)), 0.0, 27.0)[0]
+    for dt in (1e-300, 1e-30, 1e-12, 1e-6, 1.5e-4):
+        s = math.sqrt(4.0 * dt)
+        assert box_entropy(1.0, dt) == pytest.approx(K * s, rel=1e-12, abs=0)
+        if dt >= 1e-6:  # below, K s / 3 is lost to ln 3's round-off
+            assert box_entropy(3.0, dt) - math.log(3.0) == pytest.approx(K * s / 3.0, rel=1e-9, abs=0)
+    edge = (0.5 / 12.0) ** 2 / 4.0  # dt at h = 12 for width 1
+    below, above = box_entropy(1.0, edge * (1 + 1e-12)), box_entropy(1.0, edge * (1 - 1e-12))
+    assert below == pytest.approx(above, rel=1e-12, abs=0)

@@ -113,7 +113,7 @@ def _final_errors(cfg_kwargs, seeds):
 def test_adaptive_pt_matches_analytic_h_c_at_late_time(n):
     errs = _final_errors(dict(method="pt", kernel="adaptive", n=n), range(N_SEEDS_PT))
     mean, se = ensemble_stats(errs)
-    kde_offset = 0.5 * math.log(1.0 + h_de(n, D, T) ** 2 / (2 * D * T))
+    kde_offset = 0.5 * math.log(1.0 + h_de(n, 2 * D * T) ** 2 / (2 * D * T))
     assert abs(mean - kde_offset) <= 4 * se + 0.01, (mean, se, kde_offset)
     assert abs(mean) <= 4 * se + kde_offset + 0.01
 

@@ -69,8 +69,9 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "beta": "mass-transfer coefficient of the step: 1/2 for the collision kernel, 2 η D dt / h² for SPH (Eq. 20); "
     "0 for PT, FD and steps without transfer",
     "h": "width of the step's kernel: MTPT the transfer kernel's standard deviation (collision sqrt(4 η D dt), "
-    "Eq. 17; SPH h_SPH, Eq. 26; for `compensated` the widened width); PT the bin width Ω/N (Eq. 11), the fixed "
-    "kernel sqrt(2 D t_fix) or h_DE (Eq. 23, 0 at t = 0); FD dx [L]",
+    "Eq. 17; SPH h_SPH, Eq. 26, of the plume's variance; for `compensated` the widened width); PT the bin width "
+    "Ω/N (Eq. 11), the fixed kernel sqrt(2 D t_fix) or h_DE (Eq. 23) of the plume's variance (the source's plus "
+    "2 D t: 0 at t = 0 for a point); FD dx [L]",
     "substeps": "mass-transfer substeps the step was split into to keep masses non-negative (1: not split; PT and "
     "FD 1)",
     "settled": "t > dV² / (4 π e D): from here on the analytic H_C is meaningful (Section 3)",

@@ -38,7 +38,7 @@ def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
         return 0.0, 0.0
     if cfg.kernel == "collision":
         return collision_sigma(cfg.eta, cfg.D, dt), 0.5
-    h = h_sph(cfg.n, cfg.omega, cfg.D, t_end, SCHEME_RECORDS[cfg.scheme].sph_constant)
+    h = h_sph(cfg.n, cfg.omega, cfg.reference(t_end).variance, SCHEME_RECORDS[cfg.scheme].sph_constant)
     return h, beta_sph(cfg.eta, cfg.D, dt, h)
 
 

@@ -14,12 +14,13 @@ from ..numerics.kernels import h_de
 
 
 def reconstruction_width(cfg: RunConfig, t: float) -> float:
-    """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23)."""
+    """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23) of the plume's
+    variance (the source's plus 2 D t)."""
     if cfg.kernel == "bins":
         return cfg.dV
     if cfg.kernel == "fixed":
         return math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
-    return h_de(cfg.n, cfg.D, t)
+    return h_de(cfg.n, cfg.reference(t).variance)
 
 
 def bin_density(x: np.ndarray, dx: float, origin: float):
@@ -61,7 +62,7 @@ def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
     if cfg.kernel == "bins":
         pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         return pts, f, h, h
-    if h == 0.0:  # adaptive kernel at t = 0: the reconstruction is the particles' delta
+    if h == 0.0:  # a point's adaptive kernel at t = 0: the reconstruction is the particles' delta
         return np.zeros(1), np.ones(1), 1.0, 0.0
     pts, spacing = kernel_grid(x_sorted, h, cfg.D, t)
     return pts, kernel_density(pts, x_sorted, h), spacing, h

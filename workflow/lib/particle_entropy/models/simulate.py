@@ -10,6 +10,7 @@ import numpy as np
 import pyarrow as pa
 
 from ..core import measures as M
+from ..core import reference
 from ..core.records import Recorder, arrow_table
 from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
@@ -62,11 +63,15 @@ def _model(method: str):
 
 def warm_up(cfg: RunConfig) -> None:
     """Load the compiled kernels this case calls (numba's on-disk cache, ~0.05-0.4 s once per
-    process) before the timed steps, so that step 1's wall time is the step's own."""
-    key = (cfg.method, cfg.kernel, cfg.scheme, cfg.transfer_method, cfg.truncation is None)
+    process) and what its exact solution is computed with before the timed steps, so that step 0's
+    and step 1's wall times are the steps' own."""
+    key = (cfg.method, cfg.kernel, cfg.scheme, cfg.transfer_method, cfg.truncation is None, cfg.v != 0.0)
     if key not in _WARM:
         _model(cfg.method).warm_up(cfg)
         _WARM.add(key)
+    if ("reference", cfg.source.kind) not in _WARM:
+        reference.warm_up(cfg.source)
+        _WARM.add(("reference", cfg.source.kind))
 
 
 def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:

@@ -22,14 +22,16 @@ def collision_sigma(eta: float, D: float, dt: float) -> float:
     return math.sqrt(4.0 * eta * D * dt)
 
 
-def h_de(n: int, D: float, t: float) -> float:
-    """Density-estimation bandwidth h_DE = 1.06 N^(-1/5) sqrt(2 D t) (Eq. 23)."""
-    return 1.06 * n ** (-0.2) * math.sqrt(2.0 * D * t)
+def h_de(n: int, variance: float) -> float:
+    """Density-estimation bandwidth h_DE = 1.06 N^(-1/5) sqrt(variance) (Eq. 23), ``variance`` the
+    plume's (Reference.variance): 2 D t from the paper's point, plus the source's own."""
+    return 1.06 * n ** (-0.2) * math.sqrt(variance)
 
 
-def h_sph(n: int, omega: float, D: float, t: float, constant: float = SPH_CONSTANT) -> float:
-    """Adaptive SPH bandwidth h_SPH = 0.82 (2 D t)^(2/5) (N / Omega)^(-1/5) (Eq. 26; registry.SPH_CONSTANT)."""
-    return constant * (2.0 * D * t) ** 0.4 * (n / omega) ** (-0.2)
+def h_sph(n: int, omega: float, variance: float, constant: float = SPH_CONSTANT) -> float:
+    """Adaptive SPH bandwidth h_SPH = 0.82 variance^(2/5) (N / Omega)^(-1/5) (Eq. 26; registry.SPH_CONSTANT),
+    ``variance`` the plume's (Reference.variance): 2 D t from the paper's point, plus the source's own."""
+    return constant * variance**0.4 * (n / omega) ** (-0.2)
 
 
 def beta_sph(eta: float, D: float, dt: float, h: float) -> float:
