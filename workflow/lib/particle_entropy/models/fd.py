@@ -230,7 +230,9 @@ def measure(cfg: RunConfig, x: np.ndarray, c: np.ndarray, dx: float, t: float) -
 
 
 def warm_up(cfg: RunConfig) -> None:
-    """Load the compiled solver, and LAPACK's where the case advects, before the timed steps."""
+    """Load the compiled solver, and LAPACK's where the case advects implicitly, before the timed steps."""
     ImplicitSolver(8, 0.1).solve(np.ones(8))
     if cfg.v != 0.0:
-        AdvectionSolver(8, 0.1, 0.1, cfg.advection).solve(np.ones(8))
+        (TVDSolver(8, 0.1, 0.1) if cfg.advection == "tvd" else AdvectionSolver(8, 0.1, 0.1, cfg.advection)).solve(
+            np.ones(8)
+        )
