@@ -1,12 +1,17 @@
 """The cheapest model of a scene (experiments/scene.py) that reaches its accuracy, and the COMIC-best.
 
-For each candidate, a root search on its ladder of resolutions (Candidate.ladder) for the smallest
-one whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
-s / sqrt(R) of R realisations (FD is deterministic: one run, its error). Errors fall with
-resolution up to noise, so the search climbs the ladder two rungs (a factor of about 4) at a time
-until a rung passes, then halves the gap between the highest failing and the lowest passing rung
-until they are neighbours. Each round is a Snakemake checkpoint whose plan names the runs to make;
-the path depends on the config and the errors only, never on timings.
+For each candidate, the smallest rung of its affordable ladder (Candidate.ladder, within the budget)
+whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
+s / sqrt(R) of R realisations (FD is deterministic: one run, its error). The answer is the brute
+force's, as if every rung had run: errors need not fall with n (noise; FD central's error can rise
+with it). A particle rung whose interval straddles the target (mean - t_0.95 se < target < mean +
+t_0.95 se) gets another block of ``realisations`` seeds until it falls on one side or reaches
+``max_realisations`` (state): its final state depends on its own seeds only. The search climbs CLIMB
+rungs a round until a rung passes (or the top is reached), then runs in one round every unvisited
+rung below the lowest pass (on a ratio-2 ladder they cost about what that rung does), refining
+straddling rungs that can still be the answer in the same rounds; it stops once every rung below
+the lowest pass has run and settled (_next_rungs). Each round is a Snakemake checkpoint whose plan
+names the run tables to make; the path depends on the config and the errors only, never on timings.
 
 Costs are counted, not timed: work (particle- or node-steps, the run tables' ``work``) times the
 scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work); the
@@ -42,7 +47,9 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
     "method": "fd, pt or mtpt",
     "n": "the resolution: particles, or FD intervals",
-    "realisations": "runs averaged (FD: 1, deterministic; 0: not run, its first rung over the budget)",
+    "realisations": "runs averaged, over every seed block run (particles: a multiple of the scene's `realisations`, "
+    "more where the interval straddled the target, at most `max_realisations`; FD: 1, deterministic; 0: not run, "
+    "its first rung over the budget)",
     "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
     "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
     "error_hi": "upper end of that interval",
@@ -57,8 +64,10 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "core_s": "the measured core-seconds of one run (the sum of its steps' wall time) [s]",
     "COMIC_points": "mean COMIC (Eq. 43) at the common measurement points (NaN if unscored)",
     "scene": "the scene's name",
-    "stopped": "why the candidate's search stopped",
-    "n_below": "the highest failing rung visited below `n` (NaN if none): a passing row's answer lies in (n_below, n]",
+    "stopped": "why the candidate's search stopped: met (at the low end, or every rung below it fails), not met "
+    "(within n_range, or the budget: every rung within it run), over budget, or an at-rest twin",
+    "n_below": "the highest failing rung visited below `n` (NaN if none); every rung below a candidate's answer "
+    "is run, so at its first passing row this is the rung just below",
     "recommended": "the cheapest candidate's smallest rung that meets the target (at most one row)",
     "comic_best": "the lowest `COMIC_points` of the scene (one row)",
     "target": "the scene's `target.value`",
@@ -298,9 +307,9 @@ def _unvisited(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
 def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     """The scene's table: every visited (candidate, n) with its error, interval, counted cost, measured
     core-seconds and COMIC at the common points; ``recommended`` on the cheapest row that meets the
-    target (at most one row), ``n_below`` the highest failing rung visited below each row (the answer
-    of a passing row lies in (n_below, n]), ``comic_best`` on the lowest COMIC_points of each candidate's passing
-    or, if none passes, highest visited resolution; ``stopped`` says why each candidate stopped."""
+    target (at most one row), ``n_below`` the highest failing rung visited below each row (at a
+    candidate's answer the rung just below: every rung below it is run), ``comic_best`` on the lowest
+    COMIC_points of the scene's own rows; ``stopped`` says why each candidate stopped."""
     extra = _unvisited(scene, table)
     parts = [t for t in (table, extra) if len(t)]
     out = pd.concat(parts, ignore_index=True) if parts else table.copy()
@@ -313,7 +322,7 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     out["n_below"] = [
         out[(out["candidate"] == c) & (out["n"] < n) & ~out["meets"]]["n"].max()
         for c, n in zip(out["candidate"], out["n"])
-    ]  # the highest visited rung below that fails: the answer lies in (n_below, n]
+    ]  # the highest visited rung below that fails
     out["recommended"] = False
     meets = out[out["meets"] & own]
     if len(meets):
