@@ -27,6 +27,9 @@ def test_defaults_and_domains_from_the_margin():
     assert scene.omega == pytest.approx(2 * (0.5 + 6 * spread))  # the box's half width + 6 sd either side
     assert scene.fd_length == scene.omega
     assert (scene.D, scene.measure, scene.realisations) == (1e-3, "rmse", 8)
+    assert (scene.max_realisations, scene.blocks) == (32, 4)  # default: 4 blocks of realisations
+    mine = Scene.from_config("s", spec(realisations=20, max_realisations=20))
+    assert (mine.max_realisations, mine.blocks) == (20, 1)  # no refinement
     cfg = scene.run_config(scene.candidates[0], 100)
     lo, length = cfg.fd_span()
     assert length == pytest.approx(scene.fd_length + 0.01 * 50.0)  # the window plus the path v t
@@ -77,6 +80,10 @@ def test_ladders_rise_by_about_two_and_fd_takes_even_grids():
         ({"D": 0.0}, "scenes.s.D"),
         ({"t_final": -1.0}, "scenes.s.t_final"),
         ({"realisations": 1}, "scenes.s.realisations"),
+        ({"max_realisations": 4}, "scenes.s.max_realisations"),  # below realisations (8)
+        ({"max_realisations": 12}, "scenes.s.max_realisations"),  # not a multiple of it
+        ({"realisations": 4, "max_realisations": 10}, "scenes.s.max_realisations"),
+        ({"max_realisations": 8.0}, "scenes.s.max_realisations"),
         ({"source": {"kind": "gaussian", "x0": 0.0, "sd": 0.0}}, "scenes.s.source.sd"),
         ({"source": {"kind": "box", "a": 1.0, "b": 1.0}}, "scenes.s.source.b"),
         ({"source": {"kind": "line"}}, "scenes.s.source.kind"),

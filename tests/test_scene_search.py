@@ -64,6 +64,16 @@ def _search(scene, law, negative=lambda ci, n: False):
     return plan, S.judged(scene, _runs(plan, law, negative)), rounds
 
 
+def _rounds(scene, law, runs=None):
+    """The rounds of a search to its finished plan, each within max_rounds."""
+    plan, k = S.next_plan(scene, None, None, 0), 1
+    while not plan["done"].all():
+        plan = S.next_plan(scene, plan, (runs or _runs)(plan, law), 0)
+        k += 1
+        assert k <= S.max_rounds(scene)
+    return k
+
+
 def test_the_search_finds_the_smallest_passing_rung_without_visiting_the_ladder():
     scene = _scene(value=0.01)
     law = lambda ci, n, seed: 1.0 / n  # noqa: E731  deterministic: passes from n >= 100
@@ -251,21 +261,17 @@ def test_a_budget_below_every_first_rung_answers_over_budget():
 
 def test_the_round_cap_follows_the_longest_ladder():
     """Issue 39, point 13: a written-out ladder of 101 rungs, never met, stopped on "no finished plan
-    after 41 rounds"; the cap is the rounds its search can take."""
+    after 41 rounds"; the cap is the rounds its search can take, and a search may take all of them."""
     pt = {"method": "pt", "kernel": "adaptive", "ladder": list(range(30, 131))}  # 101 rungs
 
-    def rounds(scene, law):
-        plan, k = S.next_plan(scene, None, None, 0), 1
-        while not plan["done"].all():
-            plan = S.next_plan(scene, plan, _runs(plan, law), 0)
-            k += 1
-            assert k <= S.max_rounds(scene)
-        return k
-
     never = _scene(value=1e-9, candidates=(FD, pt))
-    assert 41 < rounds(never, lambda ci, n, seed: 1.0 / n) == S.max_rounds(never) - 1  # the climb and the stop
-    at_top = _scene(value=0.5, candidates=(pt,))  # met at the top rung only: one bisection round more
-    assert rounds(at_top, lambda ci, n, seed: 0.1 if n == 130 else 1.0) == S.max_rounds(at_top)
+    climb = math.ceil(100 / S.CLIMB)  # the round the climb reaches the top rung
+    # deterministic and far from the target: the climb, the fill of the skipped rungs, the stop
+    assert _rounds(never, lambda ci, n, seed: 1.0 / n) == climb + 3 <= S.max_rounds(never)
+    # the worst case: a rung the climb skipped straddles the target through every seed block
+    straddle = _scene(value=0.5, candidates=(pt,))
+    law = lambda ci, n, seed: 0.5 + (0.2 if seed % 2 else -0.199) if n == 129 else 1.0  # noqa: E731
+    assert _rounds(straddle, law) == climb + straddle.blocks + 2 == S.max_rounds(straddle)
 
 
 def test_at_rest_twin_candidates_run_once_and_keep_their_index():
@@ -328,3 +334,242 @@ def test_a_run_that_never_goes_negative_has_no_negative_step():
     )
     table.loc[2, "mass_min"] = -2e-12
     assert S.negative_steps(table)[:3] == (2, 2.0, 1.0)
+
+
+# The search's answer equals brute force: every affordable rung run, each settled by the same rule
+# (seed blocks while its 95 % interval straddles the target, up to max_realisations), the answer the
+# lowest rung whose upper bound meets the target. The brute force below judges with its own Student t.
+
+
+def _settled_bound(scene, cand, n, law, ci) -> tuple[float, int]:
+    """Brute force at one rung: (its upper bound, realisations) after adding seed blocks of
+    ``realisations`` while mean - t se < target < mean + t se, up to max_realisations (FD: one run)."""
+    from scipy.stats import t
+
+    fd = cand.case.method == "fd"
+    r = 1 if fd else scene.realisations
+    errors: list[float] = []
+    while True:
+        errors += [law(ci, n, seed) for seed in range(len(errors), len(errors) + r)]
+        e = np.array(errors)
+        margin = 0.0 if fd else t.ppf(0.95, e.size - 1) * e.std(ddof=1) / math.sqrt(e.size)
+        straddles = e.mean() - margin < scene.value < e.mean() + margin
+        if fd or not straddles or e.size >= scene.max_realisations:
+            return e.mean() + margin, e.size
+
+
+def _brute_force(scene, law) -> dict[int, int | None]:
+    """Each candidate's answer when every affordable rung is run and settled (None: not met)."""
+    out = {}
+    for ci, cand in enumerate(scene.candidates):
+        passing = [n for n in S.affordable(scene, cand) if _settled_bound(scene, cand, n, law, ci)[0] <= scene.value]
+        out[ci] = passing[0] if passing else None
+    return out
+
+
+def _answers(scene, law) -> tuple[dict[int, int | None], pd.DataFrame, int]:
+    """The search replayed round by round on ``law``: (each candidate's answer, its table, rounds)."""
+    plan, table, rounds = _search(scene, law)
+    assert rounds <= S.max_rounds(scene)
+    assert not plan.duplicated(["candidate", "n", "first"]).any()  # each seed block run once
+    out = S.result(scene, table)
+    answers = {}
+    for ci in range(len(scene.candidates)):
+        mine = out[(out["candidate"] == ci) & out["meets"]]
+        answers[ci] = int(mine["n"].min()) if len(mine) else None
+    return answers, out, rounds
+
+
+PT_LADDER = {"method": "pt", "kernel": "adaptive", "ladder": [30, 60, 120, 240, 480, 960, 1920, 3840, 7680]}
+FD_LADDER = {"method": "fd", "kernel": "implicit", "ladder": [16, 32, 64, 128, 256, 512, 1024, 2048]}
+
+
+def _noisy_law(rng: np.random.Generator, ladder_pt, ladder_fd):
+    """A random error curve per candidate: particles a power law n^-p (p in [0.3, 0.7]) with per-seed
+    noise up to the mean's size (seeded by (curve, n, seed)), FD a power law with random bumps that
+    make it rise with n over stretches; both known exactly for every (n, seed)."""
+    key = int(rng.integers(2**31))
+    p, a, sd = rng.uniform(0.3, 0.7), rng.uniform(0.5, 2.0), rng.uniform(0.05, 1.0)
+    bumps = dict(zip(ladder_fd, rng.uniform(0.3, 3.0, len(ladder_fd)) ** rng.integers(0, 2, len(ladder_fd))))
+
+    def law(ci, n, seed):
+        if ci == 0:  # FD: deterministic, non-monotone
+            return float(a * n**-0.8 * bumps[n])
+        mean = a * n**-p
+        z = np.random.default_rng([key, int(n), int(seed)]).standard_normal()
+        return float(abs(mean * (1.0 + sd * z)))
+
+    return law
+
+
+def _target_near(rng, law, scene) -> float:
+    """A target among the curves' values, where the answer is in the middle of a ladder."""
+    ci = int(rng.integers(len(scene.candidates)))
+    ladder = scene.candidates[ci].ladder()
+    n = ladder[int(rng.integers(len(ladder)))]
+    return float(np.mean([law(ci, n, s) for s in range(8)]) * rng.uniform(0.7, 1.5))
+
+
+def test_the_search_equals_brute_force_on_random_noisy_and_bumpy_curves():
+    """120 random curves and targets: noisy particles (straddling, refined in seed blocks) and FD
+    curves that rise with n over stretches; the answer always equals brute force's."""
+    from dataclasses import replace
+
+    rng = np.random.default_rng(40)
+    base = _scene(candidates=(FD_LADDER, PT_LADDER))
+    refined = met = unmet = 0
+    for trial in range(120):
+        law = _noisy_law(rng, PT_LADDER["ladder"], FD_LADDER["ladder"])
+        scene = replace(base, value=_target_near(rng, law, base))
+        answers, out, _ = _answers(scene, law)
+        assert answers == _brute_force(scene, law), trial
+        for ci, cand in enumerate(scene.candidates):  # every rung below the answer run and settled
+            rows = out[out["candidate"] == ci].set_index("n")
+            below = [n for n in cand.ladder() if answers[ci] is None or n < answers[ci]]
+            assert set(below) <= set(rows.index), trial
+            for n in below:
+                assert rows.loc[n, "realisations"] == _settled_bound(scene, cand, n, law, ci)[1], (trial, n)
+            if answers[ci] is not None and below:
+                assert rows.loc[answers[ci], "n_below"] == below[-1]  # the rung just below
+        refined += int((out["realisations"] > scene.realisations).sum())
+        met += sum(a is not None for a in answers.values())
+        unmet += sum(a is None for a in answers.values())
+    assert refined > 20 and met > 50 and unmet > 10  # the trials reach every branch
+
+
+@pytest.mark.parametrize(
+    "errors",
+    [
+        [9, 9, 0.5, 9, 9, 9, 9, 9],  # a single passing rung below failing ones, skipped by the climb
+        [9, 0.5, 9, 9, 0.5, 9, 9, 9],  # passing rungs with a failing stretch between
+        [9, 9, 9, 9, 0.5, 0.5, 2, 3],  # error rising with n past the answer
+        [0.5, 9, 9, 9, 9, 9, 9, 9],  # the low end
+        [9, 9, 9, 9, 9, 9, 9, 0.5],  # the top rung only
+        [2, 0.5, 2, 2, 2, 2, 2, 2],  # passes below the climb's first pass
+        [9, 9, 9, 9, 9, 9, 9, 9],  # never
+        [9, 9, 9, 9, 9, 9, 0.5, 9],  # the rung below the top, never visited by the climb
+    ],
+)
+def test_the_search_equals_brute_force_on_non_monotone_deterministic_curves(errors):
+    """FD-like curves (deterministic, error up and down with n) at target 1: the smallest rung at or
+    below 1, wherever it lies, and every rung below it run."""
+    scene = _scene(value=1.0, candidates=(FD_LADDER,))
+    by_n = dict(zip(FD_LADDER["ladder"], errors))
+    law = lambda ci, n, seed: by_n[n]  # noqa: E731
+    answers, out, _ = _answers(scene, law)
+    expected = next((n for n, e in by_n.items() if e <= 1.0), None)
+    assert answers == _brute_force(scene, law) == {0: expected}
+    below = [n for n in by_n if expected is None or n < expected]
+    assert set(below) <= set(out["n"])
+    stopped = out["stopped"].iloc[0]
+    if expected is None:
+        assert stopped == "not met within n_range"
+    else:
+        assert stopped == ("met at n_range's low end" if expected == 16 else "met: every rung below it fails")
+
+
+def test_a_straddling_rung_gets_seed_blocks_until_it_settles():
+    """A rung whose mean is below the target but whose bound is above it with 8 realisations gets
+    blocks of 8 more (seeds 8-15, 16-23, ...) and passes once the bound falls below; a rung whose
+    interval stays across the target stops at max_realisations and fails."""
+    scene = _scene(value=1.0, candidates=(PT_LADDER,))
+    law = lambda ci, n, seed: (0.9 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
+    plan, table, _ = _search(scene, law)
+    blocks = plan[plan["n"] == 60][["first", "last"]].values.tolist()
+    assert blocks[0] == [0, 7] and all(b == [8 * k, 8 * k + 7] for k, b in enumerate(blocks))
+    row = table.set_index("n").loc[60]
+    assert row["meets"] and 8 < row["realisations"] <= scene.max_realisations
+    assert row["realisations"] == 8 * len(blocks) and S.upper_bound(np.array([law(0, 60, s) for s in range(8)])) > 1
+    # a mean at the target: refined to max_realisations, then failing; the answer above it
+    law = lambda ci, n, seed: (1.0 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
+    answers, out, _ = _answers(scene, law)
+    assert out.set_index("n").loc[60, "realisations"] == scene.max_realisations == 4 * scene.realisations
+    assert answers == {0: 120} == _brute_force(scene, law)
+
+
+def test_a_budget_limited_search_runs_every_affordable_rung_before_saying_not_met():
+    """Met only above the budget: every affordable rung run and settled, none above, "not met within
+    the budget"; below it the answer is brute force's over the affordable rungs."""
+    ladder = PT_LADDER["ladder"]
+    probe = _scene(candidates=(PT_LADDER,))
+    budget = probe.run_cost(probe.candidates[0], ladder[4]) * 1.0001
+    spec = {"v": 0.01, "t_final": 50.0, "budget": budget, "target": {"value": 0.1}, "candidates": [PT_LADDER]}
+    scene = Scene.from_config("s", spec)
+    assert S.affordable(scene, scene.candidates[0]) == ladder[:5]
+    z = {(n, s): 0.2 + 0.05 * np.random.default_rng([n, s]).standard_normal() for n in ladder for s in range(64)}
+    law = lambda ci, n, seed: z[n, seed] if n < 960 else 0.01  # noqa: E731  met from n = 960, over the budget
+    answers, out, _ = _answers(scene, law)
+    assert answers == _brute_force(scene, law) == {0: None}
+    assert out["n"].tolist() == ladder[:5]
+    assert (out["stopped"] == f"not met within the budget (n <= {ladder[4]:,})").all()
+    within = lambda ci, n, seed: z[n, seed] if n < 240 else 0.01  # noqa: E731  met within the budget
+    assert _answers(scene, within)[0] == _brute_force(scene, within) == {0: 240}
+
+
+def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path):
+    """A tiny real scene: every rung of every candidate run with all its seed blocks (run_seeds), read
+    back as the workflow reads its tables (read_runs); the search replayed on those rows at targets
+    across the errors' range answers as brute force on the same rows does."""
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.models.simulate import run_seeds
+
+    spec = {
+        "D": 1e-3,
+        "t_final": 5.0,
+        "realisations": 2,
+        "max_realisations": 6,
+        "target": {"value": 1.0},
+        "candidates": [
+            {"method": "fd", "kernel": "implicit", "fd_dt": 0.5, "ladder": [8, 16, 32, 64]},
+            {"method": "pt", "kernel": "adaptive", "ladder": [10, 20, 40, 80]},
+        ],
+    }
+    scene = Scene.from_config("tiny", spec)
+    rows, paths = [], []
+    for ci, cand in enumerate(scene.candidates):
+        for n in cand.ladder():
+            for block in range(S._blocks(scene, cand)):
+                first, last = S.seeds(scene, cand, 0, block)
+                path = tmp_path / f"{ci}-{n}-{first}.parquet"
+                write_parquet(run_seeds(scene.run_config(cand, n), range(first, last + 1)), path)
+                rows.append({"candidate": ci, "n": n, "first": first, "last": last})
+                paths.append(str(path))
+    every = S.read_runs(pd.DataFrame(rows), paths)
+    assert len(every) == 4 + 4 * scene.max_realisations
+    by_seed = {(int(r.candidate), int(r.n), int(r.seed)): r._asdict() for r in every.itertuples(index=False)}
+
+    def runs(plan, law=None):
+        return pd.DataFrame(
+            [by_seed[int(r.candidate), int(r.n), s] for r in plan.itertuples() for s in range(r.first, r.last + 1)]
+        )
+
+    def law(ci, n, seed):
+        return S.error(scene, by_seed[ci, n, seed])
+
+    from dataclasses import replace
+
+    errors = sorted({law(ci, n, s) for ci, n, s in by_seed})
+    checked, refined = set(), 0
+    for value in np.quantile(errors, np.linspace(0.02, 0.98, 25)):
+        at = replace(scene, value=float(value))
+        plan = S.next_plan(at, None, None, 0)
+        while not plan["done"].all():
+            plan = S.next_plan(at, plan, runs(plan), 0)
+        out = S.result(at, S.judged(at, runs(plan)))
+        mine = {ci: (g.loc[g["meets"], "n"].min() if g["meets"].any() else None) for ci, g in out.groupby("candidate")}
+        assert {ci: (None if m is None else int(m)) for ci, m in mine.items()} == _brute_force(at, law)
+        checked.update((ci, m) for ci, m in mine.items())
+        refined += int((out["realisations"] > at.realisations).sum())
+    assert len(checked) >= 5 and refined > 0  # the targets reach several answers, and seed blocks
+
+
+def test_only_rungs_that_can_still_be_the_answer_are_refined():
+    """A straddling rung above the lowest pass gets no more seed blocks: it cannot be the answer."""
+    scene = _scene(value=1.0, candidates=(PT_LADDER,))
+    wobble = lambda mean, seed: mean + (0.3 if seed % 2 else -0.3)  # noqa: E731
+    law = lambda ci, n, seed: {30: 1.5, 120: wobble(0.9, seed), 480: wobble(1.0, seed)}.get(n, 0.1)  # noqa: E731
+    answers, out, _ = _answers(scene, law)
+    rows = out.set_index("n")
+    assert answers == {0: 60} == _brute_force(scene, law)  # 60 (filled) passes below 120 (refined)
+    assert rows.loc[120, "realisations"] == scene.max_realisations  # settled (it passes at 32)
+    assert rows.loc[480, "realisations"] < scene.max_realisations and not rows.loc[480, "meets"]

@@ -1131,8 +1131,17 @@ def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     coarse = table[(table["label"].str.contains("central")) & (table["n"] == 16)].iloc[0]
     assert coarse["unscored"].startswith("negative concentrations: grid Peclet") and coarse["unscored"].endswith("> 2")
     assert not coarse["meets"] and np.isnan(coarse["COMIC_points"])
-    for label, rows in table.groupby("label"):  # each candidate bracketed or stopped at its range's top
-        assert rows["stopped"].iloc[0] in ("met: bracketed by neighbouring rungs", "not met within n_range"), label
+    stops = ("met: every rung below it fails", "met at n_range's low end", "not met within n_range")
+    for label, rows in table.groupby("label"):  # each candidate met above failing rungs, or nowhere
+        assert rows["stopped"].iloc[0] in stops, label
+    ladder = (
+        Scene.from_config("carried", yaml.safe_load(SCENE_CONFIG.read_text())["scenes"]["carried"])
+        .candidates[int(best["candidate"])]
+        .ladder()
+    )
+    mine = table[table["candidate"] == best["candidate"]]
+    assert {n for n in ladder if n < best["n"]} <= set(mine["n"])  # every rung below the answer run
+    assert not mine[mine["n"] < best["n"]]["meets"].any()
     assert (work / "figures/scene_carried.png").stat().st_size > 5000
     plans = sorted((work / "results/scenes/carried").glob("round~*.parquet"), key=lambda p: int(p.stem.split("~")[1]))
     last = pd.read_parquet(plans[-1])

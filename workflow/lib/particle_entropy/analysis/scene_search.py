@@ -1,12 +1,17 @@
 """The cheapest model of a scene (experiments/scene.py) that reaches its accuracy, and the COMIC-best.
 
-For each candidate, a root search on its ladder of resolutions (Candidate.ladder) for the smallest
-one whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
-s / sqrt(R) of R realisations (FD is deterministic: one run, its error). Errors fall with
-resolution up to noise, so the search climbs the ladder two rungs (a factor of about 4) at a time
-until a rung passes, then halves the gap between the highest failing and the lowest passing rung
-until they are neighbours. Each round is a Snakemake checkpoint whose plan names the runs to make;
-the path depends on the config and the errors only, never on timings.
+For each candidate, the smallest rung of its affordable ladder (Candidate.ladder, within the budget)
+whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
+s / sqrt(R) of R realisations (FD is deterministic: one run, its error). The answer is the brute
+force's, as if every rung had run: errors need not fall with n (noise; FD central's error can rise
+with it). A particle rung whose interval straddles the target (mean - t_0.95 se < target < mean +
+t_0.95 se) gets another block of ``realisations`` seeds until it falls on one side or reaches
+``max_realisations`` (state): its final state depends on its own seeds only. The search climbs CLIMB
+rungs a round until a rung passes (or the top is reached), then runs in one round every unvisited
+rung below the lowest pass (on a ratio-2 ladder they cost about what that rung does), refining
+straddling rungs that can still be the answer in the same rounds; it stops once every rung below
+the lowest pass has run and settled (_next_rungs). Each round is a Snakemake checkpoint whose plan
+names the run tables to make; the path depends on the config and the errors only, never on timings.
 
 Costs are counted, not timed: work (particle- or node-steps, the run tables' ``work``) times the
 scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work); the
@@ -42,7 +47,9 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
     "method": "fd, pt or mtpt",
     "n": "the resolution: particles, or FD intervals",
-    "realisations": "runs averaged (FD: 1, deterministic; 0: not run, its first rung over the budget)",
+    "realisations": "runs averaged, over every seed block run (particles: a multiple of the scene's `realisations`, "
+    "more where the interval straddled the target, at most `max_realisations`; FD: 1, deterministic; 0: not run, "
+    "its first rung over the budget)",
     "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
     "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
     "error_hi": "upper end of that interval",
@@ -58,8 +65,10 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "core_s": "the measured core-seconds of one run (the sum of its steps' wall time) [s]",
     "COMIC_points": "mean COMIC (Eq. 43) at the common measurement points (NaN if unscored)",
     "scene": "the scene's name",
-    "stopped": "why the candidate's search stopped",
-    "n_below": "the highest failing rung visited below `n` (NaN if none): a passing row's answer lies in (n_below, n]",
+    "stopped": "why the candidate's search stopped: met (at the low end, or every rung below it fails), not met "
+    "(within n_range, or the budget: every rung within it run), over budget, or an at-rest twin",
+    "n_below": "the highest failing rung visited below `n` (NaN if none); every rung below a candidate's answer "
+    "is run, so at its first passing row this is the rung just below",
     "recommended": "the cheapest candidate's smallest rung that meets the target (at most one row)",
     "comic_best": "the lowest `COMIC_points` of the scene (one row)",
     "target": "the scene's `target.value`",
@@ -118,10 +127,11 @@ def upper_bound(errors: np.ndarray) -> float:
     return float(errors.mean() + _t_margin(errors, 0.95))
 
 
-def seeds(scene: Scene, candidate: Candidate, base_seed: int) -> tuple[int, int]:
-    """The first and last seed of a rung's runs (FD: one run)."""
+def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) -> tuple[int, int]:
+    """The first and last seed of a rung's seed block ``block`` (0, 1, ...): base_seed + block R to
+    base_seed + (block + 1) R - 1, R the scene's realisations (FD: one run, block 0)."""
     count = 1 if candidate.case.method == "fd" else scene.realisations
-    return base_seed, base_seed + count - 1
+    return base_seed + block * count, base_seed + (block + 1) * count - 1
 
 
 JUDGED_COLUMNS = list(RESULT_COLUMN_DOCS)[: list(RESULT_COLUMN_DOCS).index("COMIC_points") + 1]
@@ -166,12 +176,11 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
 
 
 def max_rounds(scene: Scene) -> int:
-    """The most plans a scene's search writes: round 0, a round per CLIMB rungs up the longest ladder,
-    the rounds that halve a gap of CLIMB rungs, and the round that finds every candidate stopped.
-    Each round visits a new rung of every candidate still searching (_next_rung), so no search
-    takes more; the workflow asks for this many rounds (common.smk)."""
-    longest = max(len(c.ladder()) for c in scene.candidates)
-    return 1 + math.ceil((longest - 1) / CLIMB) + math.ceil(math.log2(CLIMB)) + 1
+    """The most plans a scene's search writes (common.smk asks for this many): while no rung passes, a
+    candidate's climb reaches its top rung by round T = ceil((rungs - 1) / CLIMB); the round after, at
+    the latest, it fills every rung below its lowest pass (or all); each rung visited takes at most
+    ``blocks`` rounds to settle (FD: one), so the round after those finds it stopped: T + blocks + 2."""
+    return max(math.ceil((len(c.ladder()) - 1) / CLIMB) + _blocks(scene, c) + 2 for c in scene.candidates)
 
 
 def _twin_reason(scene: Scene, ci: int) -> str:
@@ -186,52 +195,79 @@ def affordable(scene: Scene, candidate: Candidate) -> list[int]:
     return [n for n in ladder if scene.run_cost(candidate, n) <= scene.budget]
 
 
-def _next_rung(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tuple[int | None, str]:
-    """The next resolution of one candidate's search, or (None, why it stops)."""
+def _blocks(scene: Scene, candidate: Candidate) -> int:
+    """The most seed blocks a rung of ``candidate`` runs (FD, deterministic: one)."""
+    return 1 if candidate.case.method == "fd" else scene.blocks
+
+
+PASS, FAIL, OPEN = "pass", "fail", "open"
+
+
+def state(scene: Scene, candidate: Candidate, row) -> str:
+    """A visited rung's state from its judged row: PASS (its upper bound meets the target), FAIL
+    (settled: unscored, FD, its one-sided 95 % lower bound mean - t_0.95 se at or above the target,
+    or ``max_realisations`` run) or OPEN (its interval straddles the target: another seed block may
+    settle it). A function of the rung's own runs only."""
+    if row["meets"]:
+        return PASS
+    if row["unscored"] or candidate.case.method == "fd" or row["realisations"] >= scene.max_realisations:
+        return FAIL
+    lower = 2.0 * row["error_mean"] - row["error_upper95"]  # the bound's margin, on the other side
+    return OPEN if lower < scene.value else FAIL
+
+
+def _next_rungs(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tuple[list[tuple[int, int]], str]:
+    """The next (resolution, seed block) runs of one candidate's search, or ([], why it stops).
+
+    L is the lowest rung that passes (a pass is settled: its bound is below the target). Every rung
+    at or below L (all while none passes) may still be the answer: an open one gets its next seed
+    block; once L exists, or the climb has reached the top rung, every unvisited rung below L (all)
+    gets its first; before, the climb visits the rung CLIMB above the highest visited. The search
+    stops when every rung below L (all) has run and settled: L is then the lowest passing rung of
+    the brute force that settles every rung by the same rule (state)."""
     whole = candidate.ladder()
     ladder = affordable(scene, candidate)
     if not ladder:
-        return None, f"over budget: n = {whole[0]:,} costs {scene.run_cost(candidate, whole[0]):.3g} s a run"
+        return [], f"over budget: n = {whole[0]:,} costs {scene.run_cost(candidate, whole[0]):.3g} s a run"
     if visited.empty:
-        return ladder[0], ""
-    idx = {n: i for i, n in enumerate(ladder)}
-    passing = sorted(idx[n] for n in visited.loc[visited["meets"], "n"])
-    seen = sorted(idx[n] for n in visited["n"])
-    if not passing:
-        top = seen[-1]
-        if top == len(ladder) - 1:
-            if len(ladder) < len(whole):
-                return None, f"not met within the budget (n <= {ladder[-1]:,})"
-            return None, "not met within n_range"
-        return ladder[min(top + CLIMB, len(ladder) - 1)], ""
-    best = passing[0]
-    below = [i for i in seen if i < best]
-    if not below:
-        return None, "met at the lowest visited rung" if best > 0 else "met at n_range's low end"
-    gap = best - below[-1]
-    if gap <= 1:
-        return None, "met: bracketed by neighbouring rungs"
-    return ladder[below[-1] + gap // 2], ""
+        return [(ladder[0], 0)], ""
+    rows = {int(r["n"]): r for r in visited.to_dict("records")}
+    states = [state(scene, candidate, rows[n]) if n in rows else None for n in ladder]
+    lowest = states.index(PASS) if PASS in states else None
+    limit = len(ladder) if lowest is None else lowest
+    top = max(i for i, s in enumerate(states) if s is not None)
+    per_block = 1 if candidate.case.method == "fd" else scene.realisations
+    todo = [(ladder[i], int(rows[ladder[i]]["realisations"]) // per_block) for i in range(limit) if states[i] == OPEN]
+    if lowest is not None or top == len(ladder) - 1:
+        todo += [(ladder[i], 0) for i in range(limit) if states[i] is None]
+    else:
+        todo.append((ladder[min(top + CLIMB, len(ladder) - 1)], 0))
+    if todo:
+        return sorted(todo), ""
+    if lowest is not None:
+        return [], "met at n_range's low end" if lowest == 0 else "met: every rung below it fails"
+    if len(ladder) < len(whole):
+        return [], f"not met within the budget (n <= {ladder[-1]:,})"
+    return [], "not met within n_range"
 
 
 def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None, base_seed: int) -> pd.DataFrame:
     """The plan after ``plan`` (None: round 0) given the runs it made: every earlier row, and a row
-    per candidate still searching; ``done`` on every row when no candidate searches on."""
+    per run table each candidate still searching makes next (a rung's seed block: seeds); ``done``
+    on every row when no candidate searches on."""
     k = 0 if plan is None else int(plan["round"].max()) + 1
     rows = [] if plan is None else plan.drop(columns="done").to_dict("records")
-    table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=["candidate", "n", "meets"])
-    first, _ = seeds(scene, scene.candidates[0], base_seed)
+    table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=JUDGED_COLUMNS)
     added = False
     for ci, cand in enumerate(scene.candidates):
         if scene.same_as(ci) != ci:  # its runs are an earlier candidate's (result copies its rows)
             continue
         visited = table[table["candidate"] == ci] if len(table) else table
-        n, _why = _next_rung(scene, cand, visited)
-        if n is None:
-            continue
-        lo, hi = seeds(scene, cand, base_seed)
-        rows.append({"candidate": ci, "label": cand.label, "n": int(n), "first": lo, "last": hi, "round": k})
-        added = True
+        todo, _why = _next_rungs(scene, cand, visited)
+        for n, block in todo:
+            lo, hi = seeds(scene, cand, base_seed, block)
+            rows.append({"candidate": ci, "label": cand.label, "n": int(n), "first": lo, "last": hi, "round": k})
+            added = True
     out = pd.DataFrame(rows, columns=PLAN_COLUMNS[:-1])
     out["done"] = not added
     return out
@@ -240,7 +276,7 @@ def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None
 def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
     """Each candidate's reason to have stopped."""
     return {
-        ci: _next_rung(scene, cand, table[table["candidate"] == ci])[1]
+        ci: _next_rungs(scene, cand, table[table["candidate"] == ci])[1]
         if scene.same_as(ci) == ci
         else _twin_reason(scene, ci)
         for ci, cand in enumerate(scene.candidates)
@@ -278,9 +314,9 @@ def _unvisited(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
 def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     """The scene's table: every visited (candidate, n) with its error, interval, counted cost, measured
     core-seconds and COMIC at the common points; ``recommended`` on the cheapest row that meets the
-    target (at most one row), ``n_below`` the highest failing rung visited below each row (the answer
-    of a passing row lies in (n_below, n]), ``comic_best`` on the lowest COMIC_points of each candidate's passing
-    or, if none passes, highest visited resolution; ``stopped`` says why each candidate stopped."""
+    target (at most one row), ``n_below`` the highest failing rung visited below each row (at a
+    candidate's answer the rung just below: every rung below it is run), ``comic_best`` on the lowest
+    COMIC_points of the scene's own rows; ``stopped`` says why each candidate stopped."""
     extra = _unvisited(scene, table)
     parts = [t for t in (table, extra) if len(t)]
     out = pd.concat(parts, ignore_index=True) if parts else table.copy()
@@ -293,7 +329,7 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     out["n_below"] = [
         out[(out["candidate"] == c) & (out["n"] < n) & ~out["meets"]]["n"].max()
         for c, n in zip(out["candidate"], out["n"])
-    ]  # the highest visited rung below that fails: the answer lies in (n_below, n]
+    ]  # the highest visited rung below that fails
     out["recommended"] = False
     meets = out[out["meets"] & own]
     if len(meets):

@@ -830,6 +830,19 @@ SCENE = (
         high=MAX_REALISATIONS,
     ),
     Setting(
+        "max_realisations",
+        "scenes.<name>.max_realisations",
+        NO_DEFAULT,
+        "the most realisations of a particle rung: one whose 95 % interval straddles the target (lower bound "
+        "below it, upper bound above) gets another seed block of `realisations` until it falls on one side or "
+        "reaches this many (default 4 x realisations: the bound's half-width halves, and a rung costs at most "
+        "what the rung two above it costs at `realisations`)",
+        kind="integer",
+        low=2,
+        high=MAX_REALISATIONS,
+        range_text=f"a multiple of realisations in [realisations, {MAX_REALISATIONS:,}] (default 4 x realisations)",
+    ),
+    Setting(
         "cost",
         "scenes.<name>.cost",
         {"fd": [3.85e-5, 1.72e-8], "pt": [7.99e-5, 3.71e-8], "mtpt": [8.37e-5, 2.02e-7]},

@@ -18,11 +18,15 @@ from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
 from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT
 from ..core.runconfig import RunConfig, check_plume_width, check_setting
-from ..core.settings import BY_KEY, PAPER, SCENE, SCENE_REACH, defaults
+from ..core.settings import BY_KEY, MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
+# A straddling particle rung's seed blocks by default (max_realisations = this x realisations): four
+# blocks halve the bound's half-width, t_0.95 s / sqrt(R), and cost what the rung two above costs at
+# one block on a ratio-2 ladder, so a refined rung is never dearer than the climb it may save.
+MAX_BLOCKS = 4
 # The 15 measurement points common to every model span the plume at t_final, its mean +- REACH
 # sqrt(2 variance) (+- 3 sqrt(4 D t) for a point: 4.24 standard deviations), as the paper's span
 # [-6, 6] its plume at t = 1000; they move with the plume and never depend on the FD window, which
@@ -132,6 +136,12 @@ class Scene:
     budget: float = math.inf  # the most counted cost of one run [s]
     paper_runs: frozenset = frozenset()  # candidates whose runs are the paper run's own (Scenes)
     paper_pattern: str = ""  # the paper run's table pattern, for those
+    max_realisations: int = 0  # the most realisations of a particle rung, in blocks of ``realisations`` (0: 4 x)
+
+    @property
+    def blocks(self) -> int:
+        """The most seed blocks of ``realisations`` a particle rung may run (scene_search.seeds)."""
+        return self.max_realisations // self.realisations if self.max_realisations else MAX_BLOCKS
 
     def cost_s(self, method: str, steps: float, work: float) -> float:
         """A run's counted cost: steps and work times the scene's unit costs [s]."""
@@ -236,7 +246,9 @@ class Scene:
             # fd_dt, its own or the default); twins keep their index (same_as)
             cands = tuple(replace(c, advection="none", courant=None) for c in cands)
         cost = _cost(name, spec.get("cost"))
+        most = _max_realisations(name, spec.get("max_realisations"), r)
         scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost, budget)
+        scene = replace(scene, max_realisations=most)
         _check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             for n in dict.fromkeys((c.n_lo, c.ladder()[-1])):
@@ -245,6 +257,22 @@ class Scene:
                 except SettingError as e:
                     raise _candidate_error(scene, i, raw[i], e) from None
         return scene
+
+
+def _max_realisations(name: str, value, realisations: int) -> int:
+    """scenes.<name>.max_realisations as given (default MAX_BLOCKS x realisations, within
+    MAX_REALISATIONS), else SettingError naming it: a multiple of realisations, at least one block."""
+    if value is None:
+        return min(MAX_BLOCKS, MAX_REALISATIONS // realisations) * realisations
+    most = _checked(name, "max_realisations", value)
+    if most < realisations or most % realisations:
+        raise SettingError(
+            _key(name, "max_realisations"),
+            value,
+            f"a multiple of realisations ({realisations}) in [{realisations}, {MAX_REALISATIONS:,}]: "
+            "rungs are refined a seed block of realisations at a time",
+        )
+    return most
 
 
 def _known_keys(name: str, spec: Mapping) -> None:
