@@ -167,6 +167,8 @@ def _answer(scene: str, peclet: float, fd_cost: float | None, particle_cost: flo
                     "meets": meets,
                     "cost_s": (cost or 1.0) * n / 200,
                     "n_below": 100.0 if n == 200 else np.nan,
+                    "grid_peclet": peclet / n if method == "fd" else np.nan,
+                    "courant": 0.5 if method == "fd" else np.nan,
                 }
             )
     return pd.DataFrame(rows)
@@ -187,6 +189,20 @@ def test_the_peclet_table_and_its_crossover():
     assert table.drop_duplicates("peclet")["particles_cheaper"].tolist() == [False, False, True, True]
     assert S.crossover(table) == (50.0, 500.0)
     assert S.crossover(S.peclet_table(tables[:2])) is None  # the grid wins throughout
+    assert grid.loc[50.0, "grid_peclet"] == 0.25 and grid.loc[50.0, "courant"] == 0.5  # the answer's (n = 200)
+
+
+def test_an_fd_rung_names_its_grid_peclet_and_courant_numbers():
+    """dx = the grid's span over n, dt = courant dx / |v| (or fd_dt): Pe_dx = |v| dx / D, Cr = |v| dt / dx."""
+    tvd = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75, "n_range": [64, 4096]}
+    fixed = {"method": "fd", "kernel": "implicit", "advection": "upwind", "fd_dt": 0.5, "n_range": [64, 4096]}
+    spec = {"D": 1e-4, "v": -0.03, "t_final": 100.0, "target": {"value": 0.05}, "candidates": [tvd, fixed, MTPT]}
+    scene = Scene.from_config("s", spec)
+    span = scene.run_config(scene.candidates[0], 256).fd_span()[1]
+    peclet, courant = S.grid_numbers(scene, scene.candidates[0], 256)
+    assert peclet == pytest.approx(0.03 * span / 256 / 1e-4, rel=1e-12) and courant == pytest.approx(0.75, rel=1e-12)
+    assert S.grid_numbers(scene, scene.candidates[1], 256)[1] == pytest.approx(0.03 * 0.5 / (span / 256), rel=1e-12)
+    assert all(math.isnan(x) for x in S.grid_numbers(scene, scene.candidates[2], 256))
 
 
 def test_the_counted_cost_of_a_run_is_known_before_it_runs():

@@ -74,7 +74,11 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "target": "the scene's `target.value`",
     "budget": "the scene's `budget`, the most counted cost of a run (inf: none) [s]",
     "measure": "the scene's `target.measure`: rmse, entropy or dilution",
-    "peclet": "v L / D, L the scene's FD window",
+    "peclet": "the scene's Peclet number |v| L / D, L its FD window fd_length (the span around the source that "
+    "holds the plume at rest, without the path v t_final): advection across the plume's own extent against "
+    "dispersion",
+    "grid_peclet": "FD in a flow: the grid Peclet number |v| dx / D of the rung (NaN for particles and at rest)",
+    "courant": "FD in a flow: the Courant number |v| dt / dx of the rung's step (NaN for particles and at rest)",
 }
 
 
@@ -344,6 +348,9 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     out["budget"] = scene.budget
     out["measure"] = scene.measure
     out["peclet"] = scene.peclet
+    numbers = [grid_numbers(scene, scene.candidates[c], n) for c, n in zip(out["candidate"], out["n"])]
+    out["grid_peclet"] = [p for p, _ in numbers]
+    out["courant"] = [c for _, c in numbers]
     return out.reset_index(drop=True)
 
 
@@ -415,11 +422,22 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
 FAMILIES = {"fd": "grid (best FD)", "pt": "particles (best PT or MTPT)", "mtpt": "particles (best PT or MTPT)"}
 
 
+def grid_numbers(scene: Scene, candidate: Candidate, n: int) -> tuple[float, float]:
+    """(grid Peclet |v| dx / D, Courant |v| dt / dx) of an FD candidate's rung n in a flow; NaN, NaN for
+    particles and at rest."""
+    if candidate.case.method != "fd" or scene.v == 0.0:
+        return math.nan, math.nan
+    cfg = scene.run_config(candidate, n)
+    dx = cfg.fd_span()[1] / n
+    return abs(scene.v) * dx / scene.D, abs(scene.v) * cfg.dt0 / dx
+
+
 def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
     """The Peclet sweep's answer: per scene and family (the grid: FD candidates; particles: PT and
-    MTPT), the cheapest candidate's smallest rung that meets the target, its counted cost and the
-    cost at the failing rung below it (the answer's cost lies in (cost_lo, cost_s]); NaN where
-    no candidate of the family meets it. ``particles_cheaper`` marks the scenes where particles win."""
+    MTPT), the cheapest candidate's smallest rung that meets the target, its counted cost, the
+    cost at the failing rung below it (the answer's cost lies in (cost_lo, cost_s]) and an FD answer's
+    grid Peclet and Courant numbers; NaN where no candidate of the family meets it.
+    ``particles_cheaper`` marks the scenes where particles win."""
     rows = []
     for t in tables:
         peclet, name = float(t["peclet"].iloc[0]), str(t["scene"].iloc[0])
@@ -427,12 +445,13 @@ def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
         for family in dict.fromkeys(FAMILIES.values()):
             meets = t[(t["family"] == family) & t["meets"]]
             row = {"scene": name, "peclet": peclet, "family": family, "label": "", "n": np.nan, "cost_s": np.nan}
-            row["cost_lo"] = np.nan
+            row.update(cost_lo=np.nan, grid_peclet=np.nan, courant=np.nan)
             if len(meets):
                 first = meets.sort_values("n").groupby("candidate").head(1)
                 best = first.loc[first["cost_s"].idxmin()]
                 below = t[(t["candidate"] == best["candidate"]) & (t["n"] == best["n_below"])]
                 row.update(label=best["label"], n=float(best["n"]), cost_s=float(best["cost_s"]))
+                row.update(grid_peclet=float(best["grid_peclet"]), courant=float(best["courant"]))
                 row["cost_lo"] = float(below["cost_s"].iloc[0]) if len(below) else np.nan
             rows.append(row)
     out = pd.DataFrame(rows).sort_values(["peclet", "family"]).reset_index(drop=True)

@@ -2,14 +2,24 @@
 (analysis/scene_search.peclet_table): the counted cost of one run of the cheapest FD candidate and
 of the cheapest particle candidate that meet the target, against v L / D; bars from the cost of the
 failing resolution below each answer, hollow markers where a family never meets it, the crossover
-shaded over the sweep's spacing."""
+shaded over the sweep's spacing. Each FD answer is labelled with its scheme, grid Peclet number
+|v| dx / D and Courant number |v| dt / dx."""
 
 from __future__ import annotations
 
 import pandas as pd
 
-from ..analysis.scene_search import crossover
+from ..analysis.scene_search import FAMILIES, crossover
 from .style import AUTO_COLOURS, AUTO_MARKERS, new_figure, style_axes
+
+
+def _fd_numbers(row) -> str:
+    """An FD answer's scheme (its label's third word; at rest none), grid Peclet and Courant numbers."""
+    words = str(row.label).split()
+    scheme = words[2] if len(words) > 3 else "at rest"
+    if not row.grid_peclet > 0:
+        return scheme
+    return f"{scheme}\nPe_dx {row.grid_peclet:.3g}, Cr {row.courant:.3g}"
 
 
 def scenes_peclet(table: pd.DataFrame):
@@ -39,6 +49,16 @@ def scenes_peclet(table: pd.DataFrame):
             capsize=2,
             label=family,
         )
+        if family == FAMILIES["fd"]:
+            for px, row in zip(x[met], rows[met].itertuples()):
+                ax.annotate(
+                    _fd_numbers(row),
+                    (px, row.cost_s),
+                    xytext=(4, -10),
+                    textcoords="offset points",
+                    fontsize=6,
+                    color=colour,
+                )
         if (~met).any():
             ax.plot(
                 x[~met],
