@@ -648,3 +648,14 @@ def test_tvd_with_a_step_fixed_in_time_is_taken_while_its_courant_number_is_at_m
     got = Scene.from_config("s", small(candidates=[{**S_FD, "advection": "tvd", "n_range": [16, 512]}]))
     top = got.run_config(got.candidates[0], 512)
     assert 0.5 < top.courant_number() <= 1.0
+
+
+def test_seeds_past_int64_are_refused_naming_max_realisations():
+    """A scene's seeds run to base_seed + max_realisations - 1, stored as int64 (2^63 - 1)."""
+    from particle_entropy.pipeline.crosschecks import check_scene
+
+    scene = Scene.from_config("s", spec(realisations=4, max_realisations=16))
+    check_scene(scene, 2**63 - 16, None)  # the last seed is 2^63 - 1
+    with pytest.raises(SettingError) as e:
+        check_scene(scene, 2**63 - 15, None)
+    assert e.value.name == "scenes.s.max_realisations" and "<= 15 with base_seed" in e.value.allowed

@@ -64,7 +64,7 @@ from particle_entropy.pipeline.sweeps import (
     spec_ensembles,
 )
 
-from particle_entropy.pipeline.crosschecks import check_memory, check_scene_memory, check_sweeps, optimum_searches
+from particle_entropy.pipeline.crosschecks import check_memory, check_scene, check_sweeps, optimum_searches
 from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
 from particle_entropy.pipeline.jobcost import estimated_seconds, shear_seconds
 from particle_entropy.pipeline.memory import shear_memory_mb
@@ -81,7 +81,7 @@ OPTIMUM = optimum_searches(config, AVAILABLE)
 # it; their runs are keyed by a digest of their physics (scenes share equal runs: SCENES.settings).
 SCENES = scenes(
     config,
-    None if AVAILABLE is None else partial(check_scene_memory, available=AVAILABLE),
+    partial(check_scene, base_seed=config["base_seed"], available=AVAILABLE),
     paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
 )
 # A scene's name: a user's (the schema's pattern) or one of the Peclet sweep's, peclet-<k>.

@@ -406,7 +406,7 @@ def check_config(
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
     from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_scene_memory, check_search, check_sweeps
+    from .crosschecks import check_memory, check_scene, check_search, check_sweeps
 
     try:
         check_schema(config, load_schema() if schema is None else schema)
@@ -430,7 +430,7 @@ def check_config(
             f"optimum.{name}",
             f"`snakemake optimum` and results/optimum/{name}.parquet",
         )
-    every = scenes(config, None if available is None else lambda scene: check_scene_memory(scene, available))
+    every = scenes(config, lambda scene: check_scene(scene, config["base_seed"], available))
     for name in every:  # builds and checks each scene
         peclet = name in every.sweep
         judge(

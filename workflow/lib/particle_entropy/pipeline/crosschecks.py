@@ -198,6 +198,24 @@ def _check_jobs_fit(jobs, config: Mapping, available: float) -> None:
             )
 
 
+def check_scene(scene, base_seed: int, available: float | None) -> None:
+    """A scene's further checks when first used: its seeds, base_seed + max_realisations - 1 at most,
+    fit int64 (SettingError naming scenes.<name>.max_realisations, which sets how far they run), and
+    its jobs fit in memory (check_scene_memory; ``available`` None: not checked)."""
+    most = max(1 if c.case.method == "fd" else scene.max_realisations for c in scene.candidates)
+    try:
+        _check_seed_count(int(base_seed), most)
+    except SettingError:
+        raise SettingError(
+            scene.key("max_realisations"),
+            scene.max_realisations,
+            f"an integer <= {MAX_SEED - int(base_seed) + 1} with base_seed = {base_seed} (seeds run to base_seed + "
+            "max_realisations - 1 and are stored as int64), or a lower base_seed",
+        ) from None
+    if available is not None:
+        check_scene_memory(scene, available)
+
+
 def check_scene_memory(scene, available: float) -> None:
     """Every job a scene may run must fit in ``available`` bytes: each candidate's top resolution
     with its realisations in one process (memory.estimate_mb); SettingError naming its n_range (or
