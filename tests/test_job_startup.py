@@ -229,6 +229,10 @@ for n in (2, 37, 3000):
     same(aot.thomas_factor(n, 0.7), f)
     d = rng.random(n)
     same(aot.thomas_solve(f[0], f[1], 0.7, d), jit.thomas_solve(f[0], f[1], 0.7, d))
+    if n > 2:
+        from scipy.linalg import lapack
+        g = lapack.dgttrf(np.full(n - 1, -3.6), np.full(n, 1.8), np.full(n - 1, 2.8))[:5]  # pivots
+        same(aot.gt_solve(*g, d), jit.gt_solve(*g, d))
 print("ok")
 """
     res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)

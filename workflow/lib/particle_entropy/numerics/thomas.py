@@ -33,3 +33,35 @@ def thomas_solve(inv_piv, upper, r, d):
     for i in range(n - 2, -1, -1):
         y[i] -= upper[i] * y[i + 1]
     return y
+
+
+SMALLEST_NORMAL = 2.2250738585072014e-308  # 2^-1022: below it a double is subnormal
+
+
+@njit(cache=True)
+def gt_solve(dl, d, du, du2, ipiv, b):
+    """x of A x = b from LAPACK dgttrf's LU factors of a tridiagonal A (dl multipliers, d and du, du2
+    the rows of U, ipiv the 1-based row interchanges): dgttrs' forward and backward sweeps operation
+    for operation, each result below 2^-1022 in magnitude set to 0. A decaying tail otherwise ends on
+    the smallest subnormal, which a factor above 1/2 rounds back to itself node after node, and every
+    operation on a subnormal costs about a hundred cycles (dgttrs: 4.5 ms for 65,535 nodes, 0.7 ms
+    flushed). A flushed value is below 2^-1022 of a unit mass: every normal result is dgttrs' own."""
+    n = b.shape[0]
+    x = b.copy()
+    for i in range(n - 1):  # L: the row interchanges and multipliers
+        if ipiv[i] == i + 1:
+            y = x[i + 1] - dl[i] * x[i]
+        else:
+            t = x[i]
+            x[i] = x[i + 1]
+            y = t - dl[i] * x[i]
+        x[i + 1] = y if abs(y) >= SMALLEST_NORMAL else 0.0
+    y = x[n - 1] / d[n - 1]
+    x[n - 1] = y if abs(y) >= SMALLEST_NORMAL else 0.0
+    if n > 1:
+        y = (x[n - 2] - du[n - 2] * x[n - 1]) / d[n - 2]
+        x[n - 2] = y if abs(y) >= SMALLEST_NORMAL else 0.0
+    for i in range(n - 3, -1, -1):  # U: two superdiagonals
+        y = (x[i] - du[i] * x[i + 1] - du2[i] * x[i + 2]) / d[i]
+        x[i] = y if abs(y) >= SMALLEST_NORMAL else 0.0
+    return x
