@@ -233,6 +233,8 @@ for n in (2, 37, 3000):
         from scipy.linalg import lapack
         g = lapack.dgttrf(np.full(n - 1, -3.6), np.full(n, 1.8), np.full(n - 1, 2.8))[:5]  # pivots
         same(aot.gt_solve(*g, d), jit.gt_solve(*g, d))
+    for p in (0.75, -0.3):
+        same(aot.tvd_advect(d, p), jit.tvd_advect(d, p))
 print("ok")
 """
     res = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": str(LIB)}, capture_output=True)

@@ -45,6 +45,7 @@ EXPORTS = {
     "thomas_factor": ("thomas", "UniTuple(f8[::1], 2)(i8, f8)"),
     "thomas_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8, f8[::1])"),
     "gt_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8[::1], f8[::1], i4[::1], f8[::1])"),
+    "tvd_advect": ("thomas", "Tuple((f8[::1], f8))(f8[::1], f8)"),
     # the authors' loop: (x, m, label, sigma, radius, beta, seed, symnorm, clip) -> m
     "_sweep": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),
     "_sweep_fma": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),

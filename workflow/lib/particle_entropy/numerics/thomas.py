@@ -65,3 +65,33 @@ def gt_solve(dl, d, du, du2, ipiv, b):
         y = (x[i] - du[i] * x[i + 1] - du2[i] * x[i + 2]) / d[i]
         x[i] = y if abs(y) >= SMALLEST_NORMAL else 0.0
     return x
+
+
+@njit(cache=True)
+def tvd_advect(c, p):
+    """models/fd.advect_tvd_numpy compiled, operation for operation (the same bits): one explicit
+    ULTIMATE-QUICKEST step at Courant number p, faces upstream of the flow's sign -> (c', the mass per
+    dx that leaves through the two end faces)."""
+    m = c.shape[0]
+    cr = abs(p)
+    ahead = np.empty(m + 4)  # the nodes along the flow, two zero ghosts each side
+    ahead[:2] = 0.0
+    ahead[m + 2 :] = 0.0
+    for i in range(m):
+        ahead[i + 2] = c[i] if p > 0 else c[m - 1 - i]
+    half_rest, curve_weight = 0.5 * (1.0 - cr), (1.0 - cr * cr) / 6.0
+    faces = np.empty(m + 1)
+    for k in range(m + 1):
+        up, centre, down = ahead[k], ahead[k + 1], ahead[k + 2]
+        curv = down - 2.0 * centre + up
+        face = centre + half_rest * (down - centre) - curve_weight * curv
+        delta = down - up
+        reach = up + (centre - up) / cr
+        far = min(down, reach) if delta > 0.0 else max(down, reach)
+        held = min(max(face, min(centre, far)), max(centre, far))
+        faces[k] = held if abs(curv) < abs(delta) else centre
+    out = np.empty(m)
+    for i in range(m):
+        value = ahead[i + 2] - cr * (faces[i + 1] - faces[i])
+        out[i if p > 0 else m - 1 - i] = value
+    return out, cr * (faces[m] - faces[0])

@@ -1,7 +1,9 @@
-"""FD in a flow, its tridiagonal solve by LAPACK's dgttrs against the compiled sweeps that flush
-subnormal results (numerics/thomas.gt_solve), side by side in one process on the same states.
+"""FD in a flow, old against new side by side in one process on the same states: the tridiagonal
+solve by LAPACK's dgttrs against the compiled sweeps that flush subnormal results
+(numerics/thomas.gt_solve), and tvd's advection step in numpy (advect_tvd_numpy) against its
+compiled twin (numerics/thomas.tvd_advect).
 
-    python benchmarks/fd_subnormal.py [N ...]      # default 4096 16384 65536
+    python benchmarks/fd_solvers.py [N ...]      # default 4096 16384 65536
 
 The carried scene's implicit upwind and central candidates (D 1e-4, v 1, fd_dt 0.01): each N is
 stepped 300 steps from its source, then both solves are timed on that state (best of 5 of 50
@@ -69,6 +71,17 @@ def main(sizes: list[int]) -> None:
                 f"{scheme:7s} N={n:6d}: dgttrs {old * 1e3:.3f} ms, gt_solve {new * 1e3:.3f} ms, ratio {old / new:.2f}; "
                 f"max |diff| {np.abs(got - want).max():.3g}, equal above 2^-969: {same}"
             )
+
+    for n in sizes:  # tvd at Courant 0.75 on a Gaussian: the same bits, one pass
+        x = np.linspace(-1.0, 1.0, n)
+        c = np.exp(-(x**2) / 0.01)
+        old = best(lambda c=c: fd.advect_tvd_numpy(c, 0.75))
+        new = best(lambda c=c: fd.advect_tvd(c, 0.75))
+        same = fd.advect_tvd(c, 0.75)[0].tobytes() == fd.advect_tvd_numpy(c, 0.75)[0].tobytes()
+        print(
+            f"tvd     N={n:6d}: numpy {old * 1e3:.3f} ms, compiled {new * 1e3:.3f} ms, ratio {old / new:.1f}; "
+            f"same bits: {same}"
+        )
 
 
 if __name__ == "__main__":
