@@ -20,7 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow" / "lib"))
-from particle_entropy.analysis.scene_search import crossover  # noqa: E402
+from particle_entropy.analysis.scene_search import crossover, peclet_table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -56,6 +56,15 @@ def main(workdir: Path) -> None:
         print(t.to_string())
         cross = crossover(t)
         print(f"  Peclet sweep: particles overtake the grid at Pe in {cross}" if cross else "  no crossover")
+        # the same sweep without the tvd candidates: each candidate's search is its own, so this is
+        # the crossover a sweep of upwind and central alone gives
+        tables = [pd.read_parquet(p) for p in sorted((workdir / "results/scenes").glob("peclet-*.parquet"))]
+        plain = peclet_table([x[~x["label"].str.contains(" tvd ")] for x in tables])
+        print(plain.to_string())
+        cross = crossover(plain)
+        print(
+            f"  without tvd: particles overtake the grid at Pe in {cross}" if cross else "  without tvd: no crossover"
+        )
 
 
 if __name__ == "__main__":
