@@ -84,7 +84,7 @@ def scenes_peclet(table: pd.DataFrame):
         None,
         "Where particles overtake grids",
         "counted cost of one run that meets the target [s]",
-        "Péclet number v L / D",
+        "scene Péclet number |v| L / D (L the FD window)",
         logx=True,
         logy=True,
         legend=None,
