@@ -44,7 +44,8 @@ MASS_LOSS_MAX = 1e-3
 RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a finished scene
     "candidate": "the candidate's index in `scenes.<name>.candidates` as written (a Peclet scene: in its base's; "
     "at v = 0 an FD candidate that differs from an earlier one only in advection repeats its rows)",
-    "label": "the candidate's name: method, kernel and dimensions (FD: scheme and fd_dt)",
+    "label": "the candidate's name: method, kernel and dimensions (FD: its advection scheme and its step, "
+    "dt=fd_dt or Cr=courant)",
     "method": "fd, pt or mtpt",
     "n": "the resolution: particles, or FD intervals",
     "realisations": "runs averaged, over every seed block run (particles: a multiple of the scene's `realisations`, "
