@@ -26,7 +26,9 @@ import numpy as np
 import pandas as pd
 
 from ..core.io import read_parquet
+from ..core.registry import MEASUREMENT_POINTS
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
+from .resampling import CONFIDENCE
 
 CLIMB = 2  # rungs climbed a round while no rung passes
 PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
@@ -86,7 +88,7 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
 def error(scene: Scene, row: pd.Series | dict) -> float:
     """The scene's error measure of one run at t_final (its last row)."""
     if scene.measure == "rmse":
-        return math.sqrt(row["SSE_points"] / 15.0)
+        return math.sqrt(row["SSE_points"] / MEASUREMENT_POINTS)
     if scene.measure == "entropy":
         return abs(row["H_C"] - row["H_C_analytic"])
     return abs(row["E"] / row["E_analytic"] - 1.0)
@@ -129,7 +131,7 @@ def _t_margin(errors: np.ndarray, quantile: float) -> float:
 def upper_bound(errors: np.ndarray) -> float:
     """The mean's one-sided 95 % upper bound (Student t); one value: itself."""
     errors = np.asarray(errors, dtype=float)
-    return float(errors.mean() + _t_margin(errors, 0.95))
+    return float(errors.mean() + _t_margin(errors, CONFIDENCE))
 
 
 def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) -> tuple[int, int]:
@@ -155,7 +157,7 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
         reason = next((why for why in (unscored(scene, r) for r in records) if why), "")
         errs = np.array([error(scene, r) for r in records])
         k = errs.size
-        half = _t_margin(errs, 0.975)
+        half = _t_margin(errs, 0.5 * (1.0 + CONFIDENCE))  # two-sided
         up = upper_bound(errs)
         rows.append(
             {
