@@ -112,6 +112,20 @@ def _check_seed_count(base: int, most: int) -> None:
         )
 
 
+def _check_max_realisations(key: str, most: int, base: int) -> None:
+    """_check_seed_count for a search that runs seeds up to base + ``most`` - 1, named by its own
+    ``key`` (an optimum search's or a scene's max_realisations), which sets how far they run."""
+    try:
+        _check_seed_count(base, most)
+    except SettingError:
+        raise SettingError(
+            key,
+            most,
+            f"an integer <= {MAX_SEED - base + 1} with base_seed = {base} (seeds run to base_seed + "
+            "max_realisations - 1 and are stored as int64), or a lower base_seed",
+        ) from None
+
+
 def check_shear(config: Mapping) -> None:
     """Every shear case must build a valid ShearConfig (strip inside the domain, whole steps, ...)."""
     if "shear" not in config:
@@ -203,15 +217,7 @@ def check_scene(scene, base_seed: int, available: float | None) -> None:
     fit int64 (SettingError naming scenes.<name>.max_realisations, which sets how far they run), and
     its jobs fit in memory (check_scene_memory; ``available`` None: not checked)."""
     most = max(1 if c.case.method == "fd" else scene.max_realisations for c in scene.candidates)
-    try:
-        _check_seed_count(int(base_seed), most)
-    except SettingError:
-        raise SettingError(
-            scene.key("max_realisations"),
-            scene.max_realisations,
-            f"an integer <= {MAX_SEED - int(base_seed) + 1} with base_seed = {base_seed} (seeds run to base_seed + "
-            "max_realisations - 1 and are stored as int64), or a lower base_seed",
-        ) from None
+    _check_max_realisations(scene.key("max_realisations"), most, int(base_seed))
     if available is not None:
         check_scene_memory(scene, available)
 
@@ -259,16 +265,7 @@ def check_search(name: str, config: Mapping, available: float | None = None):
             if e.name in ("n", "dt_growth"):
                 raise SettingError(f"{where}.{key}", [search.lo, search.hi], e.allowed) from None
             raise _case_error(e, f"{where}.case", case) from None
-    base = int(config["base_seed"])
-    try:
-        _check_seed_count(base, search.max_realisations)
-    except SettingError:  # named by the search's own key, which sets how far its seeds run
-        raise SettingError(
-            f"{where}.max_realisations",
-            search.max_realisations,
-            f"an integer <= {MAX_SEED - base + 1} with base_seed = {base} (seeds run to base_seed + "
-            "max_realisations - 1 and are stored as int64), or a lower base_seed",
-        ) from None
+    _check_max_realisations(f"{where}.max_realisations", search.max_realisations, int(config["base_seed"]))
     if available is not None:
         _check_jobs_fit(
             [(f"{where}.{key}", e, e.realisations) for e in optimum_largest_jobs(search)], config, available
