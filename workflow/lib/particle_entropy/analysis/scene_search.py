@@ -137,8 +137,13 @@ def upper_bound(errors: np.ndarray) -> float:
 def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) -> tuple[int, int]:
     """The first and last seed of a rung's seed block ``block`` (0, 1, ...): base_seed + block R to
     base_seed + (block + 1) R - 1, R the scene's realisations (FD: one run, block 0)."""
-    count = 1 if candidate.case.method == "fd" else scene.realisations
+    count = block_size(scene, candidate)
     return base_seed + block * count, base_seed + (block + 1) * count - 1
+
+
+def block_size(scene: Scene, candidate: Candidate) -> int:
+    """The runs of one seed block of a candidate's rung: the scene's realisations (FD: one run)."""
+    return 1 if candidate.case.method == "fd" else scene.realisations
 
 
 JUDGED_COLUMNS = list(RESULT_COLUMN_DOCS)[: list(RESULT_COLUMN_DOCS).index("COMIC_points") + 1]
@@ -243,7 +248,7 @@ def _next_rungs(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tu
     lowest = states.index(PASS) if PASS in states else None
     limit = len(ladder) if lowest is None else lowest
     top = max(i for i, s in enumerate(states) if s is not None)
-    per_block = 1 if candidate.case.method == "fd" else scene.realisations
+    per_block = block_size(scene, candidate)
     todo = [(ladder[i], int(rows[ladder[i]]["realisations"]) // per_block) for i in range(limit) if states[i] == OPEN]
     if lowest is not None or top == len(ladder) - 1:
         todo += [(ladder[i], 0) for i in range(limit) if states[i] is None]
@@ -431,8 +436,7 @@ def grid_numbers(scene: Scene, candidate: Candidate, n: int) -> tuple[float, flo
     if candidate.case.method != "fd" or scene.v == 0.0:
         return math.nan, math.nan
     cfg = scene.run_config(candidate, n)
-    dx = cfg.fd_span()[1] / n
-    return abs(scene.v) * dx / scene.D, abs(scene.v) * cfg.dt0 / dx
+    return abs(scene.v) * cfg.fd_dx / scene.D, cfg.courant_number()
 
 
 def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
