@@ -43,11 +43,8 @@ def check_balance(before: np.ndarray, after: np.ndarray, outflow: float, scale: 
 def grid(cfg: RunConfig) -> tuple[np.ndarray, float]:
     """Nodes lo + k dx, k = 0..N, dx = length / N (both end nodes held at zero): the paper's
     [-L/2, L/2], lengthened by a scene's path v t_final (RunConfig.fd_span)."""
-    if cfg.at_rest:
-        dx = cfg.fd_length / cfg.n
-        return -cfg.fd_length / 2.0 + dx * np.arange(cfg.n + 1), dx
-    lo, length = cfg.fd_span()
-    dx = length / cfg.n
+    dx = cfg.fd_dx
+    lo = -cfg.fd_length / 2.0 if cfg.at_rest else cfg.fd_span()[0]
     return lo + dx * np.arange(cfg.n + 1), dx
 
 
