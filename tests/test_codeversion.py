@@ -163,3 +163,69 @@ def test_library_path_is_exported_first_and_once(monkeypatch, tmp_path):
     export_library_path(tmp_path)
     export_library_path(tmp_path)  # a job re-parsing the Snakefile exports it again
     assert os.environ["PYTHONPATH"].split(os.pathsep) == [str(tmp_path), "/elsewhere"]
+
+
+# --------------------------------------------------------------------------- sections apart
+def _edit(path, old, new):
+    text = path.read_text()
+    assert old in text, f"{old!r} not in {path.name}: the test edits a declaration that moved"
+    _rewrite(path, text.replace(old, new, 1))
+
+
+@pytest.fixture
+def library(tmp_path):
+    """A copy of the real package, to edit declarations in."""
+    import shutil
+
+    from particle_entropy.pipeline.codeversion import PACKAGE
+
+    root = tmp_path / "particle_entropy"
+    shutil.copytree(PACKAGE, root, ignore=shutil.ignore_patterns("__pycache__"))
+    imports.cache_clear()
+    modules.cache_clear()
+    yield root
+    imports.cache_clear()
+    modules.cache_clear()
+
+
+def _simulation_hashes(root, script):
+    from particle_entropy.core.registry import METHODS
+    from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, simulation_code
+
+    hashes = {m: simulation_code(m, METHODS, script, package=root) for m in METHODS}
+    return hashes | {"shear": code_version(*SHEAR_ENTRIES, files=[script], package=root)}
+
+
+def test_simulation_code_holds_no_other_section(library):
+    """A simulation imports the run settings (core/run_settings.py) and the shear flow's, never
+    core/settings.py, which declares every other section."""
+    from particle_entropy.core.registry import METHODS
+    from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, SIMULATION_ENTRIES
+
+    for method in METHODS:
+        others = {f"models.{m}" for m in METHODS if m != method}
+        mods = closure([*SIMULATION_ENTRIES, f"models.{method}"], exclude=others, package=library)
+        assert "core.run_settings" in mods and "core.settings" not in mods
+        assert not any(m.split(".")[0] in ("analysis", "experiments", "figures", "pipeline") for m in mods)
+    assert "core.settings" not in closure(SHEAR_ENTRIES, package=library)
+
+
+def test_editing_another_section_reruns_no_simulation(library, tmp_path):
+    """Rewording a claims tolerance, a scene's cost constant or a search's key changes no
+    simulation's code hash; editing the run settings changes every 1-D one, the shear flow's
+    settings only the shear flow's."""
+    script = tmp_path / "simulate.py"
+    script.write_text("# the job script\n")
+    before = _simulation_hashes(library, script)
+    settings = library / "core" / "settings.py"
+    _edit(settings, '"allowed |H_C - analytic| of adaptive-kernel PT at t = 1000"', '"a reworded claim"')
+    _edit(settings, "MAX_REALISATIONS = 10_000", "MAX_REALISATIONS = 20_000")
+    _edit(settings, '"the searched model (unset dimensions from case_defaults)"', '"a reworded search key"')
+    assert _simulation_hashes(library, script) == before
+    _edit(library / "core" / "shear_settings.py", '"longitudinal dispersivity"', '"reworded"')
+    after_shear = _simulation_hashes(library, script)
+    assert after_shear["shear"] != before["shear"]
+    assert {m: h for m, h in after_shear.items() if m != "shear"} == {m: h for m, h in before.items() if m != "shear"}
+    _edit(library / "core" / "run_settings.py", '"diffusion coefficient"', '"reworded"')
+    after_run = _simulation_hashes(library, script)
+    assert all(after_run[m] != after_shear[m] for m in after_run)

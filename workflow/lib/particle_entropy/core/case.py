@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 from .registry import KERNELS, METHODS, PRESETS, SCHEME_RECORDS, SCHEMES, TIME_GRIDS
-from .settings import BY_NAME, PAPER
+from .run_settings import BY_NAME, PAPER
 
 N_MIN = 2  # one particle (or one FD interval) is a delta against itself: SSE 0, COMIC -inf
 

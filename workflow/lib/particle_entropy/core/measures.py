@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from .registry import MEASUREMENT_POINTS, MEASUREMENT_SEED
-from .settings import PAPER
+from .run_settings import PAPER
 
 
 def entropy_discrete(p: np.ndarray) -> float:

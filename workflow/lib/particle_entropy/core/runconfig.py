@@ -14,7 +14,7 @@ from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
 from .reference import Reference, Source
 from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_KERNEL
-from .settings import BY_NAME, MAX_SEED, PAPER, Setting
+from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
 PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0

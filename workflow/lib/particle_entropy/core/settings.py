@@ -1,11 +1,14 @@
 """The one typed definition of every config setting: key, default, unit, range, meaning.
 
-Each config section is declared here once, as a tuple of ``Setting``: the run settings
-(``SETTINGS``: physics, time, numerics, case_defaults), the keys of every section that lists cases
+Each config section is declared once, as a tuple of ``Setting``, and gathered here: the run
+settings (``SETTINGS``: physics, time, numerics, case_defaults) and the shear flow's (``SHEAR``)
+are declared in core/run_settings.py and core/shear_settings.py, apart, because simulations import
+them and a simulation's code hash covers what it imports (tests/test_codeversion.py holds it
+unchanged when any other section's declaration changes). Declared here: the keys of every section that lists cases
 (``CASE_SECTION``: figures, tradeoff, mechanism sweeps), the figures' drawing options
 (``FIGURE_OPTIONS``), seeds and their blocks (``SEEDS``), the COMIC times (``COMIC_TIMES``), the
 claims' tolerances (``CLAIMS``), the trade-off sweep (``TRADEOFF``), the mechanism experiments
-(``MECHANISM``), the shear flow (``SHEAR``) and an adaptive search (``SEARCH``), with the caps
+(``MECHANISM``) and an adaptive search (``SEARCH``), with the caps
 they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``MAX_N``, ``SHEAR_MAX_N``). From them come the paper's
 defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
 checks, the CLI's options (cli.py), the schema's blocks, which
@@ -19,201 +22,27 @@ their range is then given in words (``range_text``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from .registry import (
     ADVECTION_SCHEMES,
     CONVENTION_NAMES,
     COURANT_LIMIT,
-    FGT_TOLERANCE,
-    FGT_TOLERANCE_RANGE,
-    LOOP_ARITHMETICS,
     MEASURE_NAMES,
-    SCHEMES,
-    SHEAR_CASES,
-    TIME_GRIDS,
-    TRANSFER_METHODS,
 )
+from .run_settings import (  # noqa: F401  (re-exported: the run settings, declared apart)
+    BY_NAME,
+    CASE_SETTINGS,
+    MAX_SEED,
+    NO_DEFAULT,
+    PAPER,
+    SETTINGS,
+    Setting,
+    defaults,
+)
+from .shear_settings import SHEAR, SHEAR_MAX_N  # noqa: F401  (re-exported)
 
 MAX_REALISATIONS = 10_000  # realisations of one case or N: more is a typo, not an ensemble
-MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
 MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB for mass transfer; more is a typo
-SHEAR_MAX_N = 10**8  # shear particles: 5,000 x the paper's, ~40 GB for a random walk; more is a typo
-NO_DEFAULT = object()  # a setting the config must give (or may leave out, with no default)
-
-
-@dataclass(frozen=True)
-class Setting:
-    """One setting: ``name`` is its field (a RunConfig's: CLI option ``--name`` with dashes),
-    ``key`` its config key (``<name>`` standing for any key of a mapping, ``[]`` for any item of
-    a list). ``kind`` is number, integer, boolean or string (with ``choices``, the allowed
-    words), or shape: a structured value whose JSON-schema ``shape`` is given. Numbers lie in
-    [low, high] (``open_low``: low excluded); ``none`` allows the word none (None), as truncation
-    does; ``range_text`` states a range that depends on other fields; ``required``: the config
-    must give it."""
-
-    name: str
-    key: str
-    default: object
-    doc: str
-    unit: str = "-"
-    low: float | None = None
-    high: float = math.inf
-    open_low: bool = False
-    choices: tuple[str, ...] | None = None
-    none: bool = False
-    kind: str = "number"
-    shape: dict | None = None
-    range_text: str | None = None
-    required: bool = False
-
-    @property
-    def section(self) -> str:
-        """The key of the mapping the setting sits in (``physics``, ``mechanism.lattice``; the
-        config itself: empty)."""
-        return self.key.rsplit(".", 1)[0] if "." in self.key else ""
-
-    @property
-    def has_default(self) -> bool:
-        return self.default is not NO_DEFAULT
-
-    @property
-    def option(self) -> str:
-        return "--" + self.name.replace("_", "-")
-
-    def allowed(self) -> str:
-        """The allowed values in words, as error messages and help texts give them."""
-        if self.range_text is not None:
-            return self.range_text
-        if self.kind == "shape":
-            raise ValueError(f"setting {self.key}: a structured value needs its range_text")
-        if self.choices is not None:
-            return "one of " + ", ".join(self.choices)
-        if self.kind == "boolean":
-            return "true or false"
-        integer = self.kind == "integer"
-        noun, num = ("an integer", lambda v: f"{int(v):,}") if integer else ("a number", lambda v: f"{v:g}")
-        if self.high != math.inf:
-            words = f"{noun} in {'(' if self.open_low else '['}{num(self.low)}, {num(self.high)}]"
-        else:
-            words = f"{noun} {'>' if self.open_low else '>='} {num(self.low)}"
-        return ("none or " if self.none else "") + words
-
-
-SETTINGS = (
-    Setting("D", "physics.D", 1e-3, "diffusion coefficient", "L^2/T", low=0.0, open_low=True),
-    Setting("t_final", "physics.t_final", 1000.0, "final time", "T", low=0.0, open_low=True),
-    Setting(
-        "omega",
-        "physics.omega",
-        10.0,
-        "particle domain length Omega, particles on [-Omega/2, Omega/2]",
-        "L",
-        0.0,
-        open_low=True,
-    ),
-    Setting(
-        "fd_length",
-        "physics.fd_length",
-        12.0,
-        "finite-difference domain length, centred on x = 0",
-        "L",
-        0.0,
-        open_low=True,
-    ),
-    Setting(
-        "fixed_kernel_time",
-        "physics.fixed_kernel_time",
-        1.0,
-        "fixed-kernel PT reconstructs with a Gaussian of variance 2 D x this time",
-        "T",
-        0.0,
-        open_low=True,
-    ),
-    Setting(
-        "dt0",
-        "time.dt0",
-        0.01,
-        "first particle time step; later steps grow by the case's dt_growth",
-        "T",
-        0.0,
-        open_low=True,
-    ),
-    Setting("fd_dt", "time.fd_dt", 0.05, "finite-difference fixed time step", "T", 0.0, open_low=True),
-    Setting("fixed_dt", "time.fixed_dt", 1.0, "fixed step of particle cases with dt_growth 1", "T", 0.0, open_low=True),
-    Setting(
-        "transfer_method",
-        "numerics.transfer_method",
-        "auto",
-        "Gauss-transform algorithm of the mass transfer: auto = the exact windowed sum for few neighbours or "
-        "truncated kernels, the fast Gauss transform otherwise",
-        choices=TRANSFER_METHODS,
-    ),
-    Setting(
-        "transfer_tolerance",
-        "numerics.transfer_tolerance",
-        FGT_TOLERANCE,
-        "fast Gauss transform error bound, relative to the summed |weights| within the cut-off "
-        "(1e-17 = round-off: mass conserved to 1e-13)",
-        low=FGT_TOLERANCE_RANGE[0],
-        high=FGT_TOLERANCE_RANGE[1],
-    ),
-    Setting(
-        "loop_arithmetic",
-        "numerics.loop_arithmetic",
-        "fused",
-        "arithmetic of the authors' sequential loop (mtpt schemes with the loop): fused = each exchange's mass "
-        "update one fused multiply-add and the row sums vectorised, equal to exact to round-off in about half its "
-        "time (docs/speed.md); exact = bit for bit the loop of tests/sequential_reference.py",
-        choices=LOOP_ARITHMETICS,
-    ),
-    Setting("eta", "case_defaults.eta", 1.0, "fraction of D done by mass transfer (mtpt only)", low=0.0, high=1.0),
-    Setting(
-        "truncation",
-        "case_defaults.truncation",
-        None,
-        "transfer-kernel truncation (mtpt only): none = the whole Gaussian, else a number of kernel widths "
-        "(3 = the authors' code)",
-        "kernel widths",
-        low=0.0,
-        open_low=True,
-        none=True,
-    ),
-    Setting(
-        "dt_growth",
-        "case_defaults.dt_growth",
-        1.05,
-        "time-step growth factor dt_{n+1} = dt_growth dt_n (1 = fixed step time.fixed_dt; pt and mtpt only; at "
-        "most 10: a larger factor reaches t_final in a few steps and overflows at 1e308)",
-        low=1.0,
-        high=10.0,
-    ),
-    Setting(
-        "scheme",
-        "case_defaults.scheme",
-        "symmetric",
-        "mass-transfer scheme (mtpt only, registry.SCHEME_RECORDS)",
-        choices=SCHEMES,
-    ),
-    Setting(
-        "time_grid",
-        "case_defaults.time_grid",
-        "exact",
-        "particle time grid: exact = the last step is shortened to end at t_final; authors = whole growing "
-        "steps while t < t_final, as the authors' code (175 steps ending at t = 1021.1 for the paper's "
-        "settings; pt and mtpt only); FD steps always end at t_final",
-        choices=TIME_GRIDS,
-    ),
-)
-BY_NAME = {s.name: s for s in SETTINGS}
-CASE_SETTINGS = tuple(s.name for s in SETTINGS if s.section == "case_defaults")
-# The paper's settings (../shared/docs/experiments.md beside the repository); config.yaml equals these.
-PAPER = {s.name: s.default for s in SETTINGS}
-
-
-def defaults(settings) -> dict:
-    """Field name -> default of the settings that have one."""
-    return {s.name: s.default for s in settings if s.has_default}
 
 
 def _ref(name: str) -> dict:
@@ -465,103 +294,6 @@ CLAIMS = (  # the tolerances the paper's claims are judged at (analysis/claims.p
         "allowed |H_C - analytic| of adaptive-kernel PT at t = 1000",
         "nats",
         low=0.0,
-    ),
-)
-
-# ------------------------------------------------------------------------------ the shear flow
-SHEAR = (  # Appendix B; ShearConfig's fields (models/shear2d.py) besides `case`
-    Setting(
-        "cases",
-        "shear.cases",
-        NO_DEFAULT,
-        "cases to run: rw_nodrift, rw_drift (random walks without / with the grad.D drift), mt (mass transfer only)",
-        kind="shape",
-        shape={
-            "type": "array",
-            "minItems": 1,
-            "uniqueItems": True,
-            "items": {"type": "string", "enum": list(SHEAR_CASES)},
-        },
-        range_text="a list of " + ", ".join(SHEAR_CASES) + ", each once",
-        required=True,
-    ),
-    Setting(
-        "seed",
-        "shear.seed",
-        0,
-        "random seed",
-        kind="integer",
-        low=0,
-        high=MAX_SEED,
-        range_text="an integer in [0, 2^63 - 1] (stored as int64)",
-        required=True,
-    ),
-    Setting(
-        "n",
-        "shear.n",
-        20_000,
-        "particles, uniform over the domain (the memory check may refuse fewer)",
-        kind="integer",
-        low=1,
-        high=SHEAR_MAX_N,
-        required=True,
-    ),
-    Setting("length", "shear.length", 400.0, "periodic domain length in x", "L", 0.0, open_low=True, required=True),
-    Setting(
-        "strip_lo",
-        "shear.strip_lo",
-        90.0,
-        "left edge of the initial strip",
-        "L",
-        0.0,
-        range_text="a number in [0, length]",
-        required=True,
-    ),
-    Setting(
-        "strip_hi",
-        "shear.strip_hi",
-        110.0,
-        "right edge of the initial strip",
-        "L",
-        0.0,
-        open_low=True,
-        range_text="a number in (strip_lo, length]",
-        required=True,
-    ),
-    Setting(
-        "alpha_L",
-        "shear.alpha_L",
-        1e-2,
-        "longitudinal dispersivity",
-        "L",
-        0.0,
-        open_low=True,
-        range_text="a number > 0 with a step's dispersion sqrt(2 alpha_L v_max dt) <= length / 10 (v_max = 1/4)",
-        required=True,
-    ),
-    Setting(
-        "alpha_T",
-        "shear.alpha_T",
-        1e-3,
-        "transverse dispersivity",
-        "L",
-        0.0,
-        range_text="a number >= 0 with a step's dispersion sqrt(2 alpha_T v_max dt) <= 1/10 of the channel's width "
-        "(v_max = 1/4): alpha_T dt <= 0.02",
-        required=True,
-    ),
-    Setting("beta", "shear.beta", 0.5, "mass-transfer coefficient of Eq. 16 for the mt case", low=0.0, high=1.0),
-    Setting("dt", "shear.dt", 1.0, "time step", "T", 0.0, open_low=True, required=True),
-    Setting(
-        "t_final",
-        "shear.t_final",
-        500.0,
-        "final time",
-        "T",
-        0.0,
-        open_low=True,
-        range_text="a number > 0, a whole number of steps dt",
-        required=True,
     ),
 )
 

@@ -32,8 +32,9 @@ import numpy as np
 
 from ..core.records import Recorder
 from ..core.registry import SHEAR_CASES
+from ..core.run_settings import defaults
 from ..core.runconfig import SettingError, check_range, check_setting
-from ..core.settings import SHEAR, defaults
+from ..core.shear_settings import SHEAR
 from ..core.timegrid import MAX_STEPS
 
 if TYPE_CHECKING:

@@ -87,11 +87,11 @@ SIMULATION_ENTRIES = ("models.simulate", "core.io", "core.heap")
 SHEAR_ENTRIES = ("models.shear2d", "core.io", "core.heap")
 
 
-def simulation_code(method: str, methods, script) -> str:
+def simulation_code(method: str, methods, script, package: Path = PACKAGE) -> str:
     """The code hash of a ``method`` simulation job: SIMULATION_ENTRIES, the method's module and
     the job's script, the other ``methods``' modules left out."""
     others = {f"models.{m}" for m in methods if m != method}
-    return code_version(*SIMULATION_ENTRIES, f"models.{method}", exclude=others, files=[script])
+    return code_version(*SIMULATION_ENTRIES, f"models.{method}", exclude=others, files=[script], package=package)
 
 
 def export_library_path(lib: str | Path) -> str:
