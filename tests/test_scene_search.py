@@ -136,8 +136,19 @@ def test_the_cheaper_candidate_is_recommended_by_counted_cost():
     firsts = out[out["meets"]].sort_values("n").groupby("candidate").head(1)
     cheapest = firsts.loc[firsts["cost_s"].idxmin()]
     assert out[out["recommended"]].index.tolist() == [cheapest.name]
-    fd = scene.cost_s("fd", 100.0, 100.0 * 100)
-    assert fd == pytest.approx(3.85e-5 * 100 + 1.72e-8 * 1e4)  # the shipped cost model: a step, a unit of work
+    # a run's cost is a step's cost times its steps plus a unit of work's times its work, with the
+    # units the scene's config gives (not the shipped ones, which a test must not copy)
+    own = Scene.from_config(
+        "s",
+        {
+            "v": 0.01,
+            "t_final": 50.0,
+            "target": {"value": 0.01},
+            "candidates": [FD, MTPT],
+            "cost": {"fd": [2.0, 0.5], "pt": [1.0, 1.0], "mtpt": [1.0, 1.0]},
+        },
+    )
+    assert own.cost_s("fd", 100.0, 100.0 * 100) == 2.0 * 100 + 0.5 * 1e4
 
 
 def test_nothing_recommended_when_no_candidate_meets_the_target():

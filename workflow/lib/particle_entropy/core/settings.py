@@ -28,6 +28,7 @@ from .registry import (
     CONVENTION_NAMES,
     COURANT_LIMIT,
     MEASURE_NAMES,
+    METHODS,
 )
 from .run_settings import (  # noqa: F401  (re-exported: the run settings, declared apart)
     BY_NAME,
@@ -588,7 +589,7 @@ SCENE = (
             "additionalProperties": False,
             "properties": {
                 m: {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2}
-                for m in ("fd", "pt", "mtpt")
+                for m in METHODS
             },
         },
         range_text="per method fd, pt, mtpt: [seconds a step, seconds a unit of work], numbers >= 0",
