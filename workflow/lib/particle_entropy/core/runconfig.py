@@ -13,7 +13,7 @@ import numpy as np
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
 from .reference import Reference, Source
-from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_KERNEL
+from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION, DEFAULT_KERNEL
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
@@ -163,7 +163,7 @@ class RunConfig:
     # x = 0 at rest. FD's advection scheme is used only when v != 0.
     source: Source = PAPER_SOURCE
     v: float = 0.0
-    advection: str = "upwind"
+    advection: str = DEFAULT_ADVECTION
     window: float | None = None  # the measurement points' span: None = the paper's (at rest) or fd_length
     # FD in a flow: the step that follows the grid, dt0 = courant dx / |v| (resolved()); None: dt0 as given
     courant: float | None = None

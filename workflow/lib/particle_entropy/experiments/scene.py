@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference, Source
-from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT
+from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION
 from ..core.runconfig import RunConfig, check_plume_width, check_setting
 from ..core.settings import BY_KEY, MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
@@ -71,7 +71,7 @@ class Candidate:
     case: Case
     n_lo: int
     n_hi: int
-    advection: str = "upwind"  # "none" in a scene without flow
+    advection: str = DEFAULT_ADVECTION  # "none" in a scene without flow
     fd_dt: float = PAPER["fd_dt"]
     rungs: tuple[int, ...] = ()  # a ladder written out (config `ladder`) instead of n_range's
     courant: float | None = None  # FD in a flow: the step's Courant number instead of fd_dt
@@ -463,7 +463,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     else:
         rungs = []
     n_range = spec.pop("n_range", None)
-    advection = spec.pop("advection", "upwind")
+    advection = spec.pop("advection", DEFAULT_ADVECTION)
     fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
     courant = spec.pop("courant", None)
     ok = (
