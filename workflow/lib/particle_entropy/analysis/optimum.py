@@ -28,7 +28,9 @@ bracketing search.
 
 A plan is a table of seed blocks, one row per (N, block of seeds) added in some round; every
 block is an ordinary simulation job (sweeps.run_path), so its results are cached and shared.
-No Snakemake here: the rules in workflow/rules/optimum.smk call these functions.
+The rounds, plans, seed blocks and the rounds' inputs are the search engine's (search.py); this
+module is the rule for the next points (next_plan) and the result. No Snakemake here: the rules
+in workflow/rules/optimum.smk call these functions.
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ from ..core.settings import PAPER, SEARCH, defaults
 from ..core.timegrid import step_count
 from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
 from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
+from .search import AdaptiveSearch, check_plan_columns, extended, new_plan, next_round, runs_in, seed_block, stopped
 
 SEARCH_DEFAULTS = defaults(SEARCH)  # settings.SEARCH: one search's keys, defaults and ranges
 MEASURES = dict(
@@ -67,7 +70,7 @@ OVER = {
     "dt_growth": "the time-step growth factor at a fixed N (pt, mtpt), searched in log(dt_growth - 1)",
 }
 MAX_ROUNDS = 16  # a search that has not converged by then stops ("round limit")
-PLAN_COLUMNS = ["round", "n", "dt_growth", "first", "last", "done", "reason"]
+PLAN_COLUMNS = check_plan_columns(["round", "n", "dt_growth", "first", "last", "done", "reason"])
 REASONS = (
     "bracket narrow enough",
     "budget spent",
@@ -122,9 +125,10 @@ RESULT_COLUMNS = list(RESULT_COLUMN_DOCS)
 
 
 @dataclass(frozen=True)
-class Search:
+class Search(AdaptiveSearch):
     """One adaptive search: a model (a case without N; with one for a dt-growth search), the time
-    COMIC is judged at, the searched dimension and its range, a budget and when to stop."""
+    COMIC is judged at, the searched dimension and its range, a budget and when to stop; a kind of
+    the search engine (search.AdaptiveSearch), whose rule for the next points is next_plan."""
 
     name: str
     model: Case
@@ -144,6 +148,25 @@ class Search:
     convention: str = SEARCH_DEFAULTS["convention"]  # what is minimised over N (aggregate.CONVENTIONS)
     measure: str = SEARCH_DEFAULTS["measure"]  # where SSE is taken (MEASURES)
     steps: Mapping | None = None  # time.dt0, fd_dt, fixed_dt: set, the time step joins the sampling volume
+
+    @property
+    def title(self) -> str:
+        return f"optimum search {self.name}"
+
+    @property
+    def max_plans(self) -> int:
+        return MAX_ROUNDS + 2  # next_plan stops by round MAX_ROUNDS + 1
+
+    def first_plan(self, base_seed: int) -> pd.DataFrame:
+        return initial_plan(self, base_seed)
+
+    def next_plan(self, plan: pd.DataFrame, runs: pd.DataFrame, base_seed: int) -> pd.DataFrame:
+        return next_plan(self, plan, runs)  # the blocks' seeds follow the plan's own (base_seed of round 0)
+
+    def read_runs(self, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
+        """The runs' values at the search's time; their measured wall times are not read."""
+        frames = [read_parquet(p, columns=RUN_COLUMNS) for p in paths]
+        return realisations_table(frames, [self.time])
 
     @property
     def time_volume(self) -> bool:
@@ -363,9 +386,10 @@ def _check_spec(where: str, spec) -> None:
             raise SettingError(f"{where}.{key}", value, allowed)
 
 
-def _block(search: Search, k: int, x, first: int, count: int) -> tuple:
+def _block(search: Search, k: int, x, base: int, have: int, count: int) -> tuple:
+    """Round ``k``'s block of ``count`` runs at ``x`` after the ``have`` it has run (search.seed_block)."""
     case = search.case_at(x)
-    return (k, case.n, case.dt_growth, first, first + count - 1, False, "")
+    return (k, case.n, case.dt_growth, *seed_block(base, have, count), False, "")
 
 
 def initial_plan(search: Search, base_seed: int) -> pd.DataFrame:
@@ -373,12 +397,8 @@ def initial_plan(search: Search, base_seed: int) -> pd.DataFrame:
     (seeds base_seed ...): the cheap end first (for a growth search, the largest growth: fewest
     steps), the expensive end only when the minimum may lie there."""
     coarse = search.coarse[::-1] if search.over == "dt_growth" else search.coarse
-    rows = [_block(search, 0, x, base_seed, search.realisations) for x in coarse[: search.start_points]]
-    return pd.DataFrame(rows, columns=PLAN_COLUMNS)
-
-
-def runs_in(plan: pd.DataFrame) -> int:
-    return int((plan["last"] - plan["first"] + 1).sum())
+    rows = [_block(search, 0, x, base_seed, 0, search.realisations) for x in coarse[: search.start_points]]
+    return new_plan(rows, PLAN_COLUMNS)
 
 
 def cost_model(costs: pd.DataFrame, search: Search | None = None) -> Callable[[float], float]:
@@ -603,14 +623,12 @@ def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) ->
     with `done` set and the reason (REASONS) when the search stops. The cost model
     (calibrated_cost) counts the core-seconds budget and orders replication cheapest first:
     the plan depends on the config and the runs' values, never on how long they took."""
-    k = int(plan["round"].max()) + 1
+    k = next_round(plan)
     table, opt = evaluate(search, realisations)
     xs = table[search.over].tolist()
 
     def stop(reason):
-        out = plan.copy()
-        out["done"], out["reason"] = True, reason
-        return out
+        return stopped(plan, reason=reason)
 
     walk, ends = _walk(search, table, opt)
     counts = dict(zip(table[search.over], table["realisations"]))
@@ -650,24 +668,24 @@ def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) ->
     added = []
     spent, spent_s = runs_in(plan), planned_cost_s(search, plan) if model else 0.0
 
-    def add(x, first, count):
+    def add(x, have, count):
         nonlocal spent, spent_s
         cost = count * model(x) if model else 0.0
         if spent + count > search.budget_runs or spent_s + cost > search.budget_core_s:
             return
-        added.append(_block(search, k, x, first, count))
+        added.append(_block(search, k, x, base, have, count))
         spent, spent_s = spent + count, spent_s + cost
 
     for x in [*walk, *new]:
-        add(x, base, search.realisations)
+        add(x, 0, search.realisations)
     for x in more:  # cheapest first: a doubling at small N costs little
         have = int(counts[x])
         if have < search.max_realisations:
-            add(x, base + have, min(have, search.max_realisations - have))
+            add(x, have, min(have, search.max_realisations - have))
     if not added:
         wanted = bool(walk or new) or any(counts[x] < search.max_realisations for x in more)
         return stop(REASONS[1] if wanted else REASONS[2])
-    return pd.concat([plan, pd.DataFrame(added, columns=PLAN_COLUMNS)], ignore_index=True)
+    return extended(plan, added, PLAN_COLUMNS)
 
 
 COST_KEYS = ["n", "dt_growth", "seed"]
@@ -701,9 +719,8 @@ def _visited_end(table: pd.DataFrame, search: Search, best) -> str:
 
 def advance(search: Search, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """The next plan (next_plan) from the run tables of ``plan``'s seed blocks at ``paths``: their
-    values at the search's time; their measured wall times are not read."""
-    frames = [read_parquet(p, columns=RUN_COLUMNS) for p in paths]
-    return next_plan(search, plan, realisations_table(frames, [search.time]))
+    values at the search's time (Search.read_runs); their measured wall times are not read."""
+    return search.round(plan, paths, int(plan["first"].min()))
 
 
 def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame, costs: pd.DataFrame) -> pd.DataFrame:

@@ -12,6 +12,8 @@ rung below the lowest pass (on a ratio-2 ladder they cost about what that rung d
 straddling rungs that can still be the answer in the same rounds; it stops once every rung below
 the lowest pass has run and settled (_next_rungs). Each round is a Snakemake checkpoint whose plan
 names the run tables to make; the path depends on the config and the errors only, never on timings.
+The rounds, plans, seed blocks and the rounds' inputs are the search engine's (search.py; the kind:
+SceneSearch); this module is the rule for a candidate's next rungs (_next_rungs) and the result.
 
 Costs are counted, not timed: work (particle- or node-steps, the run tables' ``work``) times the
 scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work); the
@@ -29,9 +31,10 @@ from ..core.io import read_parquet
 from ..core.registry import MEASUREMENT_POINTS
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
+from .search import AdaptiveSearch, check_plan_columns, new_plan, next_round, seed_block
 
 CLIMB = 2  # rungs climbed a round while no rung passes
-PLAN_COLUMNS = ["candidate", "label", "n", "first", "last", "round", "done"]
+PLAN_COLUMNS = check_plan_columns(["candidate", "label", "n", "first", "last", "round", "done"])
 NEGATIVE_TOLERANCE = 1e-12  # a node or particle mass below -this of the total, at any step, is a negative concentration
 # The most of its unit mass a run may lose (FD: through its window's zero ends) and still be judged.
 # H_C and E are computed on the mass left: a Gaussian that lost 1e-3 of its tails has an entropy
@@ -138,7 +141,7 @@ def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) ->
     """The first and last seed of a rung's seed block ``block`` (0, 1, ...): base_seed + block R to
     base_seed + (block + 1) R - 1, R the scene's realisations (FD: one run, block 0)."""
     count = block_size(scene, candidate)
-    return base_seed + block * count, base_seed + (block + 1) * count - 1
+    return seed_block(base_seed, block * count, count)
 
 
 def block_size(scene: Scene, candidate: Candidate) -> int:
@@ -267,7 +270,7 @@ def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None
     """The plan after ``plan`` (None: round 0) given the runs it made: every earlier row, and a row
     per run table each candidate still searching makes next (a rung's seed block: seeds); ``done``
     on every row when no candidate searches on."""
-    k = 0 if plan is None else int(plan["round"].max()) + 1
+    k = next_round(plan)
     rows = [] if plan is None else plan.drop(columns="done").to_dict("records")
     table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=JUDGED_COLUMNS)
     added = False
@@ -280,9 +283,35 @@ def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None
             lo, hi = seeds(scene, cand, base_seed, block)
             rows.append({"candidate": ci, "label": cand.label, "n": int(n), "first": lo, "last": hi, "round": k})
             added = True
-    out = pd.DataFrame(rows, columns=PLAN_COLUMNS[:-1])
-    out["done"] = not added
-    return out
+    return new_plan(rows, PLAN_COLUMNS, done=not added)
+
+
+class SceneSearch(AdaptiveSearch):
+    """A scene's search as a kind of the search engine (search.AdaptiveSearch): its rule for the
+    next points is next_plan (each candidate's _next_rungs)."""
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+
+    @property
+    def title(self) -> str:
+        return f"scene {self.scene.name}"
+
+    @property
+    def max_plans(self) -> int:
+        return max_rounds(self.scene)
+
+    def first_plan(self, base_seed: int) -> pd.DataFrame:
+        return next_plan(self.scene, None, None, base_seed)
+
+    def next_plan(self, plan: pd.DataFrame, runs: pd.DataFrame, base_seed: int) -> pd.DataFrame:
+        return next_plan(self.scene, plan, runs, base_seed)
+
+    def read_runs(self, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
+        return read_runs(plan, paths)
+
+    def plan_paths(self, plan: pd.DataFrame) -> list[str]:
+        return plan_paths(self.scene, plan)
 
 
 def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
