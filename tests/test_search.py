@@ -241,3 +241,14 @@ def test_the_searches_code_hashes_include_the_engine():
 
     for entry in ("analysis.optimum", "analysis.scene_search"):
         assert "analysis.search" in closure([entry])
+
+
+def test_a_runs_measured_core_seconds_are_its_steps_wall_times_summed():
+    steps = pd.DataFrame({"n": [10, 10, 10, 20], "seed": [0, 0, 1, 0], "wall_s": [0.5, 0.25, 1.0, 2.0]})
+    out = E.measured_core_s(steps, ["n", "seed"])
+    assert out.to_dict("records") == [
+        {"n": 10, "seed": 0, "core_s": 0.75},
+        {"n": 10, "seed": 1, "core_s": 1.0},
+        {"n": 20, "seed": 0, "core_s": 2.0},
+    ]
+    assert list(E.measured_core_s(steps.iloc[:0], ["seed"]).columns) == ["seed", "core_s"]

@@ -14,7 +14,7 @@ def optimum_settings(wildcards):
     }
 
 
-def optimum_search(name):
+def optimum_kind(name):
     """The optimum search ``name`` (built and checked: crosschecks.check_search) and the run
     tables of a plan's seed blocks."""
     if name not in OPTIMUM:
@@ -27,7 +27,7 @@ def optimum_search(name):
     return search, plan_paths
 
 
-def scene_search(name):
+def scene_kind(name):
     """The scene ``name``'s search (the scene built and checked) and the run tables of a plan's rows."""
     if name not in SCENES:
         raise WorkflowError(f"no scene {name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
@@ -52,7 +52,7 @@ def search_inputs(search_of, checkpoint, final=False):
     return inputs
 
 
-optimum_round_inputs = search_inputs(optimum_search, "optimum_round")
-optimum_final_inputs = search_inputs(optimum_search, "optimum_round", final=True)
-scene_round_inputs = search_inputs(scene_search, "scene_round")
-scene_final_inputs = search_inputs(scene_search, "scene_round", final=True)
+optimum_round_inputs = search_inputs(optimum_kind, "optimum_round")
+optimum_final_inputs = search_inputs(optimum_kind, "optimum_round", final=True)
+scene_round_inputs = search_inputs(scene_kind, "scene_round")
+scene_final_inputs = search_inputs(scene_kind, "scene_round", final=True)

@@ -52,7 +52,17 @@ from ..core.settings import PAPER, SEARCH, defaults
 from ..core.timegrid import step_count
 from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
 from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
-from .search import AdaptiveSearch, check_plan_columns, extended, new_plan, next_round, runs_in, seed_block, stopped
+from .search import (
+    AdaptiveSearch,
+    check_plan_columns,
+    extended,
+    measured_core_s,
+    new_plan,
+    next_round,
+    runs_in,
+    seed_block,
+    stopped,
+)
 
 SEARCH_DEFAULTS = defaults(SEARCH)  # settings.SEARCH: one search's keys, defaults and ranges
 MEASURES = dict(
@@ -694,9 +704,8 @@ COST_KEYS = ["n", "dt_growth", "seed"]
 def _costs(frames: list[pd.DataFrame]) -> pd.DataFrame:
     """Measured core-seconds of every run (n, dt_growth, seed, core_s: summed step wall times)."""
     if not frames:
-        return pd.DataFrame(columns=[*COST_KEYS, "core_s"])
-    steps = pd.concat([f[[*COST_KEYS, "wall_s"]] for f in frames], ignore_index=True)
-    return steps.groupby(COST_KEYS, as_index=False)["wall_s"].sum().rename(columns={"wall_s": "core_s"})
+        return measured_core_s(pd.DataFrame(), COST_KEYS)
+    return measured_core_s(pd.concat([f[[*COST_KEYS, "wall_s"]] for f in frames], ignore_index=True), COST_KEYS)
 
 
 def read_costs(paths: list[str]) -> pd.DataFrame:

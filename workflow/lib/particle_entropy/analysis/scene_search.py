@@ -31,7 +31,7 @@ from ..core.io import read_parquet
 from ..core.registry import MEASUREMENT_POINTS
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
-from .search import AdaptiveSearch, check_plan_columns, new_plan, next_round, seed_block
+from .search import AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
 
 CLIMB = 2  # rungs climbed a round while no rung passes
 PLAN_COLUMNS = check_plan_columns(["candidate", "label", "n", "first", "last", "round", "done"])
@@ -426,7 +426,7 @@ def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """One row per run of a plan (``paths`` in its order): the last step's measures, the smallest
     mass over every step and its first negative step (negative_steps), the run's work and its
-    measured core-seconds (the sum of its steps' wall time)."""
+    measured core-seconds (the sum of its steps' wall time: search.measured_core_s)."""
     keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_total"]
     keep += ["dV", "work"]
     columns = ["candidate", "n", "seed", *keep, "mass_min", "negative_step", "negative_t", "negative_dt"]
@@ -435,6 +435,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
         return pd.DataFrame(rows, columns=[*columns, "steps", "core_s"])
     for r, path in zip(plan.itertuples(), paths):
         table = read_parquet(path)
+        core_s = measured_core_s(table, ["seed"]).set_index("seed")["core_s"]
         for seed, g in table.groupby("seed", sort=True):
             g = g.sort_values("step")
             last = g.iloc[-1]
@@ -450,7 +451,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                     "negative_t": t,
                     "negative_dt": dt,
                     "steps": float(last["step"]),
-                    "core_s": float(g["wall_s"].sum()),
+                    "core_s": float(core_s[seed]),
                 }
             )
     return pd.DataFrame(rows)

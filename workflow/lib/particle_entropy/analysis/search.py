@@ -9,6 +9,8 @@ engine owns what they share:
   beside the kind's own (PLAN_COLUMNS, check_plan_columns, new_plan, stopped, next_round);
 - seed blocks: a point's next ``count`` runs take the seeds after the ``have`` it has run, from
   the search's base seed on (seed_block), so every block is an ordinary, cached simulation job;
+- run reading shared by every kind: a run's measured core-seconds, its steps' wall times summed
+  (measured_core_s), reported beside what the kind counts and never used to decide;
 - the rounds: round 0 reads nothing, round k reads plan k-1 and its runs (none after a finished
   plan), and the finished plan is the first of at most ``max_plans`` plans with ``done`` set
   (round_inputs, final_inputs: what the Snakemake checkpoints of workflow/rules/search.smk ask for).
@@ -28,6 +30,7 @@ from ..core.io import read_parquet
 
 ROUND, FIRST, LAST, DONE = "round", "first", "last", "done"
 PLAN_COLUMNS = (ROUND, FIRST, LAST, DONE)  # every kind's plan has these, beside its own columns
+WALL, CORE_S = "wall_s", "core_s"  # a step's measured wall time (run tables); a run's, summed
 PlanPaths = Callable[[pd.DataFrame], list[str]]  # the run table of each row of a plan, in its order
 
 
@@ -46,6 +49,15 @@ def seed_block(base_seed: int, have: int, count: int) -> tuple[int, int]:
     if have < 0 or count < 1:
         raise ValueError(f"a seed block of {count} runs after {have}: count >= 1, have >= 0")
     return base_seed + have, base_seed + have + count - 1
+
+
+def measured_core_s(steps: pd.DataFrame, keys: Sequence[str]) -> pd.DataFrame:
+    """Measured core-seconds of every run of per-step tables (columns ``keys`` naming a run, and
+    wall_s): one row per run, ``keys`` and core_s, its steps' wall times summed."""
+    keys = list(keys)
+    if steps.empty:
+        return pd.DataFrame(columns=[*keys, CORE_S])
+    return steps.groupby(keys, as_index=False)[WALL].sum().rename(columns={WALL: CORE_S})
 
 
 def runs_in(plan: pd.DataFrame) -> int:
