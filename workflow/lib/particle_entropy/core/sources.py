@@ -441,8 +441,111 @@ class Box(Source):
         box_mean(np.zeros(1), 1.0)
 
 
+@dataclass(frozen=True)
+class TwoGaussians(Source):
+    """A sum of two Gaussians: mass ``fraction`` in the one of mean x1 and standard deviation sd1, the
+    rest in the one of mean x2 and sd2 (a plume with two lobes, or a tail). Each lobe spreads as a
+    Gaussian source does, to variance sd^2 + 2 D t; the entropy of their sum has no closed form and is
+    computed by Gauss-Legendre quadrature of -c ln c (``entropy``)."""
+
+    KIND: ClassVar[str] = "two_gaussians"
+    PARAMS: ClassVar[tuple[Param, ...]] = (
+        Param("x1", "first lobe's mean"),
+        Param("sd1", "first lobe's standard deviation", schema=(("type", "number"), ("exclusiveMinimum", 0))),
+        Param("x2", "second lobe's mean"),
+        Param("sd2", "second lobe's standard deviation", schema=(("type", "number"), ("exclusiveMinimum", 0))),
+        Param(
+            "fraction",
+            "the first lobe's share of the unit mass",
+            unit="-",
+            schema=(("type", "number"), ("exclusiveMinimum", 0), ("exclusiveMaximum", 1)),
+        ),
+    )
+    SUMMARY: ClassVar[str] = "two Gaussians (x1, sd1 > 0, x2, sd2 > 0, the first's mass 0 < fraction < 1)"
+    POSITION: ClassVar[str] = "x1"
+    _STEP: ClassVar[float] = 0.25  # entropy's panels: at most this many of a lobe's sd wide ...
+    _REACH: ClassVar[float] = 12.0  # ... out to this many sd each side of each lobe (exp(-72) beyond)
+
+    x1: float = 0.0
+    sd1: float = 0.0
+    x2: float = 0.0
+    sd2: float = 0.0
+    fraction: float = 0.5
+
+    def _argcheck(self):
+        for name in ("sd1", "sd2"):
+            sd = getattr(self, name)
+            if not (sd > 0 and math.isfinite(sd)):
+                raise SourceError(name, sd, f"a two_gaussians source needs {name} > 0 and finite, got {sd!r}")
+        if not (0.0 < self.fraction < 1.0):
+            raise SourceError(
+                "fraction",
+                self.fraction,
+                f"a number in (0, 1): the first lobe's share of the mass, got {self.fraction!r}",
+            )
+
+    @classmethod
+    def _speccheck(cls, values):
+        for name in ("sd1", "sd2"):
+            if 0 < values[name] < MIN_SD:
+                raise SourceError(
+                    name,
+                    values[name],
+                    f"a number >= {MIN_SD:.3g} [L]: its variance {name}^2 a normal float (below, it rounds to 0)",
+                )
+
+    def _lobes(self, D: float, v: float, t: float):
+        """((weight, mean, variance) of each lobe after time t)."""
+        spread = 2.0 * D * max(t, 0.0)
+        f = self.fraction
+        return ((f, self.x1 + v * t, self.sd1**2 + spread), (1.0 - f, self.x2 + v * t, self.sd2**2 + spread))
+
+    @property
+    def centre(self) -> float:
+        """fraction x1 + (1 - fraction) x2."""
+        return self.fraction * self.x1 + (1.0 - self.fraction) * self.x2
+
+    @property
+    def variance(self) -> float:
+        """The lobes' variances and their means' spread about the centre, weighted by their masses."""
+        c = self.centre
+        return sum(w * (var + (m - c) ** 2) for w, m, var in self._lobes(0.0, 0.0, 0.0))
+
+    @property
+    def half_width(self) -> float:
+        """From the centre to the farther lobe's mean + 6 of its sd."""
+        c = self.centre
+        return max(abs(self.x1 - c) + 6.0 * self.sd1, abs(self.x2 - c) + 6.0 * self.sd2)
+
+    def positions(self, n, rng):
+        """Each particle in the first lobe with probability fraction, then drawn from its lobe."""
+        first = rng.random(n) < self.fraction
+        z = rng.standard_normal(n)
+        return np.where(first, self.x1 + self.sd1 * z, self.x2 + self.sd2 * z)
+
+    def _weights(self, x, dV):
+        return self.density(x, 0.0, 0.0, 0.0)
+
+    def density(self, x, D, v, t):
+        x = np.asarray(x, dtype=np.float64)
+        return sum(w * _gaussian(x, m, var) for w, m, var in self._lobes(D, v, t))
+
+    def entropy(self, D, t):
+        """-integral c ln c dx by 16-node Gauss-Legendre panels that break every _STEP sd of each lobe
+        out to _REACH sd, so that each lobe, however narrow or far from the other, is resolved."""
+        lobes = self._lobes(D, 0.0, t)
+        k = np.arange(-self._REACH, self._REACH + self._STEP / 2, self._STEP)
+        edges = np.unique(np.concatenate([m + math.sqrt(var) * k for _, m, var in lobes]))
+        nodes, weights = np.polynomial.legendre.leggauss(_GL_NODES)
+        mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * (edges[1:] - edges[:-1])
+        x = (mid[:, None] + half[:, None] * nodes).ravel()
+        c = self.density(x, D, 0.0, t)
+        safe = np.where(c > 0, c, 1.0)
+        return float(np.dot((half[:, None] * weights).ravel(), -c * np.log(safe)))
+
+
 # The kinds, each once, in the order the schema and the messages list them.
-SOURCES: dict[str, type[Source]] = {cls.KIND: cls for cls in (Point, Gaussian, Box)}
+SOURCES: dict[str, type[Source]] = {cls.KIND: cls for cls in (Point, Gaussian, Box, TwoGaussians)}
 
 
 def source_shape() -> dict:
