@@ -36,7 +36,7 @@ def _old_reference():
 
     import numpy as np
 
-    from particle_entropy.core import reference as R
+    from particle_entropy.core import sources as S
     from particle_entropy.models import fd
 
     @functools.lru_cache(maxsize=256)
@@ -83,19 +83,21 @@ def _old_reference():
     def fd_warm_up(cfg) -> None:
         fd.ImplicitSolver(8, 0.1).solve(np.ones(8))
 
-    R.box_entropy, R.box_mean, R.warm_up, fd.warm_up = box_entropy, box_mean, lambda source: None, fd_warm_up
+    S.box_entropy, S.box_mean, S.Box.warm_up, fd.warm_up = box_entropy, box_mean, lambda self: None, fd_warm_up
 
 
 def _scene(config: str, name: str, source: str):
     from dataclasses import replace
 
-    from particle_entropy.core.reference import Source
+    from particle_entropy.core.sources import Source
     from particle_entropy.experiments.scene import scenes
     from particle_entropy.pipeline.configcheck import load_yaml
 
     scene = scenes(load_yaml(config))[name]
     if source == "gaussian":  # the twin: a Gaussian of the box's variance
-        scene = replace(scene, source=Source("gaussian", x0=scene.source.centre, sd=math.sqrt(scene.source.variance)))
+        scene = replace(
+            scene, source=Source.of("gaussian", x0=scene.source.centre, sd=math.sqrt(scene.source.variance))
+        )
     return scene, next(c for c in scene.candidates if c.case.method == "fd")
 
 

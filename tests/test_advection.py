@@ -10,11 +10,11 @@ import pytest
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.core.records import TIMING_COLUMNS
-from particle_entropy.core.reference import Source
 from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.core.sources import Source
 from particle_entropy.models import fd, simulate
 
-SMOOTH = Source("gaussian", x0=-0.5, sd=0.2)
+SMOOTH = Source.of("gaussian", x0=-0.5, sd=0.2)
 
 
 def _fd_final(n: int, scheme: str, D: float, v: float, t_final: float, dt: float, source=SMOOTH):
@@ -70,7 +70,7 @@ def test_upwind_adds_the_numerical_dispersion_v_dx_over_2():
 
 def test_central_oscillates_past_grid_peclet_2_and_upwind_stays_monotone():
     D, v, n, T, dt = 1e-4, 1.0, 100, 1.0, 0.01
-    box = Source("box", a=-1.0, b=-0.6)
+    box = Source.of("box", a=-1.0, b=-0.6)
     dx = (4.0 + v * T) / n
     assert fd.grid_peclet(v, dx, D) == pytest.approx(500.0)
     _, central, _, _ = _fd_final(n, "central", D, v, T, dt, box)
@@ -92,8 +92,8 @@ def test_particles_are_carried_by_v_t_and_the_transfer_is_unchanged(method, kern
     if method == "mtpt":
         settings["eta"] = eta
     v = 0.013
-    at_rest = RunConfig.of(**settings, source=Source("point", x0=0.25))
-    carried = RunConfig.of(**settings, source=Source("point", x0=0.25), v=v)
+    at_rest = RunConfig.of(**settings, source=Source.of("point", x0=0.25))
+    carried = RunConfig.of(**settings, source=Source.of("point", x0=0.25), v=v)
     _, still = simulate.run(at_rest, want_state=True)
     table, moved = simulate.run(carried, want_state=True)
     shift = np.asarray(moved["x"]) - np.asarray(still["x"])
@@ -108,7 +108,9 @@ def test_particles_are_carried_by_v_t_and_the_transfer_is_unchanged(method, kern
 def test_a_paper_run_is_untouched_by_the_scene_fields():
     """v = 0 and a point at 0 are the paper's scene: the same bits as a run that names neither."""
     plain = RunConfig.of(method="mtpt", kernel="collision", n=200, seed=3, t_final=20.0)
-    named = RunConfig.of(method="mtpt", kernel="collision", n=200, seed=3, t_final=20.0, source=Source("point"), v=0.0)
+    named = RunConfig.of(
+        method="mtpt", kernel="collision", n=200, seed=3, t_final=20.0, source=Source.of("point"), v=0.0
+    )
     a, b = simulate.run(plain)[0], simulate.run(named)[0]
     cols = [c for c in a.columns if c not in TIMING_COLUMNS]
     assert a[cols].equals(b[cols])
@@ -117,8 +119,8 @@ def test_a_paper_run_is_untouched_by_the_scene_fields():
 @pytest.mark.parametrize(
     "settings, key",
     [
-        (dict(method="fd", kernel="implicit", n=100, fd_length=1.0, source=Source("gaussian", sd=2.0)), "fd_length"),
-        (dict(method="mtpt", n=100, omega=1.0, source=Source("box", a=-3.0, b=3.0)), "omega"),
+        (dict(method="fd", kernel="implicit", n=100, fd_length=1.0, source=Source.of("gaussian", sd=2.0)), "fd_length"),
+        (dict(method="mtpt", n=100, omega=1.0, source=Source.of("box", a=-3.0, b=3.0)), "omega"),
         (dict(method="pt", n=100, v=math.inf), "v"),
         (dict(method="fd", kernel="implicit", n=100, v=1.0, advection="lax"), "advection"),
     ],

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.core.reference import Source
 from particle_entropy.core.registry import SCHEME_RECORDS
 from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.core.sources import Source
 from particle_entropy.models.mtpt import kernel_for_step
 from particle_entropy.models.pt import reconstruction_width
 from particle_entropy.models.simulate import run
@@ -97,7 +97,7 @@ def test_truncated_variance_fraction_at_three_widths_and_whole():
 
 
 def _box_run(method: str, kernel: str, width: float, **settings) -> RunConfig:
-    source = Source("box", a=-0.5 * width, b=0.5 * width)
+    source = Source.of("box", a=-0.5 * width, b=0.5 * width)
     return RunConfig.of(method=method, kernel=kernel, n=300, omega=10.0, source=source, **settings)
 
 
@@ -121,7 +121,7 @@ def test_adaptive_bandwidths_follow_the_plume_not_the_point(D, t):
 
 def test_a_gaussian_sources_bandwidth_adds_its_variance():
     sd, D, t = 0.2, 1e-3, 50.0
-    cfg = RunConfig.of(method="pt", kernel="adaptive", n=1000, D=D, source=Source("gaussian", sd=sd))
+    cfg = RunConfig.of(method="pt", kernel="adaptive", n=1000, D=D, source=Source.of("gaussian", sd=sd))
     assert reconstruction_width(cfg, t) == pytest.approx(1.06 * 1000**-0.2 * math.sqrt(sd * sd + 2 * D * t), rel=1e-15)
 
 

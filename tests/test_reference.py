@@ -11,7 +11,8 @@ from scipy.integrate import quad
 from scipy.special import erf
 
 from particle_entropy.core import measures as M
-from particle_entropy.core.reference import Reference, Source, box_entropy, box_mean
+from particle_entropy.core.reference import Reference
+from particle_entropy.core.sources import Source, box_entropy, box_mean
 
 
 def _quad_box_entropy(width: float, dt: float) -> float:
@@ -54,11 +55,11 @@ def test_a_narrowing_box_tends_to_the_point_sources_gaussian(width):
     D, t = 1e-3, 50.0
     gaussian = 0.5 * math.log(2 * math.pi * math.e * (2 * D * t + width * width / 12))
     assert box_entropy(width, D * t) == pytest.approx(gaussian, abs=1e-14)
-    point = Reference(Source("point", x0=width / 2), D, 0.01, t)
-    box = Reference(Source("box", a=0.0, b=width), D, 0.01, t)  # at 0: any width is a float there
+    point = Reference(Source.of("point", x0=width / 2), D, 0.01, t)
+    box = Reference(Source.of("box", a=0.0, b=width), D, 0.01, t)  # at 0: any width is a float there
     x = np.linspace(point.centre - 1.0, point.centre + 1.0, 41)
     assert box.density(x) == pytest.approx(point.density(x), rel=1e-13)
-    at_start = Reference(Source("box", a=0.0, b=width), D, 0.01, 0.0).sampled(np.array([-0.5, 0.0, 0.5]), 0.5)
+    at_start = Reference(Source.of("box", a=0.0, b=width), D, 0.01, 0.0).sampled(np.array([-0.5, 0.0, 0.5]), 0.5)
     assert at_start.tolist() == [0.0, 2.0, 0.0]  # its indicator: 1 / width overflows below 5.6e-309
 
 
@@ -69,8 +70,8 @@ def test_a_box_one_float_wide_is_the_point_source(a):
     x - b lost ~1e-4 of the density at a = 1000)."""
     D, v, t = 1e-3, 0.01, 50.0
     b = math.nextafter(a, math.inf)
-    box = Reference(Source("box", a=a, b=b), D, v, t)
-    point = Reference(Source("point", x0=0.5 * (a + b)), D, v, t)
+    box = Reference(Source.of("box", a=a, b=b), D, v, t)
+    point = Reference(Source.of("point", x0=0.5 * (a + b)), D, v, t)
     x = np.linspace(point.centre - 1.0, point.centre + 1.0, 201)
     assert box.density(x) == pytest.approx(point.density(x), rel=1e-9)
     assert box.sampled(x, 0.01) == pytest.approx(point.sampled(x, 0.01), rel=1e-9)
@@ -92,7 +93,7 @@ def test_box_mean_is_the_gaussians_mean_over_the_interval(u, h):
 
 @pytest.mark.parametrize(
     "source",
-    [Source("point", x0=0.3), Source("gaussian", x0=-1.0, sd=0.2), Source("box", a=-0.5, b=0.25)],
+    [Source.of("point", x0=0.3), Source.of("gaussian", x0=-1.0, sd=0.2), Source.of("box", a=-0.5, b=0.25)],
 )
 def test_density_has_unit_mass_the_carried_centre_and_the_variance(source):
     ref = Reference(source, D=0.01, v=0.7, t=2.0)
@@ -108,7 +109,7 @@ def test_density_has_unit_mass_the_carried_centre_and_the_variance(source):
     assert ref.dilution() == pytest.approx(math.exp(h), rel=1e-8)
 
 
-@pytest.mark.parametrize("source", [Source("gaussian", x0=0.1, sd=0.3), Source("box", a=-0.2, b=0.4)])
+@pytest.mark.parametrize("source", [Source.of("gaussian", x0=0.1, sd=0.3), Source.of("box", a=-0.2, b=0.4)])
 def test_density_solves_advection_dispersion(source):
     """dc/dt + v dc/dx = D d2c/dx2, by centred differences in t and x."""
     D, v, t, h, k = 0.05, -1.3, 0.8, 1e-3, 1e-4
@@ -123,22 +124,22 @@ def test_density_solves_advection_dispersion(source):
 
 def test_point_source_is_the_papers_gaussian_carried_by_v():
     D, t, v = 1e-3, 250.0, 0.02
-    ref = Reference(Source("point", x0=0.5), D, v, t)
-    narrow = Reference(Source("gaussian", x0=0.5, sd=1e-9), D, v, t)  # the general formula
+    ref = Reference(Source.of("point", x0=0.5), D, v, t)
+    narrow = Reference(Source.of("gaussian", x0=0.5, sd=1e-9), D, v, t)  # the general formula
     assert ref.entropy() == pytest.approx(narrow.entropy(), rel=1e-14)
     assert ref.entropy() == pytest.approx(0.5 * math.log(4 * math.pi * math.e * D * t), rel=1e-14)
     assert ref.dilution() == pytest.approx(M.analytic_dilution(D, t), rel=1e-14)
     assert ref.h_c(0.01) == pytest.approx(M.analytic_h_c(D, t, 0.01), rel=1e-14)
     x = np.linspace(-1, 1, 21)
     assert ref.density(x + 0.5 + v * t) == pytest.approx(M.gaussian_density(x, D, t), rel=1e-13)
-    at_rest = Reference(Source("point"), D, 0.0, t)
+    at_rest = Reference(Source.of("point"), D, 0.0, t)
     grid = np.linspace(-5, 5, 1001)
     assert at_rest.sampled(grid, 0.01).tobytes() == M.analytic_sampled(grid, D, t, 0.01).tobytes()
     assert at_rest.density(grid).tobytes() == M.gaussian_density(grid, D, t).tobytes()  # the paper's bits
 
 
 def test_a_point_at_t0_is_a_delta_on_the_nearest_sample():
-    ref = Reference(Source("point", x0=0.26), D=1.0, v=5.0, t=0.0)
+    ref = Reference(Source.of("point", x0=0.26), D=1.0, v=5.0, t=0.0)
     x = np.linspace(-1, 1, 11)  # spacing 0.2: 0.2 is nearest to 0.26
     g = ref.sampled(x, 0.2)
     assert g.tolist() == [0.0] * 6 + [5.0] + [0.0] * 4
@@ -148,9 +149,9 @@ def test_a_point_at_t0_is_a_delta_on_the_nearest_sample():
 
 
 def test_box_density_at_t0_and_the_erf_difference():
-    ref = Reference(Source("box", a=1.0, b=3.0), D=0.5, v=1.0, t=0.0)
+    ref = Reference(Source.of("box", a=1.0, b=3.0), D=0.5, v=1.0, t=0.0)
     assert ref.density(np.array([0.9, 1.5, 2.9, 3.1])).tolist() == [0.0, 0.5, 0.5, 0.0]
-    later = Reference(Source("box", a=1.0, b=3.0), D=0.5, v=1.0, t=2.0)
+    later = Reference(Source.of("box", a=1.0, b=3.0), D=0.5, v=1.0, t=2.0)
     x = np.array([2.0, 4.0, 6.0])
     s = math.sqrt(4 * 0.5 * 2.0)
     expected = [0.25 * (erf((xi - 3.0) / s) - erf((xi - 5.0) / s)) for xi in x]
@@ -159,12 +160,12 @@ def test_box_density_at_t0_and_the_erf_difference():
 
 def test_source_masses_sum_to_one_and_a_narrow_box_takes_one_node():
     x = np.linspace(-1, 1, 201)
-    for source in (Source("point", x0=0.013), Source("gaussian", sd=0.1), Source("box", a=-0.3, b=0.3)):
+    for source in (Source.of("point", x0=0.013), Source.of("gaussian", sd=0.1), Source.of("box", a=-0.3, b=0.3)):
         m = source.masses(x, 0.01)
         assert m.sum() == pytest.approx(1.0, abs=1e-15) and (m >= 0).all()
-    narrow = Source("box", a=0.5001, b=0.5002).masses(x, 0.01)
+    narrow = Source.of("box", a=0.5001, b=0.5002).masses(x, 0.01)
     assert np.count_nonzero(narrow) == 1 and narrow[150] == 1.0
-    box = Source("box", a=-0.3, b=0.3).masses(x, 0.01)
+    box = Source.of("box", a=-0.3, b=0.3).masses(x, 0.01)
     assert np.count_nonzero(box) == 61  # nodes -0.3 .. 0.3, the end ones half covered
     assert box[70] == pytest.approx(box[100] / 2)
 
@@ -180,7 +181,7 @@ def test_source_masses_sum_to_one_and_a_narrow_box_takes_one_node():
 )
 def test_bad_sources_are_refused(kwargs, match):
     with pytest.raises(ValueError, match=match):
-        Source(**kwargs)
+        Source.of(**kwargs)
 
 
 # box_entropy at main 77a862f (its Gauss-Legendre quadrature in x, rebuilt every call), rows: width

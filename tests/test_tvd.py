@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from particle_entropy.core.case import SettingError
-from particle_entropy.core.reference import Source
 from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.core.sources import Source
 from particle_entropy.models import fd, simulate
 from particle_entropy.models.conservation import MassError
 
 EPS = np.finfo(np.float64).eps
-BOX = Source("box", a=-1.0, b=-0.6)  # 1 / width = 2.5
+BOX = Source.of("box", a=-1.0, b=-0.6)  # 1 / width = 2.5
 
 
 def _box_nodes(m: int = 200, lo: int = 60, hi: int = 90) -> np.ndarray:
@@ -145,7 +145,7 @@ def test_a_broken_flux_raises_mass_error(monkeypatch):
 
 
 def _l2(scheme: str, n: int) -> float:
-    smooth = Source("gaussian", x0=-0.5, sd=0.2)
+    smooth = Source.of("gaussian", x0=-0.5, sd=0.2)
     x, c, exact, dx = _final(_config(n, scheme, D=1e-4, source=smooth))
     return math.sqrt(np.sum((c - exact) ** 2) * dx)
 
@@ -181,7 +181,7 @@ def test_a_carried_box_stays_in_its_bounds_where_central_oscillates_and_upwind_s
 
 def test_a_tvd_run_balances_its_mass_through_the_time_loop():
     """simulate.run steps a courant run to t_final on its exact grid; every step balances."""
-    cfg = _config(64, "tvd", D=1e-3, courant=0.8, source=Source("gaussian", x0=-0.5, sd=0.2))
+    cfg = _config(64, "tvd", D=1e-3, courant=0.8, source=Source.of("gaussian", x0=-0.5, sd=0.2))
     table, state = simulate.run(cfg, want_state=True)
     assert table["time"].iloc[-1] == pytest.approx(1.0)
     assert table["mass_total"].iloc[-1] == pytest.approx(1.0, abs=1e-6)
@@ -194,7 +194,7 @@ def test_a_tvd_run_balances_its_mass_through_the_time_loop():
         ({"courant": 1.5}, "courant", "(0, 1]"),
         ({"courant": None, "dt0": 0.1}, "fd_dt", "at n = 100"),
         ({"courant": 0.0}, "courant", "> 0"),
-        ({"courant": 0.5, "v": 0.0, "source": Source("gaussian", x0=0.1, sd=0.2)}, "courant", "v != 0"),
+        ({"courant": 0.5, "v": 0.0, "source": Source.of("gaussian", x0=0.1, sd=0.2)}, "courant", "v != 0"),
         ({"courant": 0.5, "method": "mtpt", "kernel": "collision"}, "courant", "fd in a flow"),
     ],
 )

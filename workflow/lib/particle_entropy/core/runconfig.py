@@ -12,12 +12,13 @@ import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
-from .reference import Reference, Source
+from .reference import Reference
 from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION, DEFAULT_KERNEL
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
+from .sources import Source, source_names
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
 
-PAPER_SOURCE = Source("point", x0=0.0)  # the paper's delta at x = 0
+PAPER_SOURCE = Source.of("point", x0=0.0)  # the paper's delta at x = 0
 # FD's fewest intervals: a node at the source's x = 0 (an even number) whose 3-point stencil reaches
 # an interior node on either side. With 2 the one interior node's neighbours are both zero ends: its
 # mass only drains into them (5 % by t = 1000 at the paper's settings) and never spreads (H_C stays 0).
@@ -159,7 +160,7 @@ class RunConfig:
     transfer_method: str = PAPER["transfer_method"]
     transfer_tolerance: float = PAPER["transfer_tolerance"]
     loop_arithmetic: str = PAPER["loop_arithmetic"]
-    # the scene (core/reference.py): the source and a uniform velocity; the paper's is a point at
+    # the scene (core/sources.py, core/reference.py): the source and a uniform velocity; the paper's is a point at
     # x = 0 at rest. FD's advection scheme is used only when v != 0.
     source: Source = PAPER_SOURCE
     v: float = 0.0
@@ -170,7 +171,7 @@ class RunConfig:
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
-            object.__setattr__(self, "source", Source(**self.source))
+            object.__setattr__(self, "source", Source.of(**self.source))
 
     @classmethod
     def of(
@@ -307,7 +308,7 @@ class RunConfig:
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
         check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
         if not isinstance(self.source, Source):
-            raise SettingError("source", self.source, "a Source (point, gaussian or box)")
+            raise SettingError("source", self.source, f"a Source ({source_names()})")
         if not (isinstance(self.v, (int, float)) and math.isfinite(self.v)):
             raise SettingError("v", self.v, "a finite number [L/T]")
         if self.advection not in ADVECTION_SCHEMES:

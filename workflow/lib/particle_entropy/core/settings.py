@@ -41,6 +41,7 @@ from .run_settings import (  # noqa: F401  (re-exported: the run settings, decla
     defaults,
 )
 from .shear_settings import SHEAR, SHEAR_MAX_N  # noqa: F401  (re-exported)
+from .sources import source_forms, source_ranges, source_shape
 
 MAX_REALISATIONS = 10_000  # realisations of one case or N: more is a typo, not an ensemble
 MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB for mass transfer; more is a typo
@@ -458,18 +459,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
 # One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
 # (core/reference.py), the candidate models and the accuracy they must reach.
 SCENE_MEASURES = ("rmse", "entropy", "dilution")
-SOURCE_SHAPE = {
-    "type": "object",
-    "additionalProperties": False,
-    "required": ["kind"],
-    "properties": {
-        "kind": {"type": "string", "enum": ["point", "gaussian", "box"]},
-        "x0": {"type": "number"},
-        "sd": {"type": "number", "exclusiveMinimum": 0},
-        "a": {"type": "number"},
-        "b": {"type": "number"},
-    },
-}
+SOURCE_SHAPE = source_shape()  # the kinds of core/sources.py
 CANDIDATE_SHAPE = {
     "type": "array",
     "minItems": 1,
@@ -506,10 +496,10 @@ SCENE = (
         "source",
         "scenes.<name>.source",
         {"kind": "point", "x0": 0.0},
-        "the initial plume, unit mass: {kind: point, x0}, {kind: gaussian, x0, sd} or {kind: box, a, b}",
+        f"the initial plume, unit mass: {source_forms()}",
         kind="shape",
         shape=SOURCE_SHAPE,
-        range_text="a point (x0), a Gaussian (x0, sd > 0) or a box (a < b)",
+        range_text=source_ranges(),
     ),
     Setting(
         "margin",

@@ -15,10 +15,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
-from ..core.reference import Reference, Source
+from ..core.reference import Reference
 from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION
 from ..core.runconfig import RunConfig, check_plume_width, check_setting
 from ..core.settings import BY_KEY, MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
+from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
@@ -44,7 +45,6 @@ USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (t
 # Half the digits of a double: a plume whose centre lies further than its width over this from x = 0
 # has positions (particles', nodes', points') rounded to more than this fraction of the width.
 HALF_DIGITS = math.sqrt(sys.float_info.epsilon)
-MIN_SD = math.sqrt(sys.float_info.min)  # a Gaussian source's sd whose variance sd^2 is a normal float
 
 
 def key_path(name: str, key: str) -> str:
@@ -194,7 +194,7 @@ class Scene:
             "t_final": self.t_final,
             "omega": self.omega,
             "fd_length": self.fd_length,
-            "source": {k: v for k, v in vars(self.source).items()},
+            "source": self.source.record(),
             "v": self.v,
             "window": self.points_span,  # the measurement points span the plume, at rest too
         }
@@ -327,9 +327,9 @@ def _check_reach(scene: Scene) -> None:
     if v != 0.0:
         lo, hi = (-reach - x0) / t_final, (reach - x0) / t_final
         raise SettingError(_key(name, "v"), v, f"a number in [{lo:.6g}, {hi:.6g}] [L/T]: {why}")
-    key = "source.x0" if source.kind != "box" else "source.a"
+    key = source.POSITION  # the parameter that places the source
     raise SettingError(
-        _key(name, key), getattr(source, key.split(".")[1]), f"a number in [{-reach:.6g}, {reach:.6g}]: {why}"
+        _key(name, f"source.{key}"), getattr(source, key), f"a number in [{-reach:.6g}, {reach:.6g}]: {why}"
     )
 
 
@@ -413,36 +413,13 @@ def _checked(name: str, key: str, value):
 
 
 def _source(name: str, spec) -> Source:
+    """The source at scenes.<name>.source (Source.from_spec), else SettingError naming its key path."""
     if not isinstance(spec, Mapping):
         raise SettingError(_key(name, "source"), spec, BY_KEY["scenes.<name>.source"].allowed())
-    spec = dict(spec)
-    kind = spec.get("kind")
-    needs = {"point": ("x0",), "gaussian": ("x0", "sd"), "box": ("a", "b")}
-    if kind not in needs:
-        raise SettingError(_key(name, "source.kind"), kind, "one of point, gaussian, box")
-    extra = set(spec) - {"kind", *needs[kind]}
-    if extra:
-        raise SettingError(
-            _key(name, f"source.{sorted(extra)[0]}"), spec[sorted(extra)[0]], f"not a key of a {kind} source"
-        )
-    values = {}
-    for key in needs[kind]:
-        value = spec.get(key, 0.0 if key == "x0" else None)
-        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)):
-            raise SettingError(_key(name, f"source.{key}"), value, "a finite number [L]")
-        values[key] = float(value)
-    if kind == "gaussian" and 0 < values["sd"] < MIN_SD:
-        raise SettingError(
-            _key(name, "source.sd"),
-            values["sd"],
-            f"a number >= {MIN_SD:.3g} [L]: its variance sd^2 a normal float (below, sd^2 rounds to 0 and the "
-            "Gaussian is a delta); for a narrower source write {kind: point, x0}",
-        )
     try:
-        return Source(kind, **values)
-    except ValueError as e:
-        bad = "sd" if kind == "gaussian" else "b"
-        raise SettingError(_key(name, f"source.{bad}"), values.get(bad), str(e)) from None
+        return Source.from_spec(spec)
+    except SourceError as e:
+        raise SettingError(_key(name, f"source.{e.param}"), e.value, e.allowed) from None
 
 
 def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:

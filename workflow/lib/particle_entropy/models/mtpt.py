@@ -15,19 +15,10 @@ from .conservation import check_particle_mass
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
-    """A point source: N - 1 zero-mass particles uniform on [-Omega/2, Omega/2] around it and one
-    unit mass on it, stored first; a Gaussian or box source: N particles uniform on that domain,
-    the source's mass on them by its density (Source.masses) -> (positions sorted, masses, storage
-    index of each), as sequential.py stores them."""
-    source = cfg.source
-    lo, hi = source.centre - cfg.omega / 2.0, source.centre + cfg.omega / 2.0
-    if source.kind == "point":
-        x = np.concatenate([[source.x0], rng.uniform(lo, hi, cfg.n - 1)])
-        m = np.zeros(cfg.n)
-        m[0] = 1.0
-    else:
-        x = rng.uniform(lo, hi, cfg.n)
-        m = source.masses(x, cfg.dV)
+    """N particles on [-Omega/2, Omega/2] around the source carrying its unit mass
+    (Source.weighted_particles: a point's on one particle stored first, others' by their density)
+    -> (positions sorted, masses, storage index of each), as sequential.py stores them."""
+    x, m = cfg.source.weighted_particles(cfg.n, cfg.omega, cfg.dV, rng)
     order = np.argsort(x, kind="stable")
     return x[order], m[order], order
 

@@ -10,7 +10,6 @@ import numpy as np
 import pyarrow as pa
 
 from ..core import measures as M
-from ..core import reference
 from ..core.records import Recorder, arrow_table
 from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
@@ -71,7 +70,7 @@ def warm_up(cfg: RunConfig) -> None:
         _model(cfg.method).warm_up(cfg)
         _WARM.add(key)
     if ("reference", cfg.source.kind) not in _WARM:
-        reference.warm_up(cfg.source)
+        cfg.source.warm_up()
         _WARM.add(("reference", cfg.source.kind))
 
 
