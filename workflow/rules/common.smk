@@ -71,10 +71,6 @@ INPUTS = inputs.Inputs(config, WorkflowError)  # the rules' input, params and re
 PLOTTED = inputs.plotted_figures(config)  # the figures that the shared plot rule draws (figures.smk)
 figure_labels = partial(inputs.figure_labels, config=config, checkout=workflow.basedir)  # report labels
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"  # a rule's code: script_code(SCRIPTS / its script)
-# summarise.smk's text is the summaries' code (a run: block, no script): it names these two, so
-# that what moves here reruns no summary
-summary_runs = INPUTS.summary_runs
-SUMMARY_CODE = script_code(Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk")
 
 
 wildcard_constraints:
@@ -179,3 +175,9 @@ def scene_final_inputs(wildcards):
         if plan["done"].all():
             return {"plan": path, "runs": plan_paths(SCENES[wildcards.name], plan)}
     raise ValueError(f"scene {wildcards.name}: no finished plan after {rounds} rounds")
+
+
+# summarise.smk's text is the summaries' code (a run: block, no script): it names these two, so
+# that what moves here reruns no summary
+summary_runs = INPUTS.summary_runs
+SUMMARY_CODE = script_code(Path(workflow.basedir) / "workflow" / "rules" / "summarise.smk")
