@@ -32,6 +32,6 @@ for _fig in PLOTTED:
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
             options=figure_options(_fig, config.get("figures", {}).get(_fig, {})),
-            code=script_code(SCRIPTS / "plot_figure.py", f"figures.{_fig}"),  # it draws figures.<fig>,
+            code=script_code(SCRIPTS / "plot_figure.py", f"figures.{_fig}"),  # the script draws figures.<fig>
         script:
             "../scripts/plot_figure.py"
