@@ -56,7 +56,7 @@ onsuccess:
         end_session(record)
     # Snakemake can end a run "100% done" with a target unmade (a rerun job with an ancient output
     # hides the jobs after it): a run exits 0 only when every requested target is there.
-    if unmade := unmade_targets():
+    if unmade := unmade_targets(workflow.dag):
         raise WorkflowError(
             f"the run ended without making {len(unmade)} of its targets: {', '.join(unmade[:5])}"
             + (" ..." if len(unmade) > 5 else "")

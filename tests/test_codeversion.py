@@ -7,8 +7,11 @@ from __future__ import annotations
 import os
 
 import pytest
+from conftest import ROOT
 
-from particle_entropy.pipeline.codeversion import closure, code_version, imports, modules
+from particle_entropy.pipeline.codeversion import closure, code_version, imports, modules, script_code, script_imports
+
+SCRIPTS = ROOT / "workflow" / "scripts"
 
 MODULES = {
     "a": "from .b import f\n\n\ndef g():\n    return f()\n",
@@ -188,44 +191,83 @@ def library(tmp_path):
     modules.cache_clear()
 
 
-def _simulation_hashes(root, script):
+def _simulation_hashes(root):
     from particle_entropy.core.registry import METHODS
-    from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, simulation_code
+    from particle_entropy.pipeline.codeversion import simulation_code
 
-    hashes = {m: simulation_code(m, METHODS, script, package=root) for m in METHODS}
-    return hashes | {"shear": code_version(*SHEAR_ENTRIES, files=[script], package=root)}
+    hashes = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py", package=root) for m in METHODS}
+    return hashes | {"shear": script_code(SCRIPTS / "shear2d.py", package=root)}
 
 
 def test_simulation_code_holds_no_other_section(library):
     """A simulation imports the run settings (core/run_settings.py) and the shear flow's, never
     core/settings.py, which declares every other section."""
     from particle_entropy.core.registry import METHODS
-    from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, SIMULATION_ENTRIES
 
+    simulation_entries = script_imports(SCRIPTS / "simulate.py", library)
+    shear_entries = script_imports(SCRIPTS / "shear2d.py", library)
     for method in METHODS:
         others = {f"models.{m}" for m in METHODS if m != method}
-        mods = closure([*SIMULATION_ENTRIES, f"models.{method}"], exclude=others, package=library)
+        mods = closure([*simulation_entries, f"models.{method}"], exclude=others, package=library)
         assert "core.run_settings" in mods and "core.settings" not in mods
         assert not any(m.split(".")[0] in ("analysis", "experiments", "figures", "pipeline") for m in mods)
-    assert "core.settings" not in closure(SHEAR_ENTRIES, package=library)
+    assert "core.settings" not in closure(shear_entries, package=library)
 
 
-def test_editing_another_section_reruns_no_simulation(library, tmp_path):
+def test_editing_another_section_reruns_no_simulation(library):
     """Rewording a claims tolerance, a scene's cost constant or a search's key changes no
     simulation's code hash; editing the run settings changes every 1-D one, the shear flow's
     settings only the shear flow's."""
-    script = tmp_path / "simulate.py"
-    script.write_text("# the job script\n")
-    before = _simulation_hashes(library, script)
+    before = _simulation_hashes(library)
     settings = library / "core" / "settings.py"
     _edit(settings, '"allowed |H_C - analytic| of adaptive-kernel PT at t = 1000"', '"a reworded claim"')
     _edit(settings, "MAX_REALISATIONS = 10_000", "MAX_REALISATIONS = 20_000")
     _edit(settings, '"the searched model (unset dimensions from case_defaults)"', '"a reworded search key"')
-    assert _simulation_hashes(library, script) == before
+    assert _simulation_hashes(library) == before
     _edit(library / "core" / "shear_settings.py", '"longitudinal dispersivity"', '"reworded"')
-    after_shear = _simulation_hashes(library, script)
+    after_shear = _simulation_hashes(library)
     assert after_shear["shear"] != before["shear"]
     assert {m: h for m, h in after_shear.items() if m != "shear"} == {m: h for m, h in before.items() if m != "shear"}
     _edit(library / "core" / "run_settings.py", '"diffusion coefficient"', '"reworded"')
-    after_run = _simulation_hashes(library, script)
+    after_run = _simulation_hashes(library)
     assert all(after_run[m] != after_shear[m] for m in after_run)
+
+
+# --------------------------------------------------------------------------- hashes from scripts
+def test_script_imports_reads_every_form_of_absolute_import(tmp_path):
+    script = tmp_path / "job.py"
+    script.write_text(
+        "import sys\nimport particle_entropy.core.io\nfrom particle_entropy.figures import fig10, style as s\n"
+        "from particle_entropy.analysis.aggregate import (\n    tradeoff_table,\n)\n\n\n"
+        "def main():\n    from particle_entropy.core.heap import keep_freed_pages\n"
+        "\n\n# from particle_entropy.core.labels import case_label\n"
+    )
+    assert script_imports(script) == {"core.io", "figures.fig10", "figures.style", "analysis.aggregate", "core.heap"}
+    rules = tmp_path / "rule.smk"  # a run: block's imports, read by a pattern (not Python)
+    rules.write_text("rule x:\n    run:\n        from particle_entropy.analysis.aggregate import summarise_files\n")
+    assert script_imports(rules) == {"analysis.aggregate"}
+
+
+# The entry modules that common.smk listed by hand for the simulation jobs, before each rule's hash
+# was read from its script: the script-derived hashes must equal these, or every simulation reruns.
+HAND_LISTED = {
+    "simulate.py": ("models.simulate", "core.io", "core.heap"),
+    "shear2d.py": ("models.shear2d", "core.io", "core.heap"),
+}
+
+
+def test_simulation_hashes_equal_the_hand_listed_ones():
+    """Reading the entries from simulate.py and shear2d.py reruns no simulation: the hashes are
+    those of the hand-written lists. When this fails a script's imports reach a module the old
+    list did not, so every such simulation would rerun: update HAND_LISTED only if that is meant."""
+    from particle_entropy.core.registry import METHODS
+    from particle_entropy.pipeline.codeversion import simulation_code
+
+    for method in METHODS:
+        others = {f"models.{m}" for m in METHODS if m != method}
+        old = code_version(
+            *HAND_LISTED["simulate.py"], f"models.{method}", exclude=others, files=[SCRIPTS / "simulate.py"]
+        )
+        assert simulation_code(method, METHODS, SCRIPTS / "simulate.py") == old, method
+    old_shear = code_version(*HAND_LISTED["shear2d.py"], files=[SCRIPTS / "shear2d.py"])
+    assert script_code(SCRIPTS / "shear2d.py") == old_shear

@@ -12,7 +12,7 @@ from conftest import ROOT
 from particle_entropy.core import case, columns, records
 from particle_entropy.core.registry import METHODS
 from particle_entropy.pipeline import columnsdoc
-from particle_entropy.pipeline.codeversion import SHEAR_ENTRIES, SIMULATION_ENTRIES, closure, modules
+from particle_entropy.pipeline.codeversion import closure, modules, script_imports
 
 SCRIPTS = ROOT / "workflow" / "scripts"
 PRESENTATION = (
@@ -20,9 +20,11 @@ PRESENTATION = (
     "pipeline.columnsdoc",
 )  # modules of column meanings that no job hashing a simulation may reach
 
-# The code each simulation job hashes (codeversion's entries, which common.smk's SIM_CODE and
-# SHEAR_CODE hash): (entry modules, the script the job runs). The script's own library imports are
-# added below, so a job is held to all it runs, even what its hash does not follow.
+# The code each simulation job hashes (codeversion.script_code: the modules its script imports, and
+# for simulate.py the method's): (entry modules, the script the job runs). The script's own library
+# imports are added below, so a job is held to all it runs, even what its hash does not follow.
+SIMULATION_ENTRIES = tuple(sorted(script_imports(SCRIPTS / "simulate.py")))
+SHEAR_ENTRIES = tuple(sorted(script_imports(SCRIPTS / "shear2d.py")))
 JOBS = {
     **{f"simulate {m}": ((*SIMULATION_ENTRIES, f"models.{m}"), "simulate.py") for m in METHODS},
     "simulate_shear": (SHEAR_ENTRIES, "shear2d.py"),

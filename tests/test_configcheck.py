@@ -335,3 +335,18 @@ def test_the_shear_n_cap_is_the_schemas():
 
     schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     assert schema["properties"]["shear"]["properties"]["n"]["maximum"] == SHEAR_MAX_N == 10**8
+
+
+def test_the_parse_checks_the_config_in_one_call():
+    """check_parsed_config: --config overrides retyped, the schema, the defaults filled in (by the
+    given function, Snakemake's validate in the workflow), then the rules between fields."""
+    from particle_entropy.pipeline.configcheck import SCHEMA_PATH, check_parsed_config
+
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    filled = []
+    check_parsed_config(config, {}, SCHEMA_PATH, lambda c, path: filled.append(path))
+    assert filled == [str(SCHEMA_PATH)]
+    bad = copy.deepcopy(config) | {"base_seed": 1000.0}  # --config base_seed=1e3, as Snakemake reads it
+    with pytest.raises(SettingError, match="base_seed"):
+        check_parsed_config(bad, {}, SCHEMA_PATH, lambda c, path: filled.append(path))
+    assert len(filled) == 1  # refused before the defaults are filled in

@@ -135,3 +135,17 @@ def test_the_workflow_reads_its_command_line(tmp_path):
     assert table.exists() and "corrupt table" not in summary.stderr
     run = subprocess.run([*cmd, "no-such-target.txt", *config], capture_output=True, text=True)
     assert "corrupt table results/tables/x.parquet" in run.stderr and not table.exists()
+
+
+def test_unmade_targets_are_the_requested_files_not_there(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    from particle_entropy.pipeline.invocation import unmade_targets
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "made.png").write_text("x")
+    jobs = [SimpleNamespace(output=[], input=["made.png", "missing.png"]), SimpleNamespace(output=["gone.pdf"])]
+    dag = SimpleNamespace(untilrules=set(), untilfiles=set(), omitrules=set(), omitfiles=set(), targetjobs=jobs)
+    assert unmade_targets(dag) == ["gone.pdf", "missing.png"]
+    dag.untilrules = {"simulate"}  # --until stops short of the targets on purpose
+    assert unmade_targets(dag) == []

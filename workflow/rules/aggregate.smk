@@ -7,8 +7,8 @@
 # N is the argmin, and the minima with their bootstrap intervals.
 rule comic_tables:
     input:
-        summaries=summaries_of("fig8", "fig9"),
-        runs=runs_of("fig8", "fig9"),
+        summaries=INPUTS.summaries_of("fig8", "fig9"),
+        runs=INPUTS.runs_of("fig8", "fig9"),
     output:
         comic="results/tables/comic.parquet",
         minima="results/tables/comic_minima.parquet",
@@ -25,7 +25,7 @@ rule comic_tables:
         "../../envs/particle-entropy.yaml"
     params:
         times=config["comic_times"],
-        code=COMIC_CODE,
+        code=script_code(SCRIPTS / "comic_tables.py"),
     script:
         "../scripts/comic_tables.py"
 
@@ -34,8 +34,8 @@ rule comic_tables:
 # only its own runs.
 rule comic_tables_section:
     input:
-        summaries=lambda w: summaries_of(w.section),
-        runs=lambda w: runs_of(w.section),
+        summaries=lambda w: INPUTS.summaries_of(w.section),
+        runs=lambda w: INPUTS.runs_of(w.section),
     output:
         comic="results/tables/{section}/comic.parquet",
         minima="results/tables/{section}/comic_minima.parquet",
@@ -52,7 +52,7 @@ rule comic_tables_section:
         "../../envs/particle-entropy.yaml"
     params:
         times=config["comic_times"],
-        code=COMIC_CODE,
+        code=script_code(SCRIPTS / "comic_tables.py"),
     script:
         "../scripts/comic_tables.py"
 
@@ -62,8 +62,8 @@ rule paper_claims:
         minima="results/tables/comic_minima.parquet",
         comic="results/tables/comic.parquet",
         realisations="results/tables/comic_realisations.parquet",
-        summaries=summaries_of("fig3", "fig5"),
-        runs=section_inputs("fig1") if "fig1" in PLOTTED else [],
+        summaries=INPUTS.summaries_of("fig3", "fig5"),
+        runs=INPUTS.section_inputs("fig1") if "fig1" in PLOTTED else [],
     output:
         table="results/tables/paper_claims.parquet",
         md="results/paper_claims.md",
@@ -78,14 +78,14 @@ rule paper_claims:
     params:
         claims=config["claims"],
         case_defaults=config.get("case_defaults", {}),
-        code=CLAIMS_CODE,
+        code=script_code(SCRIPTS / "paper_claims.py"),
     script:
         "../scripts/paper_claims.py"
 
 
 rule tradeoff_table:
     input:
-        summaries_of("tradeoff"),
+        INPUTS.summaries_of("tradeoff"),
     output:
         "results/tables/tradeoff.parquet",
     log:
@@ -97,6 +97,6 @@ rule tradeoff_table:
         "../../envs/particle-entropy.yaml"
     params:
         times=config.get("tradeoff", {}).get("times", []),
-        code=TRADEOFF_CODE,
+        code=script_code(SCRIPTS / "tradeoff_table.py"),
     script:
         "../scripts/tradeoff_table.py"

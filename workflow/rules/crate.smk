@@ -17,8 +17,8 @@ rule crate:
         "../../envs/particle-entropy.yaml"
     params:
         checkout=workflow.basedir,
-        coded=lambda w: coded_rules(workflow.rules),
-        optional=lambda w: beyond_default_target(),
-        code=CRATE_CODE,
+        coded=lambda w: inputs.coded_rules(workflow.rules),
+        optional=lambda w: inputs.beyond_default_target(workflow.rules),
+        code=script_code(SCRIPTS / "crate.py"),
     script:
         "../scripts/crate.py"

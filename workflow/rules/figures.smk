@@ -7,7 +7,7 @@ for _fig in PLOTTED:
         name:
             f"plot_{_fig}"
         input:
-            section_inputs(_fig),
+            INPUTS.section_inputs(_fig),
         output:
             png=report(
                 f"figures/{_fig}.png",
@@ -28,10 +28,10 @@ for _fig in PLOTTED:
             mem_mb=1000,
         params:
             fig=_fig,
-            cases=section_cases(_fig),
+            cases=INPUTS.section_cases(_fig),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
             options=figure_options(_fig, config.get("figures", {}).get(_fig, {})),
-            code=PLOT_CODE[_fig],
+            code=script_code(SCRIPTS / "plot_figure.py", f"figures.{_fig}"),  # the script draws figures.<fig>
         script:
             "../scripts/plot_figure.py"

@@ -18,10 +18,10 @@ if "mechanism" in config:
             n=config["mechanism"].get("fd_domain", {}).get("n", []),
             lengths=config["mechanism"].get("fd_domain", {}).get("lengths", []),
             fd_dt=config["time"]["fd_dt"],
-            times=fd_report_times(),
+            times=INPUTS.fd_report_times(),
             D=config["physics"]["D"],
             ref_length=config["physics"]["fd_length"],
-            code=FD_DOMAIN_CODE,
+            code=script_code(SCRIPTS / "fd_domain.py"),
         script:
             "../scripts/fd_domain.py"
 
@@ -52,11 +52,11 @@ if "mechanism" in config:
         resources:
             mem_mb=1000,
         params:
-            cases=section_cases("mechanism"),
+            cases=INPUTS.section_cases("mechanism"),
             D=config["physics"]["D"],
             t_final=config["physics"]["t_final"],
             omega=config["physics"]["omega"],
-            code=MECHANISM_PLOT_CODE,
+            code=script_code(SCRIPTS / "plot_fig9_mechanism.py"),
         script:
             "../scripts/plot_fig9_mechanism.py"
 
@@ -73,6 +73,6 @@ if "mechanism" in config:
         params:
             runs=[{"case": c.wildcards(), "settings": run_settings(c, config)} for c in lattice_cases(config)],
             times=config["comic_times"],
-            code=LATTICE_CODE,
+            code=script_code(SCRIPTS / "mechanism_floors.py"),
         script:
             "../scripts/mechanism_floors.py"

@@ -23,7 +23,7 @@ checkpoint optimum_round:
         spec=lambda w: config["optimum"][w.name],
         settings=optimum_settings,
         base_seed=config["base_seed"],
-        code=OPTIMUM_ROUND_CODE,
+        code=script_code(SCRIPTS / "optimum_round.py"),
     script:
         "../scripts/optimum_round.py"
 
@@ -46,7 +46,7 @@ rule optimum_table:
     params:
         spec=lambda w: config["optimum"][w.name],
         settings=optimum_settings,
-        code=OPTIMUM_TABLE_CODE,
+        code=script_code(SCRIPTS / "optimum_table.py"),
     script:
         "../scripts/optimum_table.py"
 
@@ -74,7 +74,7 @@ rule plot_optimum:
     resources:
         mem_mb=1000,
     params:
-        code=OPTIMUM_PLOT_CODE,
+        code=script_code(SCRIPTS / "plot_optimum.py"),
     script:
         "../scripts/plot_optimum.py"
 

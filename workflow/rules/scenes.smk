@@ -39,7 +39,7 @@ checkpoint scene_round:
         spec=lambda w: SCENES.spec(w.name),
         case_defaults=config.get("case_defaults", {}),
         base_seed=config["base_seed"],
-        code=SCENE_ROUND_CODE,
+        code=script_code(SCRIPTS / "scene_round.py"),
     script:
         "../scripts/scene_round.py"
 
@@ -59,7 +59,7 @@ rule scene_table:
     params:
         spec=lambda w: SCENES.spec(w.name),
         case_defaults=config.get("case_defaults", {}),
-        code=SCENE_TABLE_CODE,
+        code=script_code(SCRIPTS / "scene_table.py"),
     script:
         "../scripts/scene_table.py"
 
@@ -85,7 +85,7 @@ rule plot_scene:
     resources:
         mem_mb=1000,
     params:
-        code=SCENE_PLOT_CODE,
+        code=script_code(SCRIPTS / "plot_scene.py"),
     script:
         "../scripts/plot_scene.py"
 
@@ -112,7 +112,7 @@ rule plot_scenes_peclet:
     resources:
         mem_mb=1000,
     params:
-        code=SCENE_PLOT_CODE,
+        code=script_code(SCRIPTS / "plot_scenes_peclet.py"),
     script:
         "../scripts/plot_scenes_peclet.py"
 

@@ -23,7 +23,7 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
             runtime=10,
         params:
             **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},
-            code=SHEAR_CODE,
+            code=script_code(SCRIPTS / "shear2d.py"),
         script:
             "../scripts/shear2d.py"
 
@@ -49,6 +49,6 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
         resources:
             mem_mb=2000,
         params:
-            code=SHEAR_PLOT_CODE,
+            code=script_code(SCRIPTS / "plot_fig10.py"),
         script:
             "../scripts/plot_fig10.py"

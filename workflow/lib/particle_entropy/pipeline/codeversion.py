@@ -5,11 +5,14 @@ not (found by reading the import statements, so a new import is followed without
 keep up to date). A rule that passes this hash as a parameter reruns when, and only when, the
 content of that code changes: restoring a file's old content, or touching it, reruns nothing.
 (Snakemake's own `code` trigger compares a script's modification time, so the workflow's
-profile leaves it out and hashes the script here instead.)
+profile leaves it out and hashes the script here instead.) ``script_code("…/comic_tables.py")`` is a
+rule's hash from its script alone: the script, the package modules it imports (read from it) and
+their closure, so no rule lists its modules by hand.
 """
 
 from __future__ import annotations
 
+import ast
 import functools
 import hashlib
 import os
@@ -80,18 +83,42 @@ def code_version(*entries: str, exclude=(), files=(), package: Path = PACKAGE) -
     return h.hexdigest()[:16]
 
 
-# What the simulation jobs run besides their method's module (workflow/rules/common.smk hashes
-# these, and tests/test_columns.py holds them clear of presentation): the driver, table output and
-# the allocator setting that the job script imports.
-SIMULATION_ENTRIES = ("models.simulate", "core.io", "core.heap")
-SHEAR_ENTRIES = ("models.shear2d", "core.io", "core.heap")
+def script_imports(script, package: Path = PACKAGE) -> frozenset[str]:
+    """Package modules (dotted names) that a rule's ``script`` imports by absolute imports (``from
+    particle_entropy.core.io import x``, ``from particle_entropy.figures import fig10``, ``import
+    particle_entropy.core.io``), lazy ones included. A Python script is parsed; a rule file, whose
+    ``run:`` block imports (summarise.smk), is read by a pattern like ``imports``."""
+    known, top = modules(package), package.name
+    text = Path(script).read_text()
+    found = []  # (module path below the package, names imported from it)
+    if Path(script).suffix == ".py":
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] == top:
+                found.append((node.module.partition(".")[2], [a.name for a in node.names]))
+            elif isinstance(node, ast.Import):
+                found += [(a.name.partition(".")[2], []) for a in node.names if a.name.split(".")[0] == top]
+    else:
+        pattern = rf"^[ \t]*from[ \t]+{top}\.?([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n#]*)"
+        found = [(path, re.findall(r"\w+", names)) for path, names in re.findall(pattern, text, re.M)]
+    hit = set()
+    for path, names in found:  # from a (sub)package: the names may be modules
+        hit.update([path] if path in known else (f"{path}.{n}" if path else n for n in names))
+    return frozenset(hit & set(known))
+
+
+def script_code(script, *also: str, exclude=(), package: Path = PACKAGE) -> str:
+    """The code hash of a rule: its ``script`` (or the rule file of a ``run:`` block), the package
+    modules it imports and all that they import (``code_version``). ``also``: modules the script
+    picks by name when it runs (plot_figure.py draws figures.<name>, simulate.py runs models.<method>)."""
+    return code_version(*script_imports(script, package), *also, exclude=exclude, files=[script], package=package)
 
 
 def simulation_code(method: str, methods, script, package: Path = PACKAGE) -> str:
-    """The code hash of a ``method`` simulation job: SIMULATION_ENTRIES, the method's module and
-    the job's script, the other ``methods``' modules left out."""
+    """The code hash of a ``method`` simulation job: its ``script`` (simulate.py), what the script
+    imports, and the method's module, the other ``methods``' modules left out (the driver imports
+    them all, each run uses one)."""
     others = {f"models.{m}" for m in methods if m != method}
-    return code_version(*SIMULATION_ENTRIES, f"models.{method}", exclude=others, files=[script], package=package)
+    return script_code(script, f"models.{method}", exclude=others, package=package)
 
 
 def export_library_path(lib: str | Path) -> str:

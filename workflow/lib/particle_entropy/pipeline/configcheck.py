@@ -438,3 +438,24 @@ def check_config(
             f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",
             "`snakemake scenes` and " + ("figures/scenes_peclet.png" if peclet else f"figures/scene_{name}.png"),
         )
+
+
+def check_parsed_config(
+    config: dict, overrides: Mapping, schema_path: str | Path, fill_defaults, available: float | None = None
+) -> None:
+    """The merged config (config.yaml, --configfile, --config) as the Snakefile's parse checks it,
+    in place, in one call: the ``overrides`` of --config retyped as YAML reads them
+    (``retype_overrides``: --config physics={D: 0.002} is a number); the schema, one short message
+    naming the key path (an integer is an int, so --config base_seed=1e3, 1000.0 to Snakemake, is
+    refused, not run as seeds~1000.0); the schema's defaults filled in by ``fill_defaults(config,
+    schema_path)`` (Snakemake's validate); every rule between fields (crosschecks.check_sweeps);
+    and given the ``available`` bytes of the machine the jobs run on, that each job fits
+    (crosschecks.check_memory). The searches and scenes are checked when a target first needs them."""
+    from .crosschecks import check_memory, check_sweeps
+
+    retype_overrides(config, overrides)
+    check_schema(config, load_schema(schema_path))
+    fill_defaults(config, str(schema_path))
+    check_sweeps(config)
+    if available is not None:
+        check_memory(config, available)

@@ -10,7 +10,8 @@ judged from the parsed options by their argparse names (dests). Which dests lead
 ``execute_workflow`` is Snakemake's if/elif chain in ``args_to_api``, which no API exposes:
 ``NO_JOB_OPTIONS`` copies it, and tests/test_invocation.py reads that function's source and
 fails when a Snakemake release changes the chain. Snakemake is imported inside the function
-only, so the library still imports without it."""
+only, so the library still imports without it. After a run, ``unmade_targets`` reads Snakemake's
+DAG for the requested targets that are not there."""
 
 from __future__ import annotations
 
@@ -64,3 +65,14 @@ def snakemake_options(argv: Sequence[str]) -> dict[str, object] | None:
     except SystemExit:
         return None
     return vars(options)
+
+
+def unmade_targets(dag) -> list[str]:
+    """The requested targets (a target rule's inputs where it has no output) that are not there
+    after a run, from Snakemake's ``dag`` (``workflow.dag``); none to check under --until or
+    --omit-from, which stop short of them on purpose. Snakemake can end a run "100% done" with a
+    target unmade (a rerun job with an ancient output hides the jobs after it)."""
+    if dag.untilrules or dag.untilfiles or dag.omitrules or dag.omitfiles:
+        return []
+    files = {str(f) for job in dag.targetjobs for f in (job.output or job.input)}
+    return sorted(f for f in files if not Path(f).exists())
