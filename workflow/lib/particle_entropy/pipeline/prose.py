@@ -70,9 +70,9 @@ def percent(x: float) -> str:
     return f"{100 * float(x):g} %"
 
 
-def interval(lo: float | None, hi: float) -> str:
-    """A half-open interval of resolutions or Peclet numbers: (668, 1,243]; '<= hi' without a low end."""
-    return f"<= {integer(hi)}" if lo is None or not math.isfinite(lo) else f"({integer(lo)}, {integer(hi)}]"
+def interval(lo: float, hi: float) -> str:
+    """A half-open interval of resolutions or Peclet numbers: (668, 1,243]."""
+    return f"({integer(lo)}, {integer(hi)}]"
 
 
 def model(label: str) -> str:
@@ -239,7 +239,9 @@ def _answer(c: Mapping, with_label: bool = True) -> str:
         top = f" up to {symbol} = {integer(c['top_n'])}" if c.get("top_n") else f" ({c['stopped']})"
         return f"{name}not met{top}{why}"
     runs = f" ({a['realisations']} realisations)" if c["method"] in PARTICLES else ""
-    return f"{name}{symbol} in {interval(a['n_below'], a['n'])}, {seconds(a['cost_s'])} s{runs}"
+    below = a["n_below"]
+    rungs = f"{symbol} = {integer(a['n'])}" if below is None else f"{symbol} in {interval(below, a['n'])}"
+    return f"{name}{rungs}, {seconds(a['cost_s'])} s{runs}"
 
 
 def scene_table(numbers: Mapping) -> str:
