@@ -190,6 +190,7 @@ def test_missing_unknown_and_unclosed_markers():
     _, problems = prose.render(text, values, blocks)
     assert any("no value named 'c'" in p for p in problems)
     assert any("'b' is never closed" in p for p in problems)
+    assert prose.render("`<!-- value X -->`", values, blocks) == ("`<!-- value X -->`", [])  # quoted
 
 
 def test_a_missing_marker_is_reported(tmp_path):

@@ -14,7 +14,8 @@ workflow's rule ``scene_numbers`` writes the same file as results/scenes_numbers
     python -m particle_entropy.pipeline.prose --from results --write   # docs/numbers.json from a run, then render
 
 Every name must be marked somewhere and every marker must name a known value, so a spot cannot
-be dropped or misspelt unnoticed.
+be dropped or misspelt unnoticed. A marker right after a backtick is quoted, as in `<!-- value X -->`,
+and left alone.
 """
 
 from __future__ import annotations
@@ -39,9 +40,9 @@ from . import configcheck
 PAGES = ("README.md", "docs/*.md")  # where spots may be marked (globs under the repository root)
 NUMBERS = "docs/numbers.json"
 COMMAND = ".venv/bin/python -m particle_entropy.pipeline.prose"
-INLINE = re.compile(r"<!-- value (?P<name>[\w.-]+) -->(?P<text>.*?)<!-- /value -->", re.S)
+INLINE = re.compile(r"(?<!`)<!-- value (?P<name>[\w.-]+) -->(?P<text>.*?)<!-- /value -->", re.S)
 BLOCK = re.compile(r"^<!-- table (?P<name>[\w.-]+) -->\n(?P<text>.*?)^<!-- /table -->$", re.S | re.M)
-OPENERS = re.compile(r"<!-- (?P<kind>value|table) (?P<name>[\w.-]+) -->")
+OPENERS = re.compile(r"(?<!`)<!-- (?P<kind>value|table) (?P<name>[\w.-]+) -->")
 CLOSERS = {"value": "<!-- /value -->", "table": "<!-- /table -->"}
 SIGNIFICANT = 2  # significant digits of a counted cost [s]
 ABBREVIATED = {"fd": "FD", "pt": "PT", "mtpt": "MTPT"}
