@@ -31,11 +31,13 @@ from pathlib import Path
 import pandas as pd
 
 from ..analysis import resampling, scene_search
+from ..analysis.optimum import SEARCH_DEFAULTS
 from ..core.registry import MEASUREMENT_POINTS
 from ..core.settings import SCENE, SCENE_MIN_MARGIN, defaults
+from ..core.timegrid import MAX_STEPS
 from ..experiments import scene
 from ..experiments.scene import SWEEP_PREFIX
-from . import configcheck
+from . import configcheck, joblogs
 
 PAGES = ("README.md", "docs/*.md")  # where spots may be marked (globs under the repository root)
 NUMBERS = "docs/numbers.json"
@@ -47,6 +49,7 @@ CLOSERS = {"value": "<!-- /value -->", "table": "<!-- /table -->"}
 SIGNIFICANT = 2  # significant digits of a counted cost [s]
 ABBREVIATED = {"fd": "FD", "pt": "PT", "mtpt": "MTPT"}
 PARTICLES = ("pt", "mtpt")
+SEARCH_KEYS = ("width", "realisations", "max_realisations", "initial_points", "start_points")  # quoted defaults
 
 
 # ------------------------------------------------------------------------------ formatting
@@ -111,6 +114,9 @@ def code_values() -> dict[str, str]:
         "configcheck.MAX_CONFIG_BYTES": f"{configcheck.MAX_CONFIG_BYTES / 1e6:g} MB",
         "configcheck.MAX_VALUES": integer(configcheck.MAX_VALUES),
         "configcheck.MAX_DEPTH": str(configcheck.MAX_DEPTH),
+        "timegrid.MAX_STEPS": integer(MAX_STEPS),
+        "joblogs.TAIL_LINES": str(joblogs.TAIL_LINES),
+        **{f"optimum.{key}": f"{SEARCH_DEFAULTS[key]:g}" for key in SEARCH_KEYS},
     }
 
 
