@@ -197,3 +197,18 @@ def test_a_missing_marker_is_reported(tmp_path):
     (tmp_path / "README.md").write_text("<!-- value a -->1<!-- /value -->\n", encoding="utf-8")
     problems = check(tmp_path, {"a": "1", "b": "2"}, {"t": "| x |\n"})
     assert problems == ["no marker for b", "no marker for t"]
+
+
+def test_formats():
+    assert [prose.seconds(x) for x in (0.000356, 0.0077581, 0.0157, 1.8473, 6.8801)] == [
+        "0.00036",
+        "0.0078",
+        "0.016",
+        "1.8",
+        "6.9",
+    ]
+    assert prose.integer(16970.56) == "16,971" and prose.interval(508.9, 5091.2) == "(509, 5,091]"
+    assert prose.power(1e-3) == "1e-3" and prose.power(2.5e-12) == "2.5e-12"
+    assert prose.exponent(10**8) == "10^8" and prose.exponent(12345) == "12,345"
+    assert prose.percent(0.95) == "95 %" and prose.target("entropy", 0.01) == "H_C within 0.01 nats"
+    assert prose.model("mtpt collision eta=1") == "MTPT collision eta=1"

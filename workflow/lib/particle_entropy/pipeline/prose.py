@@ -33,6 +33,7 @@ import pandas as pd
 from ..analysis import resampling, scene_search
 from ..analysis.optimum import SEARCH_DEFAULTS
 from ..core.registry import MEASUREMENT_POINTS
+from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
 from ..core.settings import SCENE, SCENE_MIN_MARGIN, defaults
 from ..core.timegrid import MAX_STEPS
 from ..experiments import scene
@@ -67,6 +68,12 @@ def power(x: float) -> str:
     """A small tolerance as the prose writes it: 0.001 -> '1e-3', 2.5e-12 -> '2.5e-12'."""
     mantissa, exponent = f"{float(x):e}".split("e")
     return f"{float(mantissa):g}e{int(exponent)}"
+
+
+def exponent(n: int) -> str:
+    """A power of ten as 10^k (100_000_000 -> '10^8'), any other integer with separators."""
+    k = round(math.log10(n)) if n > 0 else 0
+    return f"10^{k}" if n == 10**k else integer(n)
 
 
 def percent(x: float) -> str:
@@ -115,6 +122,8 @@ def code_values() -> dict[str, str]:
         "configcheck.MAX_VALUES": integer(configcheck.MAX_VALUES),
         "configcheck.MAX_DEPTH": str(configcheck.MAX_DEPTH),
         "timegrid.MAX_STEPS": integer(MAX_STEPS),
+        "runconfig.MAX_GRID_POINTS": exponent(MAX_GRID_POINTS),
+        "runconfig.GRID_SPACING": f"{GRID_SPACING:g}",
         "joblogs.TAIL_LINES": str(joblogs.TAIL_LINES),
         **{f"optimum.{key}": f"{SEARCH_DEFAULTS[key]:g}" for key in SEARCH_KEYS},
     }
