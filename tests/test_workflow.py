@@ -1146,6 +1146,10 @@ def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     assert {n for n in ladder if n < best["n"]} <= set(mine["n"])  # every rung below the answer run
     assert not mine[mine["n"] < best["n"]]["meets"].any()
     assert (work / "figures/scene_carried.png").stat().st_size > 5000
+    numbers = json.loads((work / "results/scenes_numbers.json").read_text())  # what the README quotes
+    (quoted,) = numbers["scenes"]
+    chosen = [c for c in quoted["candidates"] if c["recommended"]]
+    assert quoted["scene"] == "carried" and chosen[0]["answer"]["n"] == best["n"] and not numbers["sweep"]
     plans = sorted((work / "results/scenes/carried").glob("round~*.parquet"), key=lambda p: int(p.stem.split("~")[1]))
     last = pd.read_parquet(plans[-1])
     assert last["done"].all() and len(plans) >= 3

@@ -117,8 +117,27 @@ rule plot_scenes_peclet:
         "../scripts/plot_scenes_peclet.py"
 
 
+# The numbers the README quotes from the scene tables (pipeline/prose.py): docs/numbers.json is this
+# file of a finished paper run, and `prose --check` holds the README and docs/ to it.
+rule scene_numbers:
+    input:
+        expand("results/scenes/{name}.parquet", name=SCENES),
+    output:
+        "results/scenes_numbers.json",
+    log:
+        "logs/scenes/numbers.log",
+    localrule: True
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        code=script_code(SCRIPTS / "scene_numbers.py"),
+    script:
+        "../scripts/scene_numbers.py"
+
+
 # Every configured scene: `snakemake -j2 scenes` (not part of the default target).
 rule scenes:
     input:
         expand("figures/scene_{name}.png", name=SCENES),
         ["figures/scenes_peclet.png"] if config.get("scenes_peclet") else [],
+        "results/scenes_numbers.json",
