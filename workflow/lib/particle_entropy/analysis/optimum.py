@@ -21,7 +21,8 @@ starting at the cheap end (the largest growth, fewest steps).
 The search stops when the bracket (the visited N around the interval) is no wider than
 ``width``, when nothing is left to add, or when the next runs would exceed the budget of runs
 or of core-seconds. Core-seconds are counted by the search's calibrated cost model
-(``Search.cost``, ``calibrated_cost``: seconds per run written in the config), never measured:
+(``Search.cost``, ``calibrated_cost``: seconds per run written in the config, a tabulated curve of
+the run cost model, core/runcost.py; asked through Search.run_seconds), never measured:
 a search's path depends only on its config and the seeds, on any machine. The measured
 core-seconds are reported beside it (``core_s``). FD is deterministic: one run per N, a
 bracketing search.
@@ -39,6 +40,7 @@ import math
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
@@ -48,6 +50,7 @@ from ..core.io import read_parquet
 from ..core.labels import case_label
 from ..core.registry import MEASURE_NAMES, MEASUREMENT_POINTS
 from ..core.runconfig import first_step
+from ..core.runcost import Tabulated
 from ..core.settings import PAPER, SEARCH, defaults
 from ..core.timegrid import step_count
 from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
@@ -55,6 +58,7 @@ from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
 from .search import (
     AdaptiveSearch,
     check_plan_columns,
+    counted_seconds,
     extended,
     measured_core_s,
     new_plan,
@@ -172,6 +176,15 @@ class Search(AdaptiveSearch):
 
     def next_plan(self, plan: pd.DataFrame, runs: pd.DataFrame, base_seed: int) -> pd.DataFrame:
         return next_plan(self, plan, runs)  # the blocks' seeds follow the plan's own (base_seed of round 0)
+
+    @cached_property
+    def cost_curve(self) -> Tabulated | None:
+        """The calibrated cost model (calibrated_cost: runcost.Tabulated), None without ``cost``."""
+        return calibrated_cost(self)
+
+    def run_seconds(self, point) -> float:
+        """Seconds of one run at the searched value ``point`` by the cost model (NaN without one)."""
+        return math.nan if self.cost_curve is None else self.cost_curve.seconds(point)
 
     def read_runs(self, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
         """The runs' values at the search's time; their measured wall times are not read."""
@@ -414,62 +427,43 @@ def initial_plan(search: Search, base_seed: int) -> pd.DataFrame:
 def cost_model(costs: pd.DataFrame, search: Search | None = None) -> Callable[[float], float]:
     """Predicted core-seconds of one run at a searched value from measured runs (columns of the
     searched dimension, seed, core_s), for the report only (the full-sweep estimate): the mean
-    per value, interpolated (_interpolated)."""
+    per value, interpolated (tabulated)."""
     column = search.over if search else "n"
     per_run = costs.groupby(column)["core_s"].mean()
     if per_run.empty:
         return lambda x: 0.0
-    return _interpolated(per_run.index.to_numpy(np.float64), per_run.to_numpy(np.float64), search)
+    return tabulated(per_run.index.to_numpy(np.float64), per_run.to_numpy(np.float64), search).seconds
 
 
-def calibrated_cost(search: Search) -> Callable[[float], float] | None:
+def calibrated_cost(search: Search) -> Tabulated | None:
     """The search's cost model: core-seconds of one run at a searched value from its calibrated
-    points (``Search.cost``), interpolated (_interpolated); None without points."""
+    points (``Search.cost``), interpolated (tabulated); None without points."""
     if not search.cost:
         return None
     xs, seconds = zip(*sorted(search.cost))
-    return _interpolated(np.array(xs), np.array(seconds), search)
+    return tabulated(np.array(xs), np.array(seconds), search)
 
 
 def cost_order(search: Search) -> Callable[[float], float]:
     """A key that orders runs by cost: the cost model, or without one N (the steps, for a growth
     search) in arbitrary units."""
-    return calibrated_cost(search) or _interpolated(np.array([float(search.lo)]), np.array([1.0]), search)
+    return (search.cost_curve or tabulated(np.array([float(search.lo)]), np.array([1.0]), search)).seconds
 
 
 def planned_cost_s(search: Search, plan: pd.DataFrame) -> float:
     """Core-seconds of every run of ``plan`` by the cost model (NaN without one): what the budget counts."""
-    model = calibrated_cost(search)
-    if model is None:
+    if search.cost_curve is None:
         return math.nan
-    counts = plan["last"] - plan["first"] + 1
-    return float(sum(c * model(x) for x, c in zip(plan[search.over], counts)))
+    return counted_seconds(search, plan[search.over], plan["last"] - plan["first"] + 1)
 
 
-def _interpolated(xs: np.ndarray, seconds: np.ndarray, search: Search | None) -> Callable[[float], float]:
-    """Seconds per run at searched values ``xs`` (increasing), interpolated in u (log N) - log
-    cost and extrapolated with the end segments' slopes (kept in [-2, 2]: no run here costs more
-    than N^2 or steps^2); one value: cost proportional to N (to steps for a growth search)."""
-    column = search.over if search else "n"
-    to_u = search.u if search else np.log
-    u = np.asarray(to_u(xs), dtype=np.float64)
-    c = np.log(np.maximum(seconds, 1e-9))
-    alone = -1.0 if column == "dt_growth" else 1.0
-
-    def slope(i, j):
-        return alone if len(u) < 2 else float(np.clip((c[j] - c[i]) / (u[j] - u[i]), -2.0, 2.0))
-
-    lo, hi = slope(0, 1), slope(-2, -1)
-
-    def predict(x: float) -> float:
-        v = float(to_u(x))
-        if v < u[0]:
-            return float(math.exp(c[0] + lo * (v - u[0])))
-        if v > u[-1]:
-            return float(math.exp(c[-1] + hi * (v - u[-1])))
-        return float(math.exp(np.interp(v, u, c)))
-
-    return predict
+def tabulated(xs: np.ndarray, seconds: np.ndarray, search: Search | None) -> Tabulated:
+    """Seconds per run at searched values ``xs`` (increasing) as a tabulated cost model (runcost.Tabulated)
+    on the search's axis u (log N; log(dt_growth - 1)); one value: cost proportional to N (to
+    steps for a growth search)."""
+    if search is None:
+        return Tabulated(xs, seconds)
+    return Tabulated(xs, seconds, search.u, -1.0 if search.over == "dt_growth" else 1.0)
 
 
 def fitted_minimum(u: np.ndarray, values: np.ndarray, weights: np.ndarray, reach: int = 2) -> np.ndarray:
@@ -671,7 +665,7 @@ def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) ->
             if a < mid < b and mid not in xs:
                 new.append(mid)
     new.sort(key=lambda x: abs(float(search.u(x)) - u_opt))  # nearest the optimum first
-    model, order = calibrated_cost(search), cost_order(search)
+    model, order = search.cost_curve, cost_order(search)
     unresolved = [x for x in rivals if x in inside]
     more = sorted(set(ends) | set(unresolved) | set([] if walk else lucky), key=order)
     base = int(plan["first"].min())
@@ -680,7 +674,7 @@ def next_plan(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame) ->
 
     def add(x, have, count):
         nonlocal spent, spent_s
-        cost = count * model(x) if model else 0.0
+        cost = count * search.run_seconds(x) if model else 0.0
         if spent + count > search.budget_runs or spent_s + cost > search.budget_core_s:
             return
         added.append(_block(search, k, x, base, have, count))
@@ -741,8 +735,8 @@ def result_table(search: Search, plan: pd.DataFrame, realisations: pd.DataFrame,
     cost_x = costs.groupby(search.over)["core_s"].sum()
     table["round_added"] = table[search.over].map(first_round).astype(int)
     table["core_s"] = table[search.over].map(cost_x).astype(float)
-    model = calibrated_cost(search)
-    table["cost_s"] = table["realisations"] * table[search.over].map(model) if model else math.nan
+    model = search.cost_curve
+    table["cost_s"] = table["realisations"] * table[search.over].map(search.run_seconds) if model else math.nan
     other = "dt_growth" if search.over == "n" else "n"
     table[other] = getattr(search.model, other)
     # a grid brackets its minimum between the argmin's two neighbours: to give the same bracket

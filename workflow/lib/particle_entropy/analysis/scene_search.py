@@ -16,8 +16,8 @@ The rounds, plans, seed blocks and the rounds' inputs are the search engine's (s
 SceneSearch); this module is the rule for a candidate's next rungs (_next_rungs) and the result.
 
 Costs are counted, not timed: work (particle- or node-steps, the run tables' ``work``) times the
-scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work); the
-measured core-seconds stand beside them.
+scene's cost model of its method (``scenes.<name>.cost``: seconds a step and a unit of work, a
+step-work model of core/runcost.py: Scene.cost_model); the measured core-seconds stand beside them.
 """
 
 from __future__ import annotations
@@ -312,6 +312,11 @@ class SceneSearch(AdaptiveSearch):
 
     def plan_paths(self, plan: pd.DataFrame) -> list[str]:
         return plan_paths(self.scene, plan)
+
+    def run_seconds(self, point) -> float:
+        """Seconds of one run at ``point`` = (candidate index, n): Scene.run_cost, its method's cost model."""
+        ci, n = point
+        return self.scene.run_cost(self.scene.candidates[int(ci)], int(n))
 
 
 def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:

@@ -11,6 +11,9 @@ engine owns what they share:
   the search's base seed on (seed_block), so every block is an ordinary, cached simulation job;
 - run reading shared by every kind: a run's measured core-seconds, its steps' wall times summed
   (measured_core_s), reported beside what the kind counts and never used to decide;
+- the cost a kind counts: one question, a run's seconds at a point (AdaptiveSearch.run_seconds,
+  answered by the kind's cost model, core/runcost.RunCost.seconds), and the seconds of runs at
+  points (counted_seconds);
 - the rounds: round 0 reads nothing, round k reads plan k-1 and its runs (none after a finished
   plan), and the finished plan is the first of at most ``max_plans`` plans with ``done`` set
   (round_inputs, final_inputs: what the Snakemake checkpoints of workflow/rules/search.smk ask for).
@@ -21,6 +24,7 @@ output) and a plan's run tables through a ``plan_paths(plan)`` one (the workflow
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
 
@@ -58,6 +62,11 @@ def measured_core_s(steps: pd.DataFrame, keys: Sequence[str]) -> pd.DataFrame:
     if steps.empty:
         return pd.DataFrame(columns=[*keys, CORE_S])
     return steps.groupby(keys, as_index=False)[WALL].sum().rename(columns={WALL: CORE_S})
+
+
+def counted_seconds(search: AdaptiveSearch, points, counts) -> float:
+    """Seconds of ``counts[i]`` runs at each ``points[i]`` by the search's cost model (run_seconds) [s]."""
+    return float(sum(c * search.run_seconds(x) for x, c in zip(points, counts)))
 
 
 def runs_in(plan: pd.DataFrame) -> int:
@@ -119,6 +128,11 @@ class AdaptiveSearch(ABC):
     @abstractmethod
     def read_runs(self, plan: pd.DataFrame, paths: list[str]):
         """What next_plan needs of the run tables of ``plan``'s rows at ``paths``."""
+
+    def run_seconds(self, point) -> float:
+        """Seconds of one run at ``point`` (a searched value; a scene's (candidate, n)) by the kind's
+        cost model (core/runcost.RunCost.seconds): what its budget counts. NaN: the kind has none."""
+        return math.nan
 
     def round(self, plan: pd.DataFrame | None, paths: list[str], base_seed: int) -> pd.DataFrame:
         """One round: the first plan (``plan`` None), else the plan after ``plan`` and its runs at ``paths``."""

@@ -18,9 +18,10 @@ from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference
 from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION
 from ..core.runconfig import RunConfig, check_plume_width, check_setting
+from ..core.runcost import StepWork, Tally
 from ..core.settings import BY_KEY, MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
-from ..core.timegrid import MAX_STEPS, max_first_step, time_steps
+from ..core.timegrid import MAX_STEPS, max_first_step
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -143,20 +144,22 @@ class Scene:
         """The most seed blocks of ``realisations`` a particle rung may run (scene_search.seeds)."""
         return self.max_realisations // self.realisations if self.max_realisations else MAX_BLOCKS
 
+    def cost_model(self, method: str) -> StepWork:
+        """The scene's cost model of a method's runs (``cost``: seconds a step, seconds a unit of work;
+        core/runcost.StepWork, units as the run tables' `work` counts them)."""
+        per_step, per_work = dict(self.cost)[method]
+        return StepWork(per_step, per_work)
+
     def cost_s(self, method: str, steps: float, work: float) -> float:
         """A run's counted cost: steps and work times the scene's unit costs [s]."""
-        per_step, per_work = dict(self.cost)[method]
-        return per_step * steps + per_work * work
+        return self.cost_model(method).counted(Tally(steps, work))
 
     def run_cost(self, candidate: Candidate, n: int) -> float:
         """The counted cost of one run of ``candidate`` at resolution n, known before it runs: its time
         steps and work (particles, or FD's n + 1 nodes, times steps; MTPT's substeps, if any, come on
         top in the run's own count) times the scene's unit costs [s]."""
         cfg = self.run_config(candidate, n)
-        grid = cfg.time_grid if cfg.method != "fd" else "exact"
-        steps = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid).size
-        size = n + 1 if cfg.method == "fd" else n
-        return self.cost_s(cfg.method, steps, steps * size)
+        return self.cost_model(cfg.method).seconds(cfg)
 
     def key(self, key: str) -> str:
         """The config key path of ``key`` in this scene (key_path)."""

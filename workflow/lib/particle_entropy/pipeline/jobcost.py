@@ -2,14 +2,14 @@
 the longest jobs first (Snakemake `priority`) and a run does not end on one long job alone
 (the shear flow's jobs: ``shear_seconds``).
 
-The model counts the work of one run step by step:
+The model is the run cost model's step-work kind (core/runcost.StepWork, which counts the steps),
+one a method (JOB_COST), with the pairs a sequential (the authors') loop visits priced too:
     seconds = seeds x sum over steps of (STEP_S + UNIT_S[method] x N + PAIR_S x pairs),
-where ``pairs`` counts the pairs a sequential (the authors') loop visits: every particle with
-the neighbours inside its cut-off radius r, each pair once, N^2 r / Omega. The symmetric
-transfer sums with windowed or fast Gauss transforms, whose cost grows with N alone. The
-constants are the per-step, per-node or particle and per-pair seconds of the paper run's 175
-simulation jobs (2-vCPU Xeon, 2026-12-03), rounded: only the order of the jobs matters, not the
-seconds.
+where ``pairs`` counts every particle with the neighbours inside its cut-off radius r, each pair
+once, N^2 r / Omega. The symmetric transfer sums with windowed or fast Gauss transforms, whose cost
+grows with N alone. The constants are the per-step, per-node or particle (per N, not per FD node)
+and per-pair seconds of the paper run's 175 simulation jobs (2-vCPU Xeon, 2026-12-03), rounded:
+only the order of the jobs matters, not the seconds.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
-from ..core.timegrid import time_steps, times
+from ..core.runcost import StepWork
 from ..numerics.kernels import collision_sigma, cutoff_radius, h_sph
 
 STEP_S = {"fd": 3e-5, "pt": 5e-5, "mtpt": 8e-5}  # a step's own cost (measures, records) [s]
@@ -39,12 +39,13 @@ def pairs_per_step(cfg: RunConfig, dt: np.ndarray, t_end: np.ndarray) -> np.ndar
     return cfg.n * np.minimum(cfg.n * radius / cfg.omega, cfg.n / 2.0)
 
 
+# the simulation jobs' cost model, one a method (the constants above; per N, pairs counted)
+JOB_COST = {m: StepWork(STEP_S[m], UNIT_S[m], PAIR_S, per="n", pairs=pairs_per_step) for m in STEP_S}
+
+
 def estimated_seconds(cfg: RunConfig, seeds: int = 1) -> float:
     """Estimated seconds of ``seeds`` runs of a resolved ``cfg`` (the model above)."""
-    dt = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid if cfg.method != "fd" else "exact")
-    t_end = times(dt)[1:]
-    work = STEP_S[cfg.method] + UNIT_S[cfg.method] * cfg.n + PAIR_S * pairs_per_step(cfg, dt, t_end)
-    return float(seeds * work.sum())
+    return seeds * JOB_COST[cfg.method].seconds(cfg)
 
 
 # a shear step per particle: mass transfer among neighbours (`mt`) or a random walk [s]; the paper
