@@ -2,7 +2,6 @@
 # (analysis/search.py), which owns the rounds and what each round reads. A search kind names its
 # searches (search_of), its round checkpoint and the run table of each plan row; its rules are in
 # optimum.smk and scenes.smk.
-from particle_entropy.analysis.scene_search import SceneSearch
 
 
 def optimum_settings(wildcards):
@@ -29,6 +28,8 @@ def optimum_kind(name):
 
 def scene_kind(name):
     """The scene ``name``'s search (the scene built and checked) and the run tables of a plan's rows."""
+    from particle_entropy.analysis.scene_search import SceneSearch  # here: parsing imports no pandas
+
     if name not in SCENES:
         raise WorkflowError(f"no scene {name!r} in config scenes: one of {', '.join(SCENES) or 'none'}")
     search = SceneSearch(SCENES[name])
