@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import math
 import os
 import re
 import stat
@@ -395,10 +396,149 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
+# jsonschema's wording of each refusal, which the messages have always quoted (tests hold it)
+_WORDS = {
+    "greater_than": "{value!r} is less than or equal to the minimum of {gt}",
+    "greater_than_equal": "{value!r} is less than the minimum of {ge}",
+    "less_than_equal": "{value!r} is greater than the maximum of {le}",
+    "too_short": "{value!r} is too short",
+    "too_long": "{value!r} is too long",
+    "int_type": "{value!r} is not of type 'integer'",
+    "float_type": "{value!r} is not of type 'number'",
+    "bool_type": "{value!r} is not of type 'boolean'",
+    "list_type": "{value!r} is not of type 'array'",
+    "dict_type": "{value!r} is not of type 'object'",
+    "model_type": "{value!r} is not of type 'object'",
+    "string_type": "{value!r} is not of type 'string'",
+    "literal_error": "{value!r} is not one of {expected}",
+    "unique_items": "{value!r} has non-unique elements",
+    "string_pattern_mismatch": "{value!r} does not match {pattern!r}",
+}
+_MISSING = object()
+
+
+def _located(loc, config, model):
+    """Walk a pydantic error location through the raw ``config`` and the typed ``model``: the key
+    path (pydantic's tags of union members and validators left out), the raw value there, the
+    field there (its description) and the model holding it (its known keys)."""
+    from pydantic import BaseModel
+
+    path, value, info, holder, kind = [], config, None, model, model
+    for part in loc:
+        step = None
+        if isinstance(value, Mapping) and isinstance(part, str) and (part in value or part not in ("[key]",)):
+            step = part
+        elif isinstance(value, list) and isinstance(part, int) and 0 <= part < len(value):
+            step = part
+        if step is None:
+            continue
+        path.append(step)
+        value = value.get(step, _MISSING) if isinstance(value, Mapping) else value[step]
+        kind, holder = _inner(kind, step)
+        if isinstance(holder, type) and issubclass(holder, BaseModel) and step in holder.model_fields:
+            info = holder.model_fields[step]
+    return path, value, info, kind
+
+
+def _members(t) -> list:
+    """The types a value of type ``t`` may have (Annotated and unions unwrapped)."""
+    import types
+    import typing
+
+    origin = typing.get_origin(t)
+    if origin is typing.Annotated:
+        return _members(typing.get_args(t)[0])
+    if origin in (typing.Union, types.UnionType):
+        return [m for a in typing.get_args(t) for m in _members(a)]
+    return [t]
+
+
+def _inner(kind, step):
+    """(type of the value at ``step`` inside a value of type ``kind``, the model that declares it)."""
+    import typing
+
+    from pydantic import BaseModel
+
+    for t in _members(kind):
+        if isinstance(t, type) and issubclass(t, BaseModel) and isinstance(step, str) and step in t.model_fields:
+            return t.model_fields[step].annotation, t
+        origin = typing.get_origin(t)
+        if origin is dict and isinstance(step, str):
+            return typing.get_args(t)[1], None
+        if origin is list and isinstance(step, int):
+            return typing.get_args(t)[0], None
+    return None, None
+
+
+def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
+    """One pydantic ValidationError as today's SettingError: key path, value, allowed values
+    (the field's description, and jsonschema's wording of the refusal)."""
+    from .config import Config
+
+    errors = error.errors()
+    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
+    path, value, info, holder = _located(first["loc"], config, Config)
+    kind, ctx = first["type"], first.get("ctx", {})
+    if kind == "extra_forbidden" or "[key]" in first["loc"]:
+        parent = _located(first["loc"][:-1], config, Config)
+        models = [t for t in _members(parent[3]) if hasattr(t, "model_fields")]
+        known = list(models[0].model_fields) if models and "[key]" not in first["loc"] else []
+        if "[key]" in first["loc"]:
+            key = first["loc"][first["loc"].index("[key]") - 1]
+            path = list(path if path and path[-1] == key else [*path, key])
+            allowed = parent[2].description if parent[2] is not None and parent[2].description else "a known key"
+        else:
+            allowed = "a known key: " + ", ".join(known)
+            key = path[-1]
+        near = difflib.get_close_matches(str(key), known, n=1)
+        return SettingError(key_path(path), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else ""))
+    described = info.description if info is not None and info.description else ""
+    if kind == "missing":
+        return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
+    if kind == "each_once":
+        return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
+    if kind == "range_order":
+        return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
+    if kind in ("one_of", "missing_one_of"):
+        return SettingError(key_path(path), "(missing)", first["msg"])
+    finite = isinstance(value, float) and math.isnan(value)
+    if finite:  # nan passes every bound in the schema: refused as not finite, as crosschecks.check_finite does
+        return SettingError(key_path(path), value, "a finite number (YAML .nan and .inf are not settings)")
+    words = _WORDS.get(kind)
+    ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
+    message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
+    allowed = f"{described} ({message})" if described else message
+    if kind in ("int_type", "float_type", "literal_error"):
+        allowed += _number_hint(value, {"type": "integer" if kind == "int_type" else "number"})
+    return SettingError(key_path(path), _short(value), allowed)
+
+
+def validate_config(config: Mapping):
+    """The merged config validated once and returned typed (pipeline.config.Config): each section
+    by its model (types, ranges, required and unknown keys, a section's own cross-field rules),
+    then the rules between sections and runs (crosschecks.check_sweeps). SettingError names the
+    key path, the value and the allowed range, as the schema's check did; its message is bounded."""
+    from pydantic import ValidationError
+
+    from .config import Config
+    from .crosschecks import check_sweeps
+
+    try:
+        typed = Config.model_validate(dict(config))
+    except ValidationError as e:
+        raise bounded(_pydantic_error_to_setting(e, config)) from None
+    try:
+        check_sweeps(config)
+    except SettingError as e:
+        raise bounded(e) from None
+    return typed
+
+
 def check_config(
     config: Mapping, schema: Mapping | None = None, available: float | None = None, not_judged: list | None = None
-) -> None:
-    """Everything a dry run checks: the schema, then every rule between fields (crosschecks.check_sweeps),
+):
+    """Everything a dry run checks, returning the typed config (pipeline.config.Config): each
+    section and every rule between fields (validate_config),
     with ``available`` bytes (the machine's, for the check-config command) that every job fits
     (crosschecks.check_memory), and every adaptive search and scene. A run checks a search or a
     scene only when a requested target needs it (none of the default target's do): given a list
@@ -406,11 +546,12 @@ def check_config(
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
     from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_scene, check_search, check_sweeps
+    from .crosschecks import check_memory, check_scene, check_search
 
+    if schema is not None:  # a schema of the caller's: the file's jsonschema check first
+        check_schema(config, schema)
+    typed = validate_config(config)
     try:
-        check_schema(config, load_schema() if schema is None else schema)
-        check_sweeps(config)
         if available is not None:
             check_memory(config, available)
     except SettingError as e:
@@ -438,3 +579,4 @@ def check_config(
             f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",
             "`snakemake scenes` and " + ("figures/scenes_peclet.png" if peclet else f"figures/scene_{name}.png"),
         )
+    return typed

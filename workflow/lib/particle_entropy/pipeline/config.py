@@ -1,0 +1,327 @@
+"""The typed config: one pydantic model per section, derived from the sections' one declaration.
+
+Every key is declared once, as a ``Setting`` (core/settings.py; the run settings and the shear
+flow's in core/run_settings.py and core/shear_settings.py): its default, unit, range, meaning
+and, for a structured value, its shape. This module *derives* a pydantic model per section from
+those tuples (``section``: ``create_model`` with ``Field(ge/gt/le, description, unit)``) instead
+of replacing ``Setting`` by pydantic fields, for two concrete reasons:
+
+- the simulation jobs import core/run_settings.py and core/shear_settings.py (and core/case.py,
+  core/runconfig.py, models/shear2d.py, which read ``Setting``); a job's code hash covers what it
+  imports (pipeline/codeversion.py), so rewriting them would rerun every simulation once, and
+  would put pydantic into every job;
+- experiments/scene.py and analysis/optimum.py read ``settings.SCENE`` and ``settings.SEARCH``.
+
+A structured value's shape is declared once too, as the JSON-schema fragment of its ``Setting``
+(schemagen writes it into the schema as it stands); ``annotation`` turns that fragment into the
+pydantic type, so the schema and the model cannot disagree. Cross-field rules a section can see
+alone are model validators here (a search's budget and range, a claim's [low, high], each N of
+the ``realisations`` table once); the rules that need several sections or a run (a case that
+builds, a time within t_final, memory) stay in pipeline/crosschecks.py.
+
+``Config`` is what ``configcheck.validate_config`` returns: the merged config, parsed once.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import Annotated, Any, ClassVar, Literal
+
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictInt,
+    create_model,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
+
+from ..core.case import NONE, from_text
+from ..core.registry import ALL_KERNELS, METHODS, PRESETS
+from ..core.settings import (
+    CASE_SECTION,
+    CLAIMS,
+    COMIC_TIMES,
+    FIGURE_OPTIONS,
+    MAX_REALISATIONS,
+    MECHANISM,
+    REALISATIONS_ENTRY,
+    SCENE,
+    SCENES_PECLET,
+    SEARCH,
+    SECTION_DOCS,
+    SEEDS,
+    SETTINGS,
+    SHEAR,
+    TRADEOFF,
+    Setting,
+)
+from ..figures import PAPER_FIGURES
+
+NAME_PATTERN = r"^[A-Za-z0-9_]+\z"  # a search's or a scene's key: letters, digits, _ (no final newline)
+
+
+def description(s: Setting) -> str:
+    """A setting's description: the meaning, the unit and the allowed values (the schema's, the
+    docs' and the refusal messages' text)."""
+    unit = "" if s.unit == "-" else f" [{s.unit}]"
+    return f"{s.doc[0].upper()}{s.doc[1:]}{unit}; {s.allowed()}."
+
+
+class Section(BaseModel):
+    """A config section: unknown keys refused, values frozen once validated."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class _OneOf(Section):
+    """A mapping that must hold exactly one of the keys ``one_of`` (none: any)."""
+
+    one_of: ClassVar[tuple[str, ...]] = ()
+
+    @model_validator(mode="after")
+    def _exactly_one(self):
+        if self.one_of and sum(k in self.model_fields_set for k in self.one_of) != 1:
+            raise PydanticCustomError("one_of", "exactly one of {keys}", {"keys": ", ".join(self.one_of)})
+        return self
+
+
+def _unique(values: list) -> list:
+    if len(values) != len({repr(float(v)) if isinstance(v, (int, float)) else repr(v) for v in values}):
+        raise PydanticCustomError("unique_items", "has non-unique elements")
+    return values
+
+
+def _number(fragment: dict, integer: bool):
+    bounds = {}
+    for key, arg in (("minimum", "ge"), ("exclusiveMinimum", "gt"), ("maximum", "le")):
+        if key in fragment:
+            bounds[arg] = fragment[key]
+    return Annotated[StrictInt if integer else float, Field(strict=True, **bounds)]
+
+
+@functools.cache
+def _defs() -> dict:
+    """The referenced shapes ($defs of the schema) as pydantic types."""
+    dims = {s.name: (annotation_of(s), description(s)) for s in SETTINGS if s.section == "case_defaults"}
+    case = create_model(
+        "CaseSpec",
+        __base__=Section,
+        __doc__="One model: method, kernel and the dimensions that differ from case_defaults.",
+        method=(Literal[METHODS], ...),
+        kernel=(Literal[ALL_KERNELS], ...),
+        preset=(Literal[tuple(PRESETS)] | None, None),
+        **{name: (kind | None, Field(None, description=text)) for name, (kind, text) in dims.items()},
+    )
+    realisations = Annotated[StrictInt, Field(ge=1, le=MAX_REALISATIONS)] | Literal["ensemble"]
+    out = {
+        "method": Literal[METHODS],
+        "kernel": Literal[ALL_KERNELS],
+        **{name: kind for name, (kind, _) in dims.items()},
+        "case": case,
+        "cases": Annotated[list[case], Field(min_length=1)],
+        "ns": Annotated[list[Annotated[StrictInt, Field(ge=2)]], Field(min_length=1)],
+        "realisations": realisations,
+    }
+    out["case_section"] = section("CaseSection", CASE_SECTION, SECTION_DOCS["<section>"], defs=out)
+    return out
+
+
+def annotation(fragment: dict, defs: dict | None = None):
+    """The pydantic type of a JSON-schema fragment (a structured Setting's ``shape``): arrays,
+    numbers, integers, enums, objects and references to the schema's $defs."""
+    if "$ref" in fragment:
+        return (defs or _defs())[fragment["$ref"].rsplit("/", 1)[1]]
+    kind = fragment.get("type")
+    if "enum" in fragment:
+        return Literal[tuple(fragment["enum"])]
+    if kind in ("number", "integer"):
+        return _number(fragment, kind == "integer")
+    if kind == "boolean":
+        return StrictBool
+    if kind == "string":
+        return str
+    if kind == "array":
+        item = annotation(fragment["items"], defs) if "items" in fragment else Any
+        length = {"min_length": fragment.get("minItems"), "max_length": fragment.get("maxItems")}
+        checks = [AfterValidator(_unique)] if fragment.get("uniqueItems") else []
+        return Annotated[list[item], Field(**{k: v for k, v in length.items() if v is not None}), *checks]
+    if kind == "object" and "properties" not in fragment:
+        return dict
+    if kind == "object":  # a mapping of declared keys, kept a plain dict (its consumer parses it further)
+        required = set(fragment.get("required", ()))
+        fields = {
+            k: (annotation(v, defs), ...) if k in required else (annotation(v, defs) | None, None)
+            for k, v in fragment["properties"].items()
+        }
+        model = create_model("Shape", __base__=_OneOf, **fields)
+        model.one_of = tuple(r["required"][0] for r in fragment.get("oneOf", []))
+        return Annotated[model, AfterValidator(lambda m: m.model_dump(exclude_unset=True))]
+    raise ValueError(f"no pydantic type for the shape {fragment}")
+
+
+def annotation_of(s: Setting):
+    """The pydantic type of one setting (without its default)."""
+    if s.kind == "shape":
+        return annotation(s.shape)
+    if s.choices is not None:
+        return Literal[s.choices]
+    if s.kind == "boolean":
+        return StrictBool
+    bounds = {} if s.low is None or s.low == -math.inf else {"gt" if s.open_low else "ge": s.low}
+    if s.high != math.inf:
+        bounds["le"] = s.high
+    base = StrictInt if s.kind == "integer" else float
+    number = Annotated[base, Field(strict=True, **bounds)]
+    if s.none:  # the word none (None), as truncation takes it
+        return Annotated[Literal[NONE] | number, AfterValidator(from_text)]
+    return number
+
+
+# Run settings a config must give, though they have defaults (core/run_settings.py declares no
+# `required`: the simulations' code hash covers that module, so it is said here, once)
+REQUIRED_RUN_SETTINGS = ("physics.D", "physics.t_final", "physics.omega", "physics.fd_length", "time.dt0", "time.fd_dt")
+
+
+def required(s: Setting) -> bool:
+    return s.required or s.key in REQUIRED_RUN_SETTINGS
+
+
+def field(s: Setting, defs: dict | None = None) -> tuple:
+    """(type, Field) of one setting in its section's model: default (a required key's is only
+    documented: the config must give it), description, unit."""
+    kind = annotation(s.shape, defs) if s.kind == "shape" else annotation_of(s)
+    info = {"description": description(s), "json_schema_extra": {"unit": s.unit}}
+    if required(s):
+        if s.has_default:
+            info["json_schema_extra"]["default"] = s.default
+        return kind, Field(..., **info)
+    if s.has_default:
+        return kind, Field(s.default, **info)
+    return kind | None, Field(None, **info)
+
+
+def section(name: str, settings, doc: str, parent=Section, defs: dict | None = None, **extra):
+    """The model of a section: a field per setting directly in it (``settings`` keys below
+    ``<key>.``: their last part), and ``extra`` fields (nested sections)."""
+    fields = {s.name: field(s, defs) for s in settings}
+    return create_model(name, __base__=parent, __doc__=doc, **fields, **extra)
+
+
+def _in(prefix: str, settings) -> tuple:
+    return tuple(s for s in settings if s.section == prefix)
+
+
+# ------------------------------------------------------------------------------ the sections
+class _Search(Section):
+    @model_validator(mode="after")
+    def _budget_and_range(self):
+        if self.budget_runs is None and self.budget_core_s is None:
+            raise PydanticCustomError("missing_one_of", "a budget: budget_runs, budget_core_s or both")
+        if (self.n_range is None) == (self.growth_range is None):
+            raise PydanticCustomError("missing_one_of", "exactly one of n_range and growth_range")
+        return self
+
+
+class _Claims(Section):
+    @model_validator(mode="after")
+    def _ranges(self):
+        for key, value in self:
+            if isinstance(value, list) and value[0] > value[1]:
+                raise PydanticCustomError("range_order", "a range [low, high] with low <= high", {"key": key})
+        return self
+
+
+Physics = section("Physics", _in("physics", SETTINGS), "The 1-D diffusion problem shared by all figures.")
+Time = section("Time", _in("time", SETTINGS), "Time stepping.")
+Numerics = section(
+    "Numerics",
+    _in("numerics", SETTINGS),
+    "How the mass-transfer Gauss transforms are computed (results agree to the tolerance).",
+)
+CaseDefaults = section(
+    "CaseDefaults",
+    _in("case_defaults", SETTINGS),
+    "Defaults for every case that does not set its own (dimensions that apply to its method).",
+)
+SeedBlocks = section("SeedBlocks", _in("seed_blocks", SEEDS), SECTION_DOCS["seed_blocks"])
+RealisationsEntry = section("RealisationsEntry", REALISATIONS_ENTRY, SECTION_DOCS["realisations[]"])
+Claims = section("Claims", CLAIMS, SECTION_DOCS["claims"], parent=_Claims)
+Shear = section("Shear", SHEAR, SECTION_DOCS["shear"])
+Search = section("Search", SEARCH, SECTION_DOCS["optimum.<name>"], parent=_Search)
+
+
+def case_section_model():
+    return _defs()["case_section"]
+
+
+CaseSection = case_section_model()
+Fig9 = section("Fig9", FIGURE_OPTIONS, SECTION_DOCS["<section>"], parent=CaseSection)
+Figures = create_model(
+    "Figures",
+    __base__=Section,
+    __doc__=SECTION_DOCS["figures"],
+    **{fig: ((Fig9 if fig == "fig9" else CaseSection) | None, None) for fig in PAPER_FIGURES},
+)
+Tradeoff = section("Tradeoff", TRADEOFF, SECTION_DOCS["tradeoff"], parent=CaseSection)
+Lattice = section("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"])
+FdDomain = section("FdDomain", _in("mechanism.fd_domain", MECHANISM), SECTION_DOCS["mechanism.fd_domain"])
+Mechanism = section(
+    "Mechanism",
+    _in("mechanism", MECHANISM),
+    SECTION_DOCS["mechanism"],
+    lattice=(Lattice | None, None),
+    fd_domain=(FdDomain | None, None),
+)
+Target = section("Target", _in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
+_SCENE_KEYS = _in("scenes.<name>", SCENE)
+Scene = section("Scene", _SCENE_KEYS, SECTION_DOCS["scenes.<name>"], target=(Target, ...))
+SceneBase = section(
+    "SceneBase", [s for s in _SCENE_KEYS if s.name != "v"], SECTION_DOCS["scenes.<name>"], target=(Target, ...)
+)
+ScenesPeclet = section(
+    "ScenesPeclet", [s for s in SCENES_PECLET if s.name != "base"], SECTION_DOCS["scenes_peclet"], base=(SceneBase, ...)
+)
+Name = Annotated[str, Field(pattern=NAME_PATTERN)]
+
+
+class _Config(Section):
+    @model_validator(mode="after")
+    def _each_n_once(self):
+        seen: dict[int, int] = {}
+        for i, entry in enumerate(self.realisations):
+            if entry.n in seen:
+                raise PydanticCustomError(
+                    "each_once", "each N once (also at realisations[{first}])", {"index": i, "first": seen[entry.n]}
+                )
+            seen[entry.n] = i
+        return self
+
+
+Config = section(
+    "Config",
+    (*SEEDS[:1], *COMIC_TIMES),
+    "Configuration of the particle-entropy workflow (Benson et al. 2020 reproduction).",
+    parent=_Config,
+    physics=(Physics, ...),
+    time=(Time, ...),
+    numerics=(Numerics, Field(default_factory=Numerics)),
+    seed_blocks=(SeedBlocks, ...),
+    realisations=(
+        list[RealisationsEntry],
+        Field(..., description="Realisations per N for figures with realisations set to ensemble."),
+    ),
+    case_defaults=(CaseDefaults, Field(default_factory=CaseDefaults)),
+    figures=(Figures, ...),
+    tradeoff=(Tradeoff | None, None),
+    mechanism=(Mechanism | None, None),
+    claims=(Claims, ...),
+    shear=(Shear | None, None),
+    optimum=(dict[Name, Search], Field(default_factory=dict, description=SECTION_DOCS["optimum"])),
+    scenes=(dict[Name, Scene], Field(default_factory=dict, description=SECTION_DOCS["scenes"])),
+    scenes_peclet=(ScenesPeclet | None, None),
+)
