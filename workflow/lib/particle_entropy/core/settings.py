@@ -11,9 +11,10 @@ claims' tolerances (``CLAIMS``), the trade-off sweep (``TRADEOFF``), the mechani
 (``MECHANISM``) and an adaptive search (``SEARCH``), with the caps
 they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``MAX_N``, ``SHEAR_MAX_N``). From them come the paper's
 defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
-checks, the CLI's options (cli.py), the schema's blocks, which
-``python -m particle_entropy.pipeline.schemagen --write`` writes into
-workflow/schemas/config.schema.yaml (tests/test_settings.py fails when the file is stale), and
+checks, the CLI's options (cli.py), the typed config that ``configcheck.validate_config``
+returns (pipeline/config.py: a pydantic model per section, derived from these tuples), the whole
+schema workflow/schemas/config.schema.yaml, which ``python -m particle_entropy.pipeline.schemagen
+--write`` writes from those models (tests/test_settings.py fails when the file is stale), and
 the column page's descriptions of settings written beside results. Cross-field rules (a strip
 inside its domain, a search's budget of at least one round) are checked where the fields meet;
 their range is then given in words (``range_text``).

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import functools
 import math
+from types import SimpleNamespace
 from typing import Annotated, Any, ClassVar, Literal
 
 from pydantic import (
@@ -43,12 +44,14 @@ from pydantic_core import PydanticCustomError
 from ..core.case import NONE, from_text
 from ..core.registry import ALL_KERNELS, METHODS, PRESETS
 from ..core.settings import (
+    BY_KEY,
     CASE_SECTION,
     CLAIMS,
     COMIC_TIMES,
     FIGURE_OPTIONS,
     MAX_REALISATIONS,
     MECHANISM,
+    REALISATIONS_DOC,
     REALISATIONS_ENTRY,
     SCENE,
     SCENES_PECLET,
@@ -62,7 +65,8 @@ from ..core.settings import (
 )
 from ..figures import PAPER_FIGURES
 
-NAME_PATTERN = r"^[A-Za-z0-9_]+\z"  # a search's or a scene's key: letters, digits, _ (no final newline)
+NAME_PATTERN = r"^[A-Za-z0-9_]+(?![\s\S])"  # a search's or a scene's key: letters, digits, _ (`$` also
+# matches before a final newline: (?![\s\S]) is the very end)
 
 
 def description(s: Setting) -> str:
@@ -104,38 +108,11 @@ def _number(fragment: dict, integer: bool):
     return Annotated[StrictInt if integer else float, Field(strict=True, **bounds)]
 
 
-@functools.cache
-def _defs() -> dict:
-    """The referenced shapes ($defs of the schema) as pydantic types."""
-    dims = {s.name: (annotation_of(s), description(s)) for s in SETTINGS if s.section == "case_defaults"}
-    case = create_model(
-        "CaseSpec",
-        __base__=Section,
-        __doc__="One model: method, kernel and the dimensions that differ from case_defaults.",
-        method=(Literal[METHODS], ...),
-        kernel=(Literal[ALL_KERNELS], ...),
-        preset=(Literal[tuple(PRESETS)] | None, None),
-        **{name: (kind | None, Field(None, description=text)) for name, (kind, text) in dims.items()},
-    )
-    realisations = Annotated[StrictInt, Field(ge=1, le=MAX_REALISATIONS)] | Literal["ensemble"]
-    out = {
-        "method": Literal[METHODS],
-        "kernel": Literal[ALL_KERNELS],
-        **{name: kind for name, (kind, _) in dims.items()},
-        "case": case,
-        "cases": Annotated[list[case], Field(min_length=1)],
-        "ns": Annotated[list[Annotated[StrictInt, Field(ge=2)]], Field(min_length=1)],
-        "realisations": realisations,
-    }
-    out["case_section"] = section("CaseSection", CASE_SECTION, SECTION_DOCS["<section>"], defs=out)
-    return out
-
-
 def annotation(fragment: dict, defs: dict | None = None):
     """The pydantic type of a JSON-schema fragment (a structured Setting's ``shape``): arrays,
     numbers, integers, enums, objects and references to the schema's $defs."""
     if "$ref" in fragment:
-        return (defs or _defs())[fragment["$ref"].rsplit("/", 1)[1]]
+        return (defs or build().defs)[fragment["$ref"].rsplit("/", 1)[1]]
     kind = fragment.get("type")
     if "enum" in fragment:
         return Literal[tuple(fragment["enum"])]
@@ -196,6 +173,8 @@ def field(s: Setting, defs: dict | None = None) -> tuple:
     documented: the config must give it), description, unit."""
     kind = annotation(s.shape, defs) if s.kind == "shape" else annotation_of(s)
     info = {"description": description(s), "json_schema_extra": {"unit": s.unit}}
+    if s.kind == "shape" and "$ref" in s.shape:  # a shared definition: the schema refers to it
+        info["json_schema_extra"]["ref"] = s.shape["$ref"]
     if required(s):
         if s.has_default:
             info["json_schema_extra"]["default"] = s.default
@@ -209,7 +188,8 @@ def section(name: str, settings, doc: str, parent=Section, defs: dict | None = N
     """The model of a section: a field per setting directly in it (``settings`` keys below
     ``<key>.``: their last part), and ``extra`` fields (nested sections)."""
     fields = {s.name: field(s, defs) for s in settings}
-    return create_model(name, __base__=parent, __doc__=doc, **fields, **extra)
+    fields.update(extra)  # a nested section, or a setting's own model in its place
+    return create_model(name, __base__=parent, __doc__=doc, **fields)
 
 
 def _in(prefix: str, settings) -> tuple:
@@ -218,6 +198,16 @@ def _in(prefix: str, settings) -> tuple:
 
 # ------------------------------------------------------------------------------ the sections
 class _Search(Section):
+    # the schema's spelling of this validator (JSON schema can say these two rules)
+    model_config = ConfigDict(
+        json_schema_extra={
+            "allOf": [
+                {"anyOf": [{"required": ["budget_runs"]}, {"required": ["budget_core_s"]}]},
+                {"oneOf": [{"required": ["n_range"]}, {"required": ["growth_range"]}]},
+            ]
+        }
+    )
+
     @model_validator(mode="after")
     def _budget_and_range(self):
         if self.budget_runs is None and self.budget_core_s is None:
@@ -236,60 +226,9 @@ class _Claims(Section):
         return self
 
 
-Physics = section("Physics", _in("physics", SETTINGS), "The 1-D diffusion problem shared by all figures.")
-Time = section("Time", _in("time", SETTINGS), "Time stepping.")
-Numerics = section(
-    "Numerics",
-    _in("numerics", SETTINGS),
-    "How the mass-transfer Gauss transforms are computed (results agree to the tolerance).",
-)
-CaseDefaults = section(
-    "CaseDefaults",
-    _in("case_defaults", SETTINGS),
-    "Defaults for every case that does not set its own (dimensions that apply to its method).",
-)
-SeedBlocks = section("SeedBlocks", _in("seed_blocks", SEEDS), SECTION_DOCS["seed_blocks"])
-RealisationsEntry = section("RealisationsEntry", REALISATIONS_ENTRY, SECTION_DOCS["realisations[]"])
-Claims = section("Claims", CLAIMS, SECTION_DOCS["claims"], parent=_Claims)
-Shear = section("Shear", SHEAR, SECTION_DOCS["shear"])
-Search = section("Search", SEARCH, SECTION_DOCS["optimum.<name>"], parent=_Search)
-
-
-def case_section_model():
-    return _defs()["case_section"]
-
-
-CaseSection = case_section_model()
-Fig9 = section("Fig9", FIGURE_OPTIONS, SECTION_DOCS["<section>"], parent=CaseSection)
-Figures = create_model(
-    "Figures",
-    __base__=Section,
-    __doc__=SECTION_DOCS["figures"],
-    **{fig: ((Fig9 if fig == "fig9" else CaseSection) | None, None) for fig in PAPER_FIGURES},
-)
-Tradeoff = section("Tradeoff", TRADEOFF, SECTION_DOCS["tradeoff"], parent=CaseSection)
-Lattice = section("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"])
-FdDomain = section("FdDomain", _in("mechanism.fd_domain", MECHANISM), SECTION_DOCS["mechanism.fd_domain"])
-Mechanism = section(
-    "Mechanism",
-    _in("mechanism", MECHANISM),
-    SECTION_DOCS["mechanism"],
-    lattice=(Lattice | None, None),
-    fd_domain=(FdDomain | None, None),
-)
-Target = section("Target", _in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
-_SCENE_KEYS = _in("scenes.<name>", SCENE)
-Scene = section("Scene", _SCENE_KEYS, SECTION_DOCS["scenes.<name>"], target=(Target, ...))
-SceneBase = section(
-    "SceneBase", [s for s in _SCENE_KEYS if s.name != "v"], SECTION_DOCS["scenes.<name>"], target=(Target, ...)
-)
-ScenesPeclet = section(
-    "ScenesPeclet", [s for s in SCENES_PECLET if s.name != "base"], SECTION_DOCS["scenes_peclet"], base=(SceneBase, ...)
-)
-Name = Annotated[str, Field(pattern=NAME_PATTERN)]
-
-
 class _Config(Section):
+    model_config = ConfigDict(regex_engine="python-re")  # NAME_PATTERN's look-ahead
+
     @model_validator(mode="after")
     def _each_n_once(self):
         seen: dict[int, int] = {}
@@ -302,26 +241,128 @@ class _Config(Section):
         return self
 
 
-Config = section(
-    "Config",
-    (*SEEDS[:1], *COMIC_TIMES),
-    "Configuration of the particle-entropy workflow (Benson et al. 2020 reproduction).",
-    parent=_Config,
-    physics=(Physics, ...),
-    time=(Time, ...),
-    numerics=(Numerics, Field(default_factory=Numerics)),
-    seed_blocks=(SeedBlocks, ...),
-    realisations=(
-        list[RealisationsEntry],
-        Field(..., description="Realisations per N for figures with realisations set to ensemble."),
-    ),
-    case_defaults=(CaseDefaults, Field(default_factory=CaseDefaults)),
-    figures=(Figures, ...),
-    tradeoff=(Tradeoff | None, None),
-    mechanism=(Mechanism | None, None),
-    claims=(Claims, ...),
-    shear=(Shear | None, None),
-    optimum=(dict[Name, Search], Field(default_factory=dict, description=SECTION_DOCS["optimum"])),
-    scenes=(dict[Name, Scene], Field(default_factory=dict, description=SECTION_DOCS["scenes"])),
-    scenes_peclet=(ScenesPeclet | None, None),
-)
+# what the schema's shared definitions ($defs) mean where no setting declares them
+DEF_DOCS = {
+    "method": "pt, mtpt or fd (registry.METHODS).",
+    "kernel": "The method's kernel (registry.KERNELS).",
+    "preset": "Named case dimensions (registry.PRESETS; a dimension the case sets wins): "
+    + "; ".join(
+        f"{k}: {', '.join(f'{d} {v:g}' if isinstance(v, float) else f'{d} {v}' for d, v in dims.items())}"
+        for k, dims in PRESETS.items()
+    )
+    + ".",
+    "cases": "Model settings drawn in the figure; unset dimensions come from case_defaults.",
+    "ns": "Particle numbers (FD intervals), each >= 2 (case.N_MIN; one particle scores a perfect COMIC -inf).",
+    "realisations": f"Realisations per N, {REALISATIONS_DOC}.",
+}
+
+
+@functools.cache
+def build(settings: tuple = SETTINGS) -> SimpleNamespace:
+    """Every section's model, from the run settings ``settings`` (settings.SETTINGS) and the other
+    sections' declarations; the shared definitions (``defs``: a case's dimensions, a case, a list
+    of cases, of N, a section of cases) by name, as the schema's $defs names them."""
+    m = SimpleNamespace()
+    dims = {s.name: (annotation_of(s), description(s)) for s in settings if s.section == "case_defaults"}
+    case = create_model(
+        "CaseSpec",
+        __base__=Section,
+        __doc__=f"One model: method and kernel, and the dimensions {', '.join(dims)} that apply to it "
+        "(unset ones come from case_defaults).",
+        method=(Literal[METHODS], ...),
+        kernel=(Literal[ALL_KERNELS], ...),
+        preset=(Literal[tuple(PRESETS)] | None, None),
+        **{name: (kind | None, Field(None, description=text)) for name, (kind, text) in dims.items()},
+    )
+    m.defs = defs = {
+        "method": Literal[METHODS],
+        "kernel": Literal[ALL_KERNELS],
+        "preset": Literal[tuple(PRESETS)],
+        **{name: kind for name, (kind, _) in dims.items()},
+        "case": case,
+        "cases": Annotated[list[case], Field(min_length=1)],
+        "ns": Annotated[list[Annotated[StrictInt, Field(ge=2)]], Field(min_length=1)],
+        "realisations": Annotated[StrictInt, Field(ge=1, le=MAX_REALISATIONS)] | Literal["ensemble"],
+    }
+    defs["case_section"] = m.CaseSection = section("CaseSection", CASE_SECTION, SECTION_DOCS["<section>"], defs=defs)
+
+    def of(name: str, keys, doc: str, parent=Section, **extra):
+        return section(name, keys, doc, parent=parent, defs=defs, **extra)
+
+    m.Physics = of("Physics", _in("physics", settings), "The 1-D diffusion problem shared by all figures.")
+    m.Time = of("Time", _in("time", settings), "Time stepping.")
+    m.Numerics = of(
+        "Numerics",
+        _in("numerics", settings),
+        "How the mass-transfer Gauss transforms are computed (results agree to the tolerance).",
+    )
+    m.CaseDefaults = of(
+        "CaseDefaults",
+        _in("case_defaults", settings),
+        "Defaults for every case that does not set its own (dimensions that apply to its method).",
+    )
+    m.SeedBlocks = of("SeedBlocks", _in("seed_blocks", SEEDS), SECTION_DOCS["seed_blocks"])
+    m.RealisationsEntry = of("RealisationsEntry", REALISATIONS_ENTRY, SECTION_DOCS["realisations[]"])
+    m.Claims = of("Claims", CLAIMS, SECTION_DOCS["claims"], parent=_Claims)
+    m.Shear = of("Shear", SHEAR, SECTION_DOCS["shear"])
+    m.Search = of("Search", SEARCH, SECTION_DOCS["optimum.<name>"], parent=_Search)
+    m.Fig9 = of("Fig9", FIGURE_OPTIONS, SECTION_DOCS["<section>"], parent=m.CaseSection)
+    m.Figures = create_model(
+        "Figures",
+        __base__=Section,
+        __doc__=SECTION_DOCS["figures"],
+        **{fig: ((m.Fig9 if fig == "fig9" else m.CaseSection) | None, None) for fig in PAPER_FIGURES},
+    )
+    m.Tradeoff = of("Tradeoff", TRADEOFF, SECTION_DOCS["tradeoff"], parent=m.CaseSection)
+    m.Lattice = of("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"])
+    m.FdDomain = of("FdDomain", _in("mechanism.fd_domain", MECHANISM), SECTION_DOCS["mechanism.fd_domain"])
+    m.Mechanism = of(
+        "Mechanism",
+        _in("mechanism", MECHANISM),
+        SECTION_DOCS["mechanism"],
+        lattice=(m.Lattice | None, None),
+        fd_domain=(m.FdDomain | None, None),
+    )
+    m.Target = of("Target", _in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
+    scene = _in("scenes.<name>", SCENE)
+    m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], target=(m.Target | None, None))
+    base = BY_KEY["scenes_peclet.base"]
+    m.SceneBase = of(
+        "SceneBase", [s for s in scene if s.name != "v"], description(base), target=(m.Target | None, None)
+    )
+    m.ScenesPeclet = of(
+        "ScenesPeclet",
+        SCENES_PECLET,
+        SECTION_DOCS["scenes_peclet"],
+        base=(m.SceneBase, Field(..., description=description(base))),
+    )
+    name = Annotated[str, Field(pattern=NAME_PATTERN)]
+    m.Config = create_model(
+        "Config",
+        __base__=_Config,
+        __doc__="Configuration of the particle-entropy workflow (Benson et al. 2020 reproduction).",
+        physics=(m.Physics, ...),
+        time=(m.Time, ...),
+        numerics=(m.Numerics, Field(default_factory=m.Numerics, json_schema_extra={"default": {}})),
+        base_seed=field(SEEDS[0]),
+        seed_blocks=(m.SeedBlocks, ...),
+        realisations=(
+            list[m.RealisationsEntry],
+            Field(..., description="Realisations per N for figures with realisations set to ensemble."),
+        ),
+        case_defaults=(m.CaseDefaults, Field(default_factory=m.CaseDefaults)),
+        figures=(m.Figures, ...),
+        tradeoff=(m.Tradeoff | None, None),
+        mechanism=(m.Mechanism | None, None),
+        comic_times=field(COMIC_TIMES[0]),
+        claims=(m.Claims, ...),
+        shear=(m.Shear | None, None),
+        optimum=(dict[name, m.Search], Field(default_factory=dict, description=SECTION_DOCS["optimum"])),
+        scenes=(dict[name, m.Scene], Field(default_factory=dict, description=SECTION_DOCS["scenes"])),
+        scenes_peclet=(m.ScenesPeclet | None, None),
+    )
+    return m
+
+
+_MODELS = build()
+Config = _MODELS.Config  # the whole config; its sections' models: build()
