@@ -240,6 +240,20 @@ class _Config(Section):
             seen[entry.n] = i
         return self
 
+    @model_validator(mode="after")
+    def _times_within_t_final(self):
+        t_final = self.physics.t_final
+        times = [("comic_times", self.comic_times), ("tradeoff.times", self.tradeoff.times if self.tradeoff else [])]
+        for key, values in times:
+            for i, t in enumerate(values):
+                if not 0 <= t <= t_final:
+                    raise PydanticCustomError(
+                        "time_range",
+                        "a time in [0, physics.t_final = {t_final:g}]",
+                        {"key": key, "index": i, "t_final": t_final},
+                    )
+        return self
+
 
 # what the schema's shared definitions ($defs) mean where no setting declares them
 DEF_DOCS = {

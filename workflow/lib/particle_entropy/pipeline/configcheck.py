@@ -497,6 +497,9 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
         return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
     if kind == "each_once":
         return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
+    if kind == "time_range":  # key, its i-th time as written
+        written = _located(tuple(ctx["key"].split(".")), config, Config)[1][ctx["index"]]
+        return SettingError(ctx["key"], written, first["msg"])
     if kind == "range_order":
         return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
     if kind in ("one_of", "missing_one_of"):
@@ -513,22 +516,31 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
     return SettingError(key_path(path), _short(value), allowed)
 
 
-def validate_config(config: Mapping):
-    """The merged config validated once and returned typed (pipeline.config.Config): each section
-    by its model (types, ranges, required and unknown keys, a section's own cross-field rules),
-    then the rules between sections and runs (crosschecks.check_sweeps). SettingError names the
-    key path, the value and the allowed range, as the schema's check did; its message is bounded."""
+def parse(config: Mapping):
+    """The config as its typed form (pipeline.config.Config): each section by its model (types,
+    ranges, required and unknown keys, the rules within a section and between the times and
+    t_final); SettingError names the key path, the value and the allowed range, as the schema's
+    check did. Only parses: validate_config also checks the runs the config plans."""
     from pydantic import ValidationError
 
     from .config import Config
-    from .crosschecks import check_sweeps
 
     try:
-        typed = Config.model_validate(dict(config))
+        return Config.model_validate(dict(config))
     except ValidationError as e:
         raise bounded(_pydantic_error_to_setting(e, config)) from None
+
+
+def validate_config(config: Mapping):
+    """The merged config validated once and returned typed (pipeline.config.Config): parsed by its
+    section models (parse), then the rules between sections and runs (crosschecks.check_sweeps)
+    checked on it. SettingError names the key path, the value and the allowed range; its message
+    is bounded."""
+    from .crosschecks import check_sweeps
+
+    typed = parse(config)
     try:
-        check_sweeps(config)
+        check_sweeps(config, typed)
     except SettingError as e:
         raise bounded(e) from None
     return typed
@@ -553,7 +565,7 @@ def check_config(
     typed = validate_config(config)
     try:
         if available is not None:
-            check_memory(config, available)
+            check_memory(config, available, typed)
     except SettingError as e:
         raise bounded(e) from None
 
