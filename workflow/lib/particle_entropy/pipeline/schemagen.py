@@ -231,30 +231,82 @@ def _lines(block: dict, indent: str = "") -> list[str]:
     return out
 
 
+def _cell(value) -> str:
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def docs(settings: tuple = SETTINGS) -> str:
+    """docs/config.md: a table per section (each model once, at the first key it sits at) of its
+    keys, defaults, units and meanings with their allowed values."""
+    m = typed.build(settings)
+    names = {id(t): f"$defs.{n}" for n, t in m.defs.items()}
+    out = [
+        "# Config settings\n\n",
+        f"Generated from the typed config (pipeline/config.py, declared in core/settings.py) by `{COMMAND}`;\n",
+        "do not edit. `workflow/schemas/config.schema.yaml` is generated from the same models.\n",
+    ]
+    seen, todo = set(), [("config", m.Config)]
+    while todo:
+        path, model = todo.pop(0)
+        if id(model) in seen:
+            continue
+        seen.add(id(model))
+        out += [f"\n## `{names.get(id(model), path)}`\n\n{_doc(model)}\n\n"]
+        out += ["| key | default | unit | meaning; allowed values |\n", "|---|---|---|---|\n"]
+        nested = []
+        for name, info in model.model_fields.items():
+            tp = info.annotation
+            inner = typing.get_args(tp)[1] if typing.get_origin(tp) is dict else tp
+            inner = typing.get_args(inner)[0] if typing.get_origin(inner) is list else inner
+            models = [t for t in _members(inner) if _is_model(t) and not issubclass(t, typed._OneOf)]
+            where = f"{path}.{name}" if path != "config" else name
+            if models:
+                key = where + (".<name>" if typing.get_origin(tp) is dict else "[]" if inner is not tp else "")
+                nested.append((key, models[0]))
+                shown = names.get(id(models[0]), key)
+                out.append(
+                    f"| `{name}` | | | section `{shown}`{': ' + info.description if info.description else ''} |\n"
+                )
+                continue
+            extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+            default = extra.get("default", info.default)
+            default = "" if default is None or repr(default) == "PydanticUndefined" else f"`{_yaml(default)}`"
+            if info.is_required():
+                default = (default + " " if default else "") + "(required)"
+            unit = "" if extra.get("unit", "-") == "-" else extra["unit"]
+            out.append(f"| `{name}` | {_cell(default)} | {_cell(unit)} | {_cell(info.description or '')} |\n")
+        todo += nested
+    return "".join(out)
+
+
 def render(text: str = "") -> str:
     """The schema's text, written afresh from the models (``text``, the file as it stands, is not
     read: nothing in it is kept)."""
     return HEADER + "".join(_lines(Writer(SETTINGS).schema()))
 
 
+DOCS_PATH = SCHEMA_PATH.parents[2] / "docs" / "config.md"
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m particle_entropy.pipeline.schemagen", description=__doc__)
-    p.add_argument("--check", action="store_true", help="exit 1 when the schema file is stale")
-    p.add_argument("--write", action="store_true", help="rewrite the schema file")
+    p.add_argument("--check", action="store_true", help="exit 1 when the schema file or the docs table is stale")
+    p.add_argument("--write", action="store_true", help="rewrite the schema file and the docs table")
     p.add_argument("--schema", default=str(SCHEMA_PATH), help="schema file (default: the workflow's)")
+    p.add_argument("--docs", default=str(DOCS_PATH), help="docs table of the settings (default: docs/config.md)")
     a = p.parse_args(argv)
-    path = Path(a.schema)
-    text = path.read_text(encoding="utf-8") if path.exists() else ""
-    new = render(text)
-    if a.write:
-        if new != text:
+    stale = []
+    for path, new in ((Path(a.schema), render()), (Path(a.docs), docs())):
+        text = path.read_text(encoding="utf-8") if path.exists() else ""
+        if a.write and new != text:
             path.write_text(new, encoding="utf-8")
-        return 0
-    if a.check and new != text:
-        print(f"{path}: the schema is stale; run `{COMMAND}`", file=sys.stderr)
+        elif new != text:
+            stale.append(path)
+        if not (a.write or a.check) and path == Path(a.schema):
+            sys.stdout.write(new)
+    if a.check and stale:
+        print(f"{', '.join(map(str, stale))}: stale; run `{COMMAND}`", file=sys.stderr)
         return 1
-    if not a.check:
-        sys.stdout.write(new)
     return 0
 
 
