@@ -19,7 +19,10 @@ alone are model validators here (a search's budget and range, a claim's [low, hi
 the ``realisations`` table once); the rules that need several sections or a run (a case that
 builds, a time within t_final, memory) stay in pipeline/crosschecks.py.
 
-``Config`` is what ``configcheck.validate_config`` returns: the merged config, parsed once.
+``Config`` is what ``configcheck.validate_config`` returns: the merged config, parsed once. A key
+the config may leave out and that has no default (a section, a search's ``n``) is None in it; an
+explicit null is refused, as the schema refuses it (such fields are typed ``X`` with default None,
+not ``X | None``).
 """
 
 from __future__ import annotations
@@ -108,6 +111,12 @@ def _number(fragment: dict, integer: bool):
     return Annotated[StrictInt if integer else float, Field(strict=True, **bounds)]
 
 
+def _ref_of(fragment: dict) -> dict:
+    """The schema's reference of a value whose type is a shared definition (pydantic folds an
+    Annotated type into its field, so the schema could not tell it from its own entry)."""
+    return {"ref": fragment["$ref"]} if "$ref" in fragment else {}
+
+
 def annotation(fragment: dict, defs: dict | None = None):
     """The pydantic type of a JSON-schema fragment (a structured Setting's ``shape``): arrays,
     numbers, integers, enums, objects and references to the schema's $defs."""
@@ -132,7 +141,7 @@ def annotation(fragment: dict, defs: dict | None = None):
     if kind == "object":  # a mapping of declared keys, kept a plain dict (its consumer parses it further)
         required = set(fragment.get("required", ()))
         fields = {
-            k: (annotation(v, defs), ...) if k in required else (annotation(v, defs) | None, None)
+            k: (annotation(v, defs), Field(... if k in required else None, json_schema_extra=_ref_of(v)))
             for k, v in fragment["properties"].items()
         }
         model = create_model("Shape", __base__=_OneOf, **fields)
@@ -181,7 +190,7 @@ def field(s: Setting, defs: dict | None = None) -> tuple:
         return kind, Field(..., **info)
     if s.has_default:
         return kind, Field(s.default, **info)
-    return kind | None, Field(None, **info)
+    return kind, Field(None, **info)  # absent: None (null itself is refused)
 
 
 def section(name: str, settings, doc: str, parent=Section, defs: dict | None = None, **extra):
@@ -249,8 +258,8 @@ class _Config(Section):
                 if not 0 <= t <= t_final:
                     raise PydanticCustomError(
                         "time_range",
-                        "a time in [0, physics.t_final = {t_final:g}]",
-                        {"key": key, "index": i, "t_final": t_final},
+                        "a time in [0, physics.t_final = {t_final}]",
+                        {"key": key, "index": i, "t_final": f"{t_final:g}"},
                     )
         return self
 
@@ -283,10 +292,13 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         __base__=Section,
         __doc__=f"One model: method and kernel, and the dimensions {', '.join(dims)} that apply to it "
         "(unset ones come from case_defaults).",
-        method=(Literal[METHODS], ...),
-        kernel=(Literal[ALL_KERNELS], ...),
-        preset=(Literal[tuple(PRESETS)] | None, None),
-        **{name: (kind | None, Field(None, description=text)) for name, (kind, text) in dims.items()},
+        method=(Literal[METHODS], Field(..., description=DEF_DOCS["method"])),
+        kernel=(Literal[ALL_KERNELS], Field(..., description=DEF_DOCS["kernel"])),
+        preset=(Literal[tuple(PRESETS)], Field(None, description=DEF_DOCS["preset"])),
+        **{
+            name: (kind, Field(None, description=text, json_schema_extra={"ref": f"#/$defs/{name}"}))
+            for name, (kind, text) in dims.items()
+        },
     )
     m.defs = defs = {
         "method": Literal[METHODS],
@@ -325,7 +337,7 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         "Figures",
         __base__=Section,
         __doc__=SECTION_DOCS["figures"],
-        **{fig: ((m.Fig9 if fig == "fig9" else m.CaseSection) | None, None) for fig in PAPER_FIGURES},
+        **{fig: ((m.Fig9 if fig == "fig9" else m.CaseSection), None) for fig in PAPER_FIGURES},
     )
     m.Tradeoff = of("Tradeoff", TRADEOFF, SECTION_DOCS["tradeoff"], parent=m.CaseSection)
     m.Lattice = of("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"])
@@ -334,16 +346,14 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         "Mechanism",
         _in("mechanism", MECHANISM),
         SECTION_DOCS["mechanism"],
-        lattice=(m.Lattice | None, None),
-        fd_domain=(m.FdDomain | None, None),
+        lattice=(m.Lattice, None),
+        fd_domain=(m.FdDomain, None),
     )
     m.Target = of("Target", _in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
     scene = _in("scenes.<name>", SCENE)
-    m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], target=(m.Target | None, None))
+    m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], target=(m.Target, None))
     base = BY_KEY["scenes_peclet.base"]
-    m.SceneBase = of(
-        "SceneBase", [s for s in scene if s.name != "v"], description(base), target=(m.Target | None, None)
-    )
+    m.SceneBase = of("SceneBase", [s for s in scene if s.name != "v"], description(base), target=(m.Target, None))
     m.ScenesPeclet = of(
         "ScenesPeclet",
         SCENES_PECLET,
@@ -366,14 +376,14 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         ),
         case_defaults=(m.CaseDefaults, Field(default_factory=m.CaseDefaults)),
         figures=(m.Figures, ...),
-        tradeoff=(m.Tradeoff | None, None),
-        mechanism=(m.Mechanism | None, None),
+        tradeoff=(m.Tradeoff, None),
+        mechanism=(m.Mechanism, None),
         comic_times=field(COMIC_TIMES[0]),
         claims=(m.Claims, ...),
-        shear=(m.Shear | None, None),
+        shear=(m.Shear, None),
         optimum=(dict[name, m.Search], Field(default_factory=dict, description=SECTION_DOCS["optimum"])),
         scenes=(dict[name, m.Scene], Field(default_factory=dict, description=SECTION_DOCS["scenes"])),
-        scenes_peclet=(m.ScenesPeclet | None, None),
+        scenes_peclet=(m.ScenesPeclet, None),
     )
     return m
 

@@ -413,24 +413,28 @@ _WORDS = {
     "literal_error": "{value!r} is not one of {expected}",
     "unique_items": "{value!r} has non-unique elements",
     "string_pattern_mismatch": "{value!r} does not match {pattern!r}",
+    "union": "{value!r} is not valid under any of the given schemas",
 }
 _MISSING = object()
 
 
-def _located(loc, config, model):
+def _located(loc, config, model, missing: bool = False):
     """Walk a pydantic error location through the raw ``config`` and the typed ``model``: the key
-    path (pydantic's tags of union members and validators left out), the raw value there, the
-    field there (its description) and the model holding it (its known keys)."""
+    path (pydantic's tags of union members and validators left out), the raw value there (as
+    written), the field there (its description) and the type there (its known keys). ``missing``:
+    the location's last key is one the config does not hold."""
     from pydantic import BaseModel
 
-    path, value, info, holder, kind = [], config, None, model, model
-    for part in loc:
-        step = None
-        if isinstance(value, Mapping) and isinstance(part, str) and (part in value or part not in ("[key]",)):
-            step = part
+    path, value, info, kind = [], config, None, model
+    for i, part in enumerate(loc):
+        if isinstance(value, Mapping) and isinstance(part, str):
+            absent = missing and i == len(loc) - 1
+            step = part if part in value or absent else None
         elif isinstance(value, list) and isinstance(part, int) and 0 <= part < len(value):
             step = part
-        if step is None:
+        else:
+            step = None
+        if step is None:  # a tag: a union's member, a validator
             continue
         path.append(step)
         value = value.get(step, _MISSING) if isinstance(value, Mapping) else value[step]
@@ -477,8 +481,11 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
 
     errors = error.errors()
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
-    path, value, info, holder = _located(first["loc"], config, Config)
     kind, ctx = first["type"], first.get("ctx", {})
+    path, value, info, _ = _located(first["loc"], config, Config, missing=kind == "missing")
+    members = [e for e in errors if _located(e["loc"], config, Config)[0] == path and e["loc"] != first["loc"]]
+    if members and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it
+        kind, ctx = "union", {}
     if kind == "extra_forbidden" or "[key]" in first["loc"]:
         parent = _located(first["loc"][:-1], config, Config)
         models = [t for t in _members(parent[3]) if hasattr(t, "model_fields")]
@@ -511,7 +518,7 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
     ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
     message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
     allowed = f"{described} ({message})" if described else message
-    if kind in ("int_type", "float_type", "literal_error"):
+    if kind in ("int_type", "float_type", "literal_error", "union"):
         allowed += _number_hint(value, {"type": "integer" if kind == "int_type" else "number"})
     return SettingError(key_path(path), _short(value), allowed)
 
