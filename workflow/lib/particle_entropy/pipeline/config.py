@@ -238,6 +238,16 @@ class _Claims(Section):
 class _Config(Section):
     model_config = ConfigDict(regex_engine="python-re")  # NAME_PATTERN's look-ahead
 
+    def case_sections(self) -> dict:
+        """Every section that lists cases, by its key: each figure, `tradeoff` and each sweep of
+        `mechanism` (as sweeps.case_sections names them)."""
+        out = {f"figures.{fig}": spec for fig, spec in self.figures if spec is not None}
+        if self.tradeoff is not None:
+            out["tradeoff"] = self.tradeoff
+        for i, spec in enumerate(self.mechanism.sweeps if self.mechanism else []):
+            out[f"mechanism.sweeps[{i}]"] = spec
+        return out
+
     @model_validator(mode="after")
     def _each_n_once(self):
         seen: dict[int, int] = {}

@@ -297,20 +297,21 @@ def check_sweeps(config: Mapping, typed: Config | None = None) -> None:
     message names the section, key and value."""
     check_finite(config)  # first: a config not yet parsed (common.smk) has its .nan named so
     cfg = typed or parse(config)
-    for name, spec in case_sections(config).items():
-        for i, c in enumerate(spec["cases"]):
+    defaults = cfg.case_defaults.model_dump()
+    for name, spec in cfg.case_sections().items():
+        for i, c in enumerate(spec.cases):
             where = f"{name}.cases[{i}]"
             case = None
             try:
-                for n in spec["n"]:
-                    case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
+                for n in spec.n:
+                    case = Case.from_spec(c.model_dump(exclude_unset=True), n, defaults)
                     run_config(case, config)
             except SettingError as e:
                 raise _case_error(e, where, case) from None  # a shared setting names its key and the case
-        particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
-        for n in spec["n"] if particles else []:
+        particles = any(c.method != "fd" for c in spec.cases)  # FD runs once whatever the ensemble
+        for n in spec.n if particles else []:
             try:
-                realisations_for(spec, int(n), config)
+                realisations_for(spec.model_dump(exclude_none=True), n, config)
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     check_lattice(config, cfg)
