@@ -64,6 +64,7 @@ from ..core.settings import (
     SETTINGS,
     SHEAR,
     TRADEOFF,
+    UNIQUE,
     Setting,
 )
 from ..figures import PAPER_FIGURES
@@ -97,12 +98,6 @@ class _OneOf(Section):
         return self
 
 
-def _unique(values: list) -> list:
-    if len(values) != len({repr(float(v)) if isinstance(v, (int, float)) else repr(v) for v in values}):
-        raise PydanticCustomError("unique_items", "has non-unique elements")
-    return values
-
-
 def _number(fragment: dict, integer: bool):
     bounds = {}
     for key, arg in (("minimum", "ge"), ("exclusiveMinimum", "gt"), ("maximum", "le")):
@@ -134,7 +129,7 @@ def annotation(fragment: dict, defs: dict | None = None):
     if kind == "array":
         item = annotation(fragment["items"], defs) if "items" in fragment else Any
         length = {"min_length": fragment.get("minItems"), "max_length": fragment.get("maxItems")}
-        checks = [AfterValidator(_unique)] if fragment.get("uniqueItems") else []
+        checks = [UNIQUE] if fragment.get("uniqueItems") else []
         return Annotated[list[item], Field(**{k: v for k, v in length.items() if v is not None}), *checks]
     if kind == "object" and "properties" not in fragment:
         return dict
@@ -150,10 +145,10 @@ def annotation(fragment: dict, defs: dict | None = None):
     raise ValueError(f"no pydantic type for the shape {fragment}")
 
 
-def annotation_of(s: Setting):
+def annotation_of(s: Setting, defs: dict | None = None):
     """The pydantic type of one setting (without its default)."""
     if s.kind == "shape":
-        return annotation(s.shape)
+        return annotation(s.shape, defs) if isinstance(s.shape, dict) else s.shape
     if s.choices is not None:
         return Literal[s.choices]
     if s.kind == "boolean":
@@ -180,9 +175,9 @@ def required(s: Setting) -> bool:
 def field(s: Setting, defs: dict | None = None) -> tuple:
     """(type, Field) of one setting in its section's model: default (a required key's is only
     documented: the config must give it), description, unit."""
-    kind = annotation(s.shape, defs) if s.kind == "shape" else annotation_of(s)
+    kind = annotation_of(s, defs)
     info = {"description": description(s), "json_schema_extra": {"unit": s.unit}}
-    if s.kind == "shape" and "$ref" in s.shape:  # a shared definition: the schema refers to it
+    if s.kind == "shape" and isinstance(s.shape, dict) and "$ref" in s.shape:  # the schema refers to it
         info["json_schema_extra"]["ref"] = s.shape["$ref"]
     if required(s):
         if s.has_default:

@@ -21,11 +21,11 @@ import typing
 from pathlib import Path
 
 import annotated_types as at
-from pydantic import AfterValidator, BaseModel, StrictBool, StrictInt
+from pydantic import BaseModel, StrictBool, StrictInt
 from pydantic.fields import FieldInfo
 
 from ..core.case import NONE
-from ..core.settings import SETTINGS
+from ..core.settings import SETTINGS, UNIQUE
 from . import config as typed
 from .configcheck import SCHEMA_PATH
 
@@ -73,7 +73,7 @@ def _constraints(metadata) -> dict:
             if type(m) in kinds:
                 key, attr = kinds[type(m)]
                 out[key] = _number(getattr(m, attr))
-        if isinstance(m, AfterValidator) and m.func is typed._unique:
+        if m is UNIQUE:
             out["uniqueItems"] = True
     return out
 
@@ -118,6 +118,9 @@ class Writer:
             return {"type": "boolean"}
         if tp is dict:
             return {"type": "object"}
+        if origin is dict:  # keys of an enum, each with a value of one type
+            keys = self.entry(args[0])
+            return {"type": "object", "propertyNames": keys, "additionalProperties": self.entry(args[1])}
         if isinstance(tp, type) and issubclass(tp, BaseModel):
             return self.body(tp, flow=True)
         raise TypeError(f"no schema entry for {tp!r}")
@@ -152,7 +155,7 @@ class Writer:
                     )
                 if info.description and nested[0].__doc__ != info.description:
                     props[name]["description"] = info.description
-            elif typing.get_origin(tp) is dict:
+            elif typing.get_origin(tp) is dict and _is_model(typing.get_args(tp)[1]):  # one per name
                 pattern = typing.get_args(typing.get_args(tp)[0])[1].metadata[0].pattern
                 value = typing.get_args(tp)[1]
                 props[name] = Block(
