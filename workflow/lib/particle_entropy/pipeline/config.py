@@ -107,9 +107,15 @@ def _number(fragment: dict, integer: bool):
 
 
 def _ref_of(fragment: dict) -> dict:
-    """The schema's reference of a value whose type is a shared definition (pydantic folds an
-    Annotated type into its field, so the schema could not tell it from its own entry)."""
-    return {"ref": fragment["$ref"]} if "$ref" in fragment else {}
+    """The Field of a key of a shape: a shared definition's reference (pydantic folds an
+    Annotated type into its field, so the schema could not tell it from its own entry) and
+    meaning."""
+    if "$ref" not in fragment:
+        return {}
+    name = fragment["$ref"].rsplit("/", 1)[1]
+    setting = BY_KEY.get(f"case_defaults.{name}")
+    text = description(setting) if setting is not None else DEF_DOCS.get(name)
+    return {"json_schema_extra": {"ref": fragment["$ref"]}, "description": text}
 
 
 def annotation(fragment: dict, defs: dict | None = None):
@@ -136,7 +142,7 @@ def annotation(fragment: dict, defs: dict | None = None):
     if kind == "object":  # a mapping of declared keys, kept a plain dict (its consumer parses it further)
         required = set(fragment.get("required", ()))
         fields = {
-            k: (annotation(v, defs), Field(... if k in required else None, json_schema_extra=_ref_of(v)))
+            k: (annotation(v, defs), Field(... if k in required else None, **_ref_of(v)))
             for k, v in fragment["properties"].items()
         }
         model = create_model("Shape", __base__=_OneOf, **fields)
@@ -225,7 +231,7 @@ class _Claims(Section):
     @model_validator(mode="after")
     def _ranges(self):
         for key, value in self:
-            if isinstance(value, list) and value[0] > value[1]:
+            if isinstance(value, list) and all(map(math.isfinite, value)) and value[0] > value[1]:
                 raise PydanticCustomError("range_order", "a range [low, high] with low <= high", {"key": key})
         return self
 
@@ -252,20 +258,6 @@ class _Config(Section):
                     "each_once", "each N once (also at realisations[{first}])", {"index": i, "first": seen[entry.n]}
                 )
             seen[entry.n] = i
-        return self
-
-    @model_validator(mode="after")
-    def _times_within_t_final(self):
-        t_final = self.physics.t_final
-        times = [("comic_times", self.comic_times), ("tradeoff.times", self.tradeoff.times if self.tradeoff else [])]
-        for key, values in times:
-            for i, t in enumerate(values):
-                if not 0 <= t <= t_final:
-                    raise PydanticCustomError(
-                        "time_range",
-                        "a time in [0, physics.t_final = {t_final}]",
-                        {"key": key, "index": i, "t_final": f"{t_final:g}"},
-                    )
         return self
 
 

@@ -402,6 +402,7 @@ _WORDS = {
     "greater_than_equal": "{value!r} is less than the minimum of {ge}",
     "less_than_equal": "{value!r} is greater than the maximum of {le}",
     "too_short": "{value!r} is too short",
+    "empty": "{value!r} should be non-empty",
     "too_long": "{value!r} is too long",
     "int_type": "{value!r} is not of type 'integer'",
     "float_type": "{value!r} is not of type 'number'",
@@ -410,7 +411,7 @@ _WORDS = {
     "dict_type": "{value!r} is not of type 'object'",
     "model_type": "{value!r} is not of type 'object'",
     "string_type": "{value!r} is not of type 'string'",
-    "literal_error": "{value!r} is not one of {expected}",
+    "literal_error": "{value!r} is not one of {expected}",  # expected: the words, as a list
     "unique_items": "{value!r} has non-unique elements",
     "string_pattern_mismatch": "{value!r} does not match {pattern!r}",
     "union": "{value!r} is not valid under any of the given schemas",
@@ -483,9 +484,12 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
     kind, ctx = first["type"], first.get("ctx", {})
     path, value, info, _ = _located(first["loc"], config, Config, missing=kind == "missing")
-    members = [e for e in errors if _located(e["loc"], config, Config)[0] == path and e["loc"] != first["loc"]]
-    if members and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it
-        kind, ctx = "union", {}
+    members = [e for e in errors if _located(e["loc"], config, Config)[0] == path]
+    if len(members) > 1 and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it:
+        # a member of its type names the bound it breaks, else none is of its type
+        typed = [e for e in members if not e["type"].endswith("_type") and e["type"] != "literal_error"]
+        first = typed[0] if typed else first
+        kind, ctx = (first["type"], first.get("ctx", {})) if typed else ("union", {})
     if kind == "extra_forbidden" or "[key]" in first["loc"]:
         parent = _located(first["loc"][:-1], config, Config)
         models = [t for t in _members(parent[3]) if hasattr(t, "model_fields")]
@@ -504,18 +508,21 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
         return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
     if kind == "each_once":
         return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
-    if kind == "time_range":  # key, its i-th time as written
-        written = _located(tuple(ctx["key"].split(".")), config, Config)[1][ctx["index"]]
-        return SettingError(ctx["key"], written, first["msg"])
     if kind == "range_order":
         return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
     if kind in ("one_of", "missing_one_of"):
         return SettingError(key_path(path), "(missing)", first["msg"])
-    finite = isinstance(value, float) and math.isnan(value)
-    if finite:  # nan passes every bound in the schema: refused as not finite, as crosschecks.check_finite does
+    bound = kind in ("greater_than", "greater_than_equal", "less_than_equal")
+    if bound and isinstance(value, float) and math.isnan(value):  # nan passes every bound in the schema:
+        # refused as not finite, as crosschecks.check_finite does
         return SettingError(key_path(path), value, "a finite number (YAML .nan and .inf are not settings)")
-    words = _WORDS.get(kind)
     ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
+    if kind == "literal_error":  # jsonschema's words: a type, then the enum
+        kind = "string_type" if not isinstance(value, str) else kind
+        ctx = {"expected": re.findall(r"'([^']*)'", str(ctx.get("expected", "")))}
+    if kind == "too_short" and ctx.get("min_length") == 1:
+        kind = "empty"
+    words = _WORDS.get(kind)
     message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
     allowed = f"{described} ({message})" if described else message
     if kind in ("int_type", "float_type", "literal_error", "union"):
@@ -525,9 +532,9 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
 
 def parse(config: Mapping):
     """The config as its typed form (pipeline.config.Config): each section by its model (types,
-    ranges, required and unknown keys, the rules within a section and between the times and
-    t_final); SettingError names the key path, the value and the allowed range, as the schema's
-    check did. Only parses: validate_config also checks the runs the config plans."""
+    ranges, required and unknown keys, the rules within a section); SettingError names the key
+    path, the value and the allowed range, as the schema's check did. Only parses:
+    validate_config also checks the rules between sections and the runs the config plans."""
     from pydantic import ValidationError
 
     from .config import Config

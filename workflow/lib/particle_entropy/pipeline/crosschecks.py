@@ -145,8 +145,9 @@ def check_shear(config: Mapping, typed: Config | None = None) -> None:
     for case in shear.cases:
         try:
             ShearConfig(case=case, **settings)
-        except SettingError as e:
-            raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
+        except SettingError as e:  # named with the value as the config wrote it
+            written = config["shear"].get(e.name, e.value)
+            raise SettingError(f"shear.{e.name}", written, f"{e.allowed} (shear case {case})") from None
 
 
 class Searches(Mapping):
@@ -318,3 +319,10 @@ def check_sweeps(config: Mapping, typed: Config | None = None) -> None:
     check_fd_domain(config, cfg)
     check_seeds(config, cfg)
     check_shear(config, cfg)  # the optimum searches are checked when a target uses them (Searches)
+    t_final = cfg.physics.t_final
+    written = {"comic_times": config["comic_times"], "tradeoff.times": config.get("tradeoff", {}).get("times", [])}
+    times = [("comic_times", cfg.comic_times), ("tradeoff.times", cfg.tradeoff.times if cfg.tradeoff else [])]
+    for key, values in times:
+        for t, as_written in zip(values, written[key]):
+            if not 0 <= t <= t_final:
+                raise SettingError(key, as_written, f"a time in [0, physics.t_final = {t_final:g}]")
