@@ -1,10 +1,12 @@
 """Check a workflow config before any job runs, each problem in one short message.
 
-Three layers: YAML syntax (with the line and column), the JSON schema (one error, named by its
-key path, with the allowed values from the schema's own description) and the rules between
-fields that a schema cannot say (crosschecks.check_sweeps). Snakemake's own loader and validator
-report the first two without a line number and with the whole schema and config around the
-one useful line.
+Three layers: YAML syntax (with the line and column), the typed config (``parse``: each section
+by its pydantic model, pipeline/config.py; one error, named by its key path and value, with the
+field's description and jsonschema's wording of the refusal, as when the config was checked
+against the schema alone) and the rules between sections and runs (crosschecks.check_sweeps).
+``validate_config`` runs the last two and returns the typed config. Snakemake's own loader and
+validator report the first two without a line number and with the whole schema and config
+around the one useful line.
 """
 
 from __future__ import annotations
@@ -314,15 +316,9 @@ def float_spelling(text: str) -> str | None:
     return out if isinstance(yaml.load(out, Loader=SAFE_LOADER), float) else None
 
 
-def _wants_integer(schema: Mapping) -> bool:
-    kind = schema.get("type")
-    return kind == "integer" or (isinstance(kind, list) and "integer" in kind and "number" not in kind)
-
-
-def _number_hint(value, schema: Mapping | None = None) -> str:
+def _number_hint(value, integer: bool = False) -> str:
     """How to write ``value`` as the number it looks like: YAML 1.1 reads 1e-3 (no dot in the
-    mantissa, no sign in the exponent) and 0o17 as text; an integer setting takes no 1000.0."""
-    integer = _wants_integer(schema or {})
+    mantissa, no sign in the exponent) and 0o17 as text; an ``integer`` setting takes no 1000.0."""
     if isinstance(value, float) and integer and value.is_integer() and abs(value) < 2**63:
         return f"; write {int(value)}: an integer, with no decimal point or exponent"
     if not isinstance(value, str):
@@ -339,56 +335,15 @@ def _number_hint(value, schema: Mapping | None = None) -> str:
     return f"; YAML 1.1 reads {_short(text)} as text: write {spelling}"
 
 
-def _strict_validator():
-    """Draft 2020-12 with an integer that is an int: JSON Schema counts 1000.0 as an integer, but a
-    seed or an N of 1000.0 names files seeds~1000.0 that no rule makes."""
-    from jsonschema import Draft202012Validator, validators
-
-    integer = Draft202012Validator.TYPE_CHECKER.redefine(
-        "integer", lambda checker, value: isinstance(value, int) and not isinstance(value, bool)
-    )
-    return validators.extend(Draft202012Validator, type_checker=integer)
-
-
-def _schema_error_to_setting(error) -> SettingError:
-    """One jsonschema ValidationError as a SettingError: key path, value, allowed values."""
-    path = list(error.absolute_path)
-    schema = error.schema if isinstance(error.schema, Mapping) else {}
-    if error.validator == "additionalProperties":
-        known = list(schema.get("properties", {}))
-        unexpected = [k for k in error.instance if k not in known]
-        unexpected = [k for k in unexpected if not any(re.match(p, k) for p in schema.get("patternProperties", {}))]
-        key = unexpected[0] if unexpected else "?"
-        if schema.get("patternProperties") or not known:  # keys by pattern: the description says which
-            allowed = schema.get("description", "a known key")
-        else:
-            allowed = "a known key: " + ", ".join(known)
-        near = difflib.get_close_matches(str(key), known, n=1)
-        return SettingError(
-            key_path([*path, key]), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else "")
-        )
-    if error.validator == "required":
-        key = re.match(r"'([^']+)'", error.message)
-        key = key.group(1) if key else "?"
-        described = schema.get("properties", {}).get(key, {}).get("description", "")
-        return SettingError(
-            key_path([*path, key]), "(missing)", "a required key" + (f": {described}" if described else "")
-        )
-    described = schema.get("description", "")
-    message = _clip(error.message)  # it quotes the value
-    allowed = f"{described} ({message})" if described else message
-    if error.validator in ("type", "oneOf"):
-        allowed += _number_hint(error.instance, schema)
-    return SettingError(key_path(path), _short(error.instance), allowed)
-
-
-def check_schema(config: Mapping, schema: Mapping) -> None:
-    """SettingError for the most relevant way ``config`` breaks ``schema`` (none if it conforms)."""
-    from jsonschema.exceptions import best_match
-
-    error = best_match(_strict_validator()(schema).iter_errors(dict(config)))
-    if error is not None:
-        raise bounded(_schema_error_to_setting(error))
+def check_schema(config: Mapping, schema: Mapping | None = None) -> None:
+    """SettingError for the first way ``config`` breaks the workflow's schema (none if it conforms).
+    The schema is generated from the typed config's models (schemagen), so the config is checked
+    by those models (parse): one check and one form of message, for a dry run as for check-config.
+    ``schema``, when given (common.smk passes the file Snakemake's validate then reads), must be
+    that generated schema."""
+    if schema is not None and schema != load_schema():
+        raise ValueError("check_schema checks the workflow's schema, which pipeline/config.py generates")
+    parse(config)
 
 
 def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
@@ -396,7 +351,8 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
-# jsonschema's wording of each refusal, which the messages have always quoted (tests hold it)
+# jsonschema's wording of each refusal, which the messages have quoted since the config was checked
+# against the schema alone (tests hold it)
 _WORDS = {
     "greater_than": "{value!r} is less than or equal to the minimum of {gt}",
     "greater_than_equal": "{value!r} is less than the minimum of {ge}",
@@ -525,8 +481,8 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
     words = _WORDS.get(kind)
     message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
     allowed = f"{described} ({message})" if described else message
-    if kind in ("int_type", "float_type", "literal_error", "union"):
-        allowed += _number_hint(value, {"type": "integer" if kind == "int_type" else "number"})
+    if kind in ("int_type", "float_type", "string_type", "literal_error", "union"):
+        allowed += _number_hint(value, integer=kind == "int_type")
     return SettingError(key_path(path), _short(value), allowed)
 
 
@@ -574,7 +530,7 @@ def check_config(
     from ..experiments.scene import scenes
     from .crosschecks import check_memory, check_scene, check_search
 
-    if schema is not None:  # a schema of the caller's: the file's jsonschema check first
+    if schema is not None:  # the workflow's, as check_schema takes it
         check_schema(config, schema)
     typed = validate_config(config)
     try:
