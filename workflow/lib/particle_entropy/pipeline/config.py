@@ -12,12 +12,15 @@ of replacing ``Setting`` by pydantic fields, for two concrete reasons:
   would put pydantic into every job;
 - experiments/scene.py and analysis/optimum.py read ``settings.SCENE`` and ``settings.SEARCH``.
 
-A structured value's shape is declared once too, as the JSON-schema fragment of its ``Setting``
-(schemagen writes it into the schema as it stands); ``annotation`` turns that fragment into the
-pydantic type, so the schema and the model cannot disagree. Cross-field rules a section can see
-alone are model validators here (a search's budget and range, a claim's [low, high], each N of
-the ``realisations`` table once); the rules that need several sections or a run (a case that
-builds, a time within t_final, memory) stay in pipeline/crosschecks.py.
+A structured value's shape is declared once too, with its ``Setting``: a pydantic type (made
+with settings.number, integer and array), or, where the shape is built from other declarations,
+a JSON-schema fragment that ``annotation`` turns into one: a shared definition (``build().defs``:
+a case, the lists of cases and of N, a section of cases), a scene's source and candidates (kept
+plain dicts, which experiments/scene.py checks further) and the shear cases. schemagen renders
+the schema from these models, so the schema and the models cannot disagree. Cross-field rules a
+section can see alone are model validators here (a search's budget and range, a claim's [low,
+high], each N of the ``realisations`` table once); the rules that need several sections or a run
+(a case that builds, a time within t_final, memory) stay in pipeline/crosschecks.py.
 
 ``Config`` is what ``configcheck.validate_config`` returns: the merged config, parsed once. A key
 the config may leave out and that has no default (a section, a search's ``n``) is None in it; an
@@ -30,7 +33,7 @@ from __future__ import annotations
 import functools
 import math
 from types import SimpleNamespace
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal
 
 from pydantic import (
     AfterValidator,
@@ -38,13 +41,12 @@ from pydantic import (
     ConfigDict,
     Field,
     StrictBool,
-    StrictInt,
     create_model,
     model_validator,
 )
 from pydantic_core import PydanticCustomError
 
-from ..core.case import NONE, from_text
+from ..core.case import N_MIN, NONE, from_text
 from ..core.registry import ALL_KERNELS, METHODS, PRESETS
 from ..core.settings import (
     BY_KEY,
@@ -66,6 +68,9 @@ from ..core.settings import (
     TRADEOFF,
     UNIQUE,
     Setting,
+    array,
+    integer,
+    number,
 )
 from ..figures import PAPER_FIGURES
 
@@ -98,14 +103,6 @@ class _OneOf(Section):
         return self
 
 
-def _number(fragment: dict, integer: bool):
-    bounds = {}
-    for key, arg in (("minimum", "ge"), ("exclusiveMinimum", "gt"), ("maximum", "le")):
-        if key in fragment:
-            bounds[arg] = fragment[key]
-    return Annotated[StrictInt if integer else float, Field(strict=True, **bounds)]
-
-
 def _ref_of(fragment: dict) -> dict:
     """The Field of a key of a shape: a shared definition's reference (pydantic folds an
     Annotated type into its field, so the schema could not tell it from its own entry) and
@@ -118,27 +115,25 @@ def _ref_of(fragment: dict) -> dict:
     return {"json_schema_extra": {"ref": fragment["$ref"]}, "description": text}
 
 
+_BOUNDS = {"minimum": "ge", "exclusiveMinimum": "gt", "maximum": "le"}
+_LENGTHS = {"minItems": "min_length", "maxItems": "max_length"}
+
+
 def annotation(fragment: dict, defs: dict | None = None):
-    """The pydantic type of a JSON-schema fragment (a structured Setting's ``shape``): arrays,
-    numbers, integers, enums, objects and references to the schema's $defs."""
+    """The pydantic type of a JSON-schema fragment (a structured Setting's ``shape``): a reference
+    to a shared definition, an enum, a number, an integer, an array or an object."""
     if "$ref" in fragment:
         return (defs or build().defs)[fragment["$ref"].rsplit("/", 1)[1]]
     kind = fragment.get("type")
     if "enum" in fragment:
         return Literal[tuple(fragment["enum"])]
     if kind in ("number", "integer"):
-        return _number(fragment, kind == "integer")
-    if kind == "boolean":
-        return StrictBool
-    if kind == "string":
-        return str
+        bounds = {arg: fragment[key] for key, arg in _BOUNDS.items() if key in fragment}
+        return integer(**bounds) if kind == "integer" else number(**bounds)
     if kind == "array":
-        item = annotation(fragment["items"], defs) if "items" in fragment else Any
-        length = {"min_length": fragment.get("minItems"), "max_length": fragment.get("maxItems")}
+        length = {arg: fragment[key] for key, arg in _LENGTHS.items() if key in fragment}
         checks = [UNIQUE] if fragment.get("uniqueItems") else []
-        return Annotated[list[item], Field(**{k: v for k, v in length.items() if v is not None}), *checks]
-    if kind == "object" and "properties" not in fragment:
-        return dict
+        return array(annotation(fragment["items"], defs), *checks, **length)
     if kind == "object":  # a mapping of declared keys, kept a plain dict (its consumer parses it further)
         required = set(fragment.get("required", ()))
         fields = {
@@ -162,11 +157,10 @@ def annotation_of(s: Setting, defs: dict | None = None):
     bounds = {} if s.low is None or s.low == -math.inf else {"gt" if s.open_low else "ge": s.low}
     if s.high != math.inf:
         bounds["le"] = s.high
-    base = StrictInt if s.kind == "integer" else float
-    number = Annotated[base, Field(strict=True, **bounds)]
+    value = integer(**bounds) if s.kind == "integer" else number(**bounds)
     if s.none:  # the word none (None), as truncation takes it
-        return Annotated[Literal[NONE] | number, AfterValidator(from_text)]
-    return number
+        return Annotated[Literal[NONE] | value, AfterValidator(from_text)]
+    return value
 
 
 # Run settings a config must give, though they have defaults (core/run_settings.py declares no
@@ -303,9 +297,9 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         "preset": Literal[tuple(PRESETS)],
         **{name: kind for name, (kind, _) in dims.items()},
         "case": case,
-        "cases": Annotated[list[case], Field(min_length=1)],
-        "ns": Annotated[list[Annotated[StrictInt, Field(ge=2)]], Field(min_length=1)],
-        "realisations": Annotated[StrictInt, Field(ge=1, le=MAX_REALISATIONS)] | Literal["ensemble"],
+        "cases": array(case, min_length=1),
+        "ns": array(integer(ge=N_MIN), min_length=1),
+        "realisations": integer(ge=1, le=MAX_REALISATIONS) | Literal["ensemble"],
     }
     defs["case_section"] = m.CaseSection = section("CaseSection", CASE_SECTION, SECTION_DOCS["<section>"], defs=defs)
 
