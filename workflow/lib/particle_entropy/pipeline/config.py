@@ -221,12 +221,26 @@ class _Search(Section):
         return self
 
 
+def refuse(key: str, allowed: str):
+    """A section's rule broken at its ``key``: configcheck names the key path, the value as written
+    and ``allowed``."""
+    return PydanticCustomError("rule", allowed, {"key": key})
+
+
 class _Claims(Section):
     @model_validator(mode="after")
     def _ranges(self):
         for key, value in self:
             if isinstance(value, list) and all(map(math.isfinite, value)) and value[0] > value[1]:
-                raise PydanticCustomError("range_order", "a range [low, high] with low <= high", {"key": key})
+                raise refuse(key, "a range [low, high] with low <= high")
+        return self
+
+
+class _Lattice(Section):
+    @model_validator(mode="after")
+    def _odd(self):
+        if self.n % 2 == 0:
+            raise refuse("n", "an odd integer >= 3, so that a particle sits at x = 0")
         return self
 
 
@@ -331,7 +345,7 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         **{fig: ((m.Fig9 if fig == "fig9" else m.CaseSection), None) for fig in PAPER_FIGURES},
     )
     m.Tradeoff = of("Tradeoff", TRADEOFF, SECTION_DOCS["tradeoff"], parent=m.CaseSection)
-    m.Lattice = of("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"])
+    m.Lattice = of("Lattice", _in("mechanism.lattice", MECHANISM), SECTION_DOCS["mechanism.lattice"], parent=_Lattice)
     m.FdDomain = of("FdDomain", _in("mechanism.fd_domain", MECHANISM), SECTION_DOCS["mechanism.fd_domain"])
     m.Mechanism = of(
         "Mechanism",

@@ -464,7 +464,7 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
         return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
     if kind == "each_once":
         return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
-    if kind == "range_order":
+    if kind == "rule":
         return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
     if kind in ("one_of", "missing_one_of"):
         return SettingError(key_path(path), "(missing)", first["msg"])

@@ -34,13 +34,12 @@ from .sweeps import (
 
 
 def check_lattice(config: Mapping, typed: Config | None = None) -> None:
-    """A lattice run needs an odd N and mtpt cases at eta = 1 (random walks leave the lattice)."""
+    """A lattice run needs mtpt cases at eta = 1 (random walks leave the lattice) that run (its odd
+    N: the Lattice model)."""
     cfg = typed or parse(config)
     lattice = cfg.mechanism.lattice if cfg.mechanism else None
     if lattice is None:
         return
-    if lattice.n % 2 == 0:
-        raise SettingError("mechanism.lattice.n", lattice.n, "an odd integer >= 3, so that a particle sits at x = 0")
     for i, spec in enumerate(lattice.cases or []):
         try:
             case = Case.from_spec(spec.model_dump(exclude_unset=True), lattice.n, cfg.case_defaults.model_dump())
