@@ -188,12 +188,25 @@ def field(s: Setting, defs: dict | None = None) -> tuple:
     return kind, Field(None, **info)  # absent: None (null itself is refused)
 
 
-def section(name: str, settings, doc: str, parent=Section, defs: dict | None = None, **extra):
+def section(name: str, settings, doc: str, parent=Section, defs: dict | None = None, order=(), **extra):
     """The model of a section: a field per setting directly in it (``settings`` keys below
-    ``<key>.``: their last part), and ``extra`` fields (nested sections)."""
+    ``<key>.``: their last part), and ``extra`` fields (nested sections); keys named in ``order``
+    first, in that order."""
     fields = {s.name: field(s, defs) for s in settings}
     fields.update(extra)  # a nested section, or a setting's own model in its place
+    fields = {**{k: fields[k] for k in order if k in fields}, **fields}
     return create_model(name, __base__=parent, __doc__=doc, **fields)
+
+
+def key_order(prefix: str, settings) -> list[str]:
+    """The keys of the section at ``prefix`` in the order ``settings`` declares them, a nested
+    section's where its first setting is (scenes.<name>: target after fd_length)."""
+    names = [
+        s.name if s.section == prefix else s.section[len(prefix) + 1 :].split(".")[0]
+        for s in settings
+        if s.section == prefix or s.section.startswith(prefix + ".")
+    ]
+    return list(dict.fromkeys(names))
 
 
 def _in(prefix: str, settings) -> tuple:
@@ -317,8 +330,8 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
     }
     defs["case_section"] = m.CaseSection = section("CaseSection", CASE_SECTION, SECTION_DOCS["<section>"], defs=defs)
 
-    def of(name: str, keys, doc: str, parent=Section, **extra):
-        return section(name, keys, doc, parent=parent, defs=defs, **extra)
+    def of(name: str, keys, doc: str, parent=Section, order=(), **extra):
+        return section(name, keys, doc, parent=parent, defs=defs, order=order, **extra)
 
     m.Physics = of("Physics", _in("physics", settings), "The 1-D diffusion problem shared by all figures.")
     m.Time = of("Time", _in("time", settings), "Time stepping.")
@@ -356,9 +369,11 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
     )
     m.Target = of("Target", _in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
     scene = _in("scenes.<name>", SCENE)
-    m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], target=(m.Target, None))
+    order = key_order("scenes.<name>", SCENE)
+    m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], order=order, target=(m.Target, None))
     base = BY_KEY["scenes_peclet.base"]
-    m.SceneBase = of("SceneBase", [s for s in scene if s.name != "v"], description(base), target=(m.Target, None))
+    without_v = [s for s in scene if s.name != "v"]
+    m.SceneBase = of("SceneBase", without_v, description(base), order=order, target=(m.Target, None))
     m.ScenesPeclet = of(
         "ScenesPeclet",
         SCENES_PECLET,
