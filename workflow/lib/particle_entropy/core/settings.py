@@ -11,9 +11,10 @@ claims' tolerances (``CLAIMS``), the trade-off sweep (``TRADEOFF``), the mechani
 (``MECHANISM``) and an adaptive search (``SEARCH``), with the caps
 they share (``MAX_REALISATIONS``, ``MAX_SEED``, ``MAX_N``, ``SHEAR_MAX_N``). From them come the paper's
 defaults (``PAPER``), ``RunConfig``'s, ``ShearConfig``'s and ``Search``'s defaults and range
-checks, the CLI's options (cli.py), the schema's blocks, which
-``python -m particle_entropy.pipeline.schemagen --write`` writes into
-workflow/schemas/config.schema.yaml (tests/test_settings.py fails when the file is stale), and
+checks, the CLI's options (cli.py), the typed config that ``configcheck.validate_config``
+returns (pipeline/config.py: a pydantic model per section, derived from these tuples), the whole
+schema workflow/schemas/config.schema.yaml, which ``python -m particle_entropy.pipeline.schemagen
+--write`` writes from those models (tests/test_settings.py fails when the file is stale), and
 the column page's descriptions of settings written beside results. Cross-field rules (a strip
 inside its domain, a search's budget of at least one round) are checked where the fields meet;
 their range is then given in words (``range_text``).
@@ -22,6 +23,10 @@ their range is then given in words (``range_text``).
 from __future__ import annotations
 
 import math
+from typing import Annotated, Literal
+
+from pydantic import AfterValidator, Field, StrictInt
+from pydantic_core import PydanticCustomError
 
 from .registry import (
     ADVECTION_SCHEMES,
@@ -48,7 +53,40 @@ MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB 
 
 
 def _ref(name: str) -> dict:
+    """The shape of a value of a shared definition (pipeline/config.py builds them: a case, the
+    lists of cases and of N, a section of cases), as the schema's $defs name it."""
     return {"$ref": f"#/$defs/{name}"}
+
+
+# A structured value's shape is a pydantic type made of these (pipeline/config.py validates by it,
+# schemagen writes its schema entry), or, for the shapes built from other declarations, a
+# JSON-schema fragment read by pipeline/config.annotation: a shared definition (_ref), a scene's
+# source and candidates (their owner, experiments/scene.py, checks them further), the shear cases.
+def number(**bounds):
+    """A real number (an int is one too; not a bool or a string) within ``bounds`` (gt, ge, le)."""
+    return Annotated[float, Field(strict=True, **bounds)]
+
+
+def integer(**bounds):
+    """An int (not 1000.0, which would name files n~1000.0), within ``bounds``."""
+    return Annotated[StrictInt, Field(**bounds)]
+
+
+def _unique(values: list) -> list:
+    if len(values) != len({repr(float(v)) if isinstance(v, (int, float)) else repr(v) for v in values}):
+        raise PydanticCustomError("unique_items", "has non-unique elements")
+    return values
+
+
+UNIQUE = AfterValidator(_unique)  # each item once (250 and 250.0 are one time)
+
+
+def array(item, *checks, **length):
+    """A list of ``item`` with ``length`` (min_length, max_length) and ``checks`` (UNIQUE)."""
+    return Annotated[list[item], Field(**length), *checks]
+
+
+TIMES = array(number(ge=0), UNIQUE, min_length=1)  # times of a run, each once [T]
 
 
 # ------------------------------------------------------------------------------ sections of cases
@@ -127,7 +165,7 @@ TRADEOFF = (
         "times at which cost and error are tabulated (nearest step)",
         "T",
         kind="shape",
-        shape={"type": "array", "minItems": 1, "uniqueItems": True, "items": {"type": "number", "minimum": 0}},
+        shape=TIMES,
         range_text="times in [0, physics.t_final], each once",
         required=True,
     ),
@@ -180,7 +218,7 @@ MECHANISM = (
         "domain lengths, the first the paper's",
         "L",
         kind="shape",
-        shape={"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0}},
+        shape=array(number(gt=0), min_length=1),
         range_text="lengths > 0 that hold the plume",
         required=True,
     ),
@@ -246,12 +284,12 @@ COMIC_TIMES = (
         "times at which COMIC tables and minima are reported (nearest step)",
         "T",
         kind="shape",
-        shape={"type": "array", "minItems": 1, "uniqueItems": True, "items": {"type": "number", "minimum": 0}},
+        shape=TIMES,
         range_text="times in [0, physics.t_final], each once",
         required=True,
     ),
 )
-_RANGE = {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}
+_RANGE = array(number(), min_length=2, max_length=2)
 CLAIMS = (  # the tolerances the paper's claims are judged at (analysis/claims.py); the paper's own
     Setting(
         "fd_optimum_nodes",
@@ -328,7 +366,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
         NO_DEFAULT,
         "[low, high]: the N searched (particles; FD intervals)",
         kind="shape",
-        shape={"type": "array", "items": {"type": "integer", "minimum": 1}, "minItems": 2, "maxItems": 2},
+        shape=array(integer(ge=1), min_length=2, max_length=2),
         range_text="integers with 1 <= low < high (FD: low >= 2)",
     ),
     Setting(
@@ -338,7 +376,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
         "[low, high]: search the time-step growth factor instead of N (pt, mtpt), at the N given by `n`, "
         "in log(dt_growth - 1)",
         kind="shape",
-        shape={"type": "array", "items": {"type": "number", "exclusiveMinimum": 1}, "minItems": 2, "maxItems": 2},
+        shape=array(number(gt=1), min_length=2, max_length=2),
         range_text="numbers with 1 < low < high",
     ),
     Setting("n", "optimum.<name>.n", NO_DEFAULT, "the N at which a growth_range search runs", kind="integer", low=1),
@@ -369,17 +407,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
         "the cost model: [[searched value (N or dt_growth), seconds per run], ...], interpolated in log-log; "
         "calibrated once on a quiet machine by benchmarks/calibrate_search_costs.py",
         kind="shape",
-        shape={
-            "type": "array",
-            "minItems": 1,
-            "maxItems": 1000,
-            "items": {
-                "type": "array",
-                "items": {"type": "number", "exclusiveMinimum": 0},
-                "minItems": 2,
-                "maxItems": 2,
-            },
-        },
+        shape=array(array(number(gt=0), min_length=2, max_length=2), min_length=1, max_length=1000),
         range_text="pairs of numbers > 0 at distinct values",
     ),
     Setting(
@@ -574,14 +602,7 @@ SCENE = (
         "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03)",
         "s",
         kind="shape",
-        shape={
-            "type": "object",
-            "additionalProperties": False,
-            "properties": {
-                m: {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2}
-                for m in METHODS
-            },
-        },
+        shape=dict[Literal[METHODS], array(number(ge=0), min_length=2, max_length=2)],
         range_text="per method fd, pt, mtpt: [seconds a step, seconds a unit of work], numbers >= 0",
     ),
     Setting(
@@ -619,7 +640,7 @@ SCENES_PECLET = (
         NO_DEFAULT,
         "a scene without its v (the keys of scenes.<name>); each velocity of `v` makes one scene of it",
         kind="shape",
-        shape={"type": "object"},
+        shape=dict,
         range_text="a scene (scenes.<name>) without v",
         required=True,
     ),
@@ -630,7 +651,7 @@ SCENES_PECLET = (
         "the velocities, ascending; the Peclet number of each is v L / D (L: the base's FD window)",
         "L/T",
         kind="shape",
-        shape={"type": "array", "minItems": 2, "items": {"type": "number", "minimum": 0}},
+        shape=array(number(ge=0), min_length=2),
         range_text="at least two numbers >= 0, ascending",
         required=True,
     ),

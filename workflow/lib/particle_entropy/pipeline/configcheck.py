@@ -1,16 +1,19 @@
 """Check a workflow config before any job runs, each problem in one short message.
 
-Three layers: YAML syntax (with the line and column), the JSON schema (one error, named by its
-key path, with the allowed values from the schema's own description) and the rules between
-fields that a schema cannot say (crosschecks.check_sweeps). Snakemake's own loader and validator
-report the first two without a line number and with the whole schema and config around the
-one useful line.
+Three layers: YAML syntax (with the line and column), the typed config (``parse``: each section
+by its pydantic model, pipeline/config.py; one error, named by its key path and value, with the
+field's description and jsonschema's wording of the refusal, as when the config was checked
+against the schema alone) and the rules between sections and runs (crosschecks.check_sweeps).
+``validate_config`` runs the last two and returns the typed config. Snakemake's own loader and
+validator report the first two without a line number and with the whole schema and config
+around the one useful line.
 """
 
 from __future__ import annotations
 
 import difflib
 import json
+import math
 import os
 import re
 import stat
@@ -313,15 +316,9 @@ def float_spelling(text: str) -> str | None:
     return out if isinstance(yaml.load(out, Loader=SAFE_LOADER), float) else None
 
 
-def _wants_integer(schema: Mapping) -> bool:
-    kind = schema.get("type")
-    return kind == "integer" or (isinstance(kind, list) and "integer" in kind and "number" not in kind)
-
-
-def _number_hint(value, schema: Mapping | None = None) -> str:
+def _number_hint(value, integer: bool = False) -> str:
     """How to write ``value`` as the number it looks like: YAML 1.1 reads 1e-3 (no dot in the
-    mantissa, no sign in the exponent) and 0o17 as text; an integer setting takes no 1000.0."""
-    integer = _wants_integer(schema or {})
+    mantissa, no sign in the exponent) and 0o17 as text; an ``integer`` setting takes no 1000.0."""
     if isinstance(value, float) and integer and value.is_integer() and abs(value) < 2**63:
         return f"; write {int(value)}: an integer, with no decimal point or exponent"
     if not isinstance(value, str):
@@ -338,56 +335,15 @@ def _number_hint(value, schema: Mapping | None = None) -> str:
     return f"; YAML 1.1 reads {_short(text)} as text: write {spelling}"
 
 
-def _strict_validator():
-    """Draft 2020-12 with an integer that is an int: JSON Schema counts 1000.0 as an integer, but a
-    seed or an N of 1000.0 names files seeds~1000.0 that no rule makes."""
-    from jsonschema import Draft202012Validator, validators
-
-    integer = Draft202012Validator.TYPE_CHECKER.redefine(
-        "integer", lambda checker, value: isinstance(value, int) and not isinstance(value, bool)
-    )
-    return validators.extend(Draft202012Validator, type_checker=integer)
-
-
-def _schema_error_to_setting(error) -> SettingError:
-    """One jsonschema ValidationError as a SettingError: key path, value, allowed values."""
-    path = list(error.absolute_path)
-    schema = error.schema if isinstance(error.schema, Mapping) else {}
-    if error.validator == "additionalProperties":
-        known = list(schema.get("properties", {}))
-        unexpected = [k for k in error.instance if k not in known]
-        unexpected = [k for k in unexpected if not any(re.match(p, k) for p in schema.get("patternProperties", {}))]
-        key = unexpected[0] if unexpected else "?"
-        if schema.get("patternProperties") or not known:  # keys by pattern: the description says which
-            allowed = schema.get("description", "a known key")
-        else:
-            allowed = "a known key: " + ", ".join(known)
-        near = difflib.get_close_matches(str(key), known, n=1)
-        return SettingError(
-            key_path([*path, key]), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else "")
-        )
-    if error.validator == "required":
-        key = re.match(r"'([^']+)'", error.message)
-        key = key.group(1) if key else "?"
-        described = schema.get("properties", {}).get(key, {}).get("description", "")
-        return SettingError(
-            key_path([*path, key]), "(missing)", "a required key" + (f": {described}" if described else "")
-        )
-    described = schema.get("description", "")
-    message = _clip(error.message)  # it quotes the value
-    allowed = f"{described} ({message})" if described else message
-    if error.validator in ("type", "oneOf"):
-        allowed += _number_hint(error.instance, schema)
-    return SettingError(key_path(path), _short(error.instance), allowed)
-
-
-def check_schema(config: Mapping, schema: Mapping) -> None:
-    """SettingError for the most relevant way ``config`` breaks ``schema`` (none if it conforms)."""
-    from jsonschema.exceptions import best_match
-
-    error = best_match(_strict_validator()(schema).iter_errors(dict(config)))
-    if error is not None:
-        raise bounded(_schema_error_to_setting(error))
+def check_schema(config: Mapping, schema: Mapping | None = None) -> None:
+    """SettingError for the first way ``config`` breaks the workflow's schema (none if it conforms).
+    The schema is generated from the typed config's models (schemagen), so the config is checked
+    by those models (parse): one check and one form of message, for a dry run as for check-config.
+    ``schema``, when given (common.smk passes the file Snakemake's validate then reads), must be
+    that generated schema."""
+    if schema is not None and schema != load_schema():
+        raise ValueError("check_schema checks the workflow's schema, which pipeline/config.py generates")
+    parse(config)
 
 
 def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
@@ -395,10 +351,176 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
+# jsonschema's wording of each refusal, which the messages have quoted since the config was checked
+# against the schema alone (tests hold it)
+_WORDS = {
+    "greater_than": "{value!r} is less than or equal to the minimum of {gt}",
+    "greater_than_equal": "{value!r} is less than the minimum of {ge}",
+    "less_than_equal": "{value!r} is greater than the maximum of {le}",
+    "too_short": "{value!r} is too short",
+    "empty": "{value!r} should be non-empty",
+    "too_long": "{value!r} is too long",
+    "int_type": "{value!r} is not of type 'integer'",
+    "float_type": "{value!r} is not of type 'number'",
+    "bool_type": "{value!r} is not of type 'boolean'",
+    "list_type": "{value!r} is not of type 'array'",
+    "dict_type": "{value!r} is not of type 'object'",
+    "model_type": "{value!r} is not of type 'object'",
+    "string_type": "{value!r} is not of type 'string'",
+    "literal_error": "{value!r} is not one of {expected}",  # expected: the words, as a list
+    "unique_items": "{value!r} has non-unique elements",
+    "string_pattern_mismatch": "{value!r} does not match {pattern!r}",
+    "union": "{value!r} is not valid under any of the given schemas",
+}
+_MISSING = object()
+
+
+def _located(loc, config, model, missing: bool = False):
+    """Walk a pydantic error location through the raw ``config`` and the typed ``model``: the key
+    path (pydantic's tags of union members and validators left out), the raw value there (as
+    written), the field there (its description) and the type there (its known keys). ``missing``:
+    the location's last key is one the config does not hold."""
+    from pydantic import BaseModel
+
+    path, value, info, kind = [], config, None, model
+    for i, part in enumerate(loc):
+        if isinstance(value, Mapping) and isinstance(part, str):
+            absent = missing and i == len(loc) - 1
+            step = part if part in value or absent else None
+        elif isinstance(value, list) and isinstance(part, int) and 0 <= part < len(value):
+            step = part
+        else:
+            step = None
+        if step is None:  # a tag: a union's member, a validator
+            continue
+        path.append(step)
+        value = value.get(step, _MISSING) if isinstance(value, Mapping) else value[step]
+        kind, holder = _inner(kind, step)
+        if isinstance(holder, type) and issubclass(holder, BaseModel) and step in holder.model_fields:
+            info = holder.model_fields[step]
+    return path, value, info, kind
+
+
+def _members(t) -> list:
+    """The types a value of type ``t`` may have (Annotated and unions unwrapped)."""
+    import types
+    import typing
+
+    origin = typing.get_origin(t)
+    if origin is typing.Annotated:
+        return _members(typing.get_args(t)[0])
+    if origin in (typing.Union, types.UnionType):
+        return [m for a in typing.get_args(t) for m in _members(a)]
+    return [t]
+
+
+def _inner(kind, step):
+    """(type of the value at ``step`` inside a value of type ``kind``, the model that declares it)."""
+    import typing
+
+    from pydantic import BaseModel
+
+    for t in _members(kind):
+        if isinstance(t, type) and issubclass(t, BaseModel) and isinstance(step, str) and step in t.model_fields:
+            return t.model_fields[step].annotation, t
+        origin = typing.get_origin(t)
+        if origin is dict and isinstance(step, str):
+            return typing.get_args(t)[1], None
+        if origin is list and isinstance(step, int):
+            return typing.get_args(t)[0], None
+    return None, None
+
+
+def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
+    """One pydantic ValidationError as today's SettingError: key path, value, allowed values
+    (the field's description, and jsonschema's wording of the refusal)."""
+    from .config import Config
+
+    errors = error.errors()
+    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
+    kind, ctx = first["type"], first.get("ctx", {})
+    path, value, info, _ = _located(first["loc"], config, Config, missing=kind == "missing")
+    members = [e for e in errors if _located(e["loc"], config, Config)[0] == path]
+    if len(members) > 1 and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it:
+        # a member of its type names the bound it breaks, else none is of its type
+        typed = [e for e in members if not e["type"].endswith("_type") and e["type"] != "literal_error"]
+        first = typed[0] if typed else first
+        kind, ctx = (first["type"], first.get("ctx", {})) if typed else ("union", {})
+    if kind == "extra_forbidden" or "[key]" in first["loc"]:
+        parent = _located(first["loc"][:-1], config, Config)
+        models = [t for t in _members(parent[3]) if hasattr(t, "model_fields")]
+        known = list(models[0].model_fields) if models and "[key]" not in first["loc"] else []
+        if "[key]" in first["loc"]:
+            key = first["loc"][first["loc"].index("[key]") - 1]
+            path = list(path if path and path[-1] == key else [*path, key])
+            allowed = parent[2].description if parent[2] is not None and parent[2].description else "a known key"
+        else:
+            allowed = "a known key: " + ", ".join(known)
+            key = path[-1]
+        near = difflib.get_close_matches(str(key), known, n=1)
+        return SettingError(key_path(path), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else ""))
+    described = info.description if info is not None and info.description else ""
+    if kind == "missing":
+        return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
+    if kind == "each_once":
+        return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
+    if kind == "rule":
+        return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
+    if kind in ("one_of", "missing_one_of"):
+        return SettingError(key_path(path), "(missing)", first["msg"])
+    bound = kind in ("greater_than", "greater_than_equal", "less_than_equal")
+    if bound and isinstance(value, float) and math.isnan(value):  # nan passes every bound in the schema:
+        # refused as not finite, as crosschecks.check_finite does
+        return SettingError(key_path(path), value, "a finite number (YAML .nan and .inf are not settings)")
+    ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
+    if kind == "literal_error":  # jsonschema's words: a type, then the enum
+        kind = "string_type" if not isinstance(value, str) else kind
+        ctx = {"expected": re.findall(r"'([^']*)'", str(ctx.get("expected", "")))}
+    if kind == "too_short" and ctx.get("min_length") == 1:
+        kind = "empty"
+    words = _WORDS.get(kind)
+    message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
+    allowed = f"{described} ({message})" if described else message
+    if kind in ("int_type", "float_type", "string_type", "literal_error", "union"):
+        allowed += _number_hint(value, integer=kind == "int_type")
+    return SettingError(key_path(path), _short(value), allowed)
+
+
+def parse(config: Mapping):
+    """The config as its typed form (pipeline.config.Config): each section by its model (types,
+    ranges, required and unknown keys, the rules within a section); SettingError names the key
+    path, the value and the allowed range, as the schema's check did. Only parses:
+    validate_config also checks the rules between sections and the runs the config plans."""
+    from pydantic import ValidationError
+
+    from .config import Config
+
+    try:
+        return Config.model_validate(dict(config))
+    except ValidationError as e:
+        raise bounded(_pydantic_error_to_setting(e, config)) from None
+
+
+def validate_config(config: Mapping):
+    """The merged config validated once and returned typed (pipeline.config.Config): parsed by its
+    section models (parse), then the rules between sections and runs (crosschecks.check_sweeps)
+    checked on it. SettingError names the key path, the value and the allowed range; its message
+    is bounded."""
+    from .crosschecks import check_sweeps
+
+    typed = parse(config)
+    try:
+        check_sweeps(config, typed)
+    except SettingError as e:
+        raise bounded(e) from None
+    return typed
+
+
 def check_config(
     config: Mapping, schema: Mapping | None = None, available: float | None = None, not_judged: list | None = None
-) -> None:
-    """Everything a dry run checks: the schema, then every rule between fields (crosschecks.check_sweeps),
+):
+    """Everything a dry run checks, returning the typed config (pipeline.config.Config): each
+    section and every rule between fields (validate_config),
     with ``available`` bytes (the machine's, for the check-config command) that every job fits
     (crosschecks.check_memory), and every adaptive search and scene. A run checks a search or a
     scene only when a requested target needs it (none of the default target's do): given a list
@@ -406,13 +528,14 @@ def check_config(
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
     from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_scene, check_search, check_sweeps
+    from .crosschecks import check_memory, check_scene, check_search
 
+    if schema is not None:  # the workflow's, as check_schema takes it
+        check_schema(config, schema)
+    typed = validate_config(config)
     try:
-        check_schema(config, load_schema() if schema is None else schema)
-        check_sweeps(config)
         if available is not None:
-            check_memory(config, available)
+            check_memory(config, available, typed)
     except SettingError as e:
         raise bounded(e) from None
 
@@ -438,24 +561,27 @@ def check_config(
             f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",
             "`snakemake scenes` and " + ("figures/scenes_peclet.png" if peclet else f"figures/scene_{name}.png"),
         )
+    return typed
 
 
 def check_parsed_config(
     config: dict, overrides: Mapping, schema_path: str | Path, fill_defaults, available: float | None = None
-) -> None:
+):
     """The merged config (config.yaml, --configfile, --config) as the Snakefile's parse checks it,
-    in place, in one call: the ``overrides`` of --config retyped as YAML reads them
-    (``retype_overrides``: --config physics={D: 0.002} is a number); the schema, one short message
-    naming the key path (an integer is an int, so --config base_seed=1e3, 1000.0 to Snakemake, is
-    refused, not run as seeds~1000.0); the schema's defaults filled in by ``fill_defaults(config,
-    schema_path)`` (Snakemake's validate); every rule between fields (crosschecks.check_sweeps);
-    and given the ``available`` bytes of the machine the jobs run on, that each job fits
-    (crosschecks.check_memory). The searches and scenes are checked when a target first needs them."""
+    in one call, returned typed (pipeline.config.Config, parsed once): the ``overrides`` of --config
+    retyped as YAML reads them (``retype_overrides``: --config physics={D: 0.002} is a number); each
+    section by its model (``parse``: one short message naming the key path; an integer is an int, so
+    --config base_seed=1e3, 1000.0 to Snakemake, is refused, not run as seeds~1000.0); the generated
+    schema's defaults filled into ``config`` by ``fill_defaults(config, schema_path)`` (Snakemake's
+    validate); every rule between fields (crosschecks.check_sweeps); and given the ``available``
+    bytes of the machine the jobs run on, that each job fits (crosschecks.check_memory). The
+    searches and scenes are checked when a target first needs them."""
     from .crosschecks import check_memory, check_sweeps
 
     retype_overrides(config, overrides)
-    check_schema(config, load_schema(schema_path))
+    typed = parse(config)
     fill_defaults(config, str(schema_path))
-    check_sweeps(config)
+    check_sweeps(config, typed)
     if available is not None:
-        check_memory(config, available)
+        check_memory(config, available, typed)
+    return typed

@@ -1,8 +1,13 @@
-"""The rules between config fields that a JSON schema cannot say, checked before any job runs:
-every number finite, every case of every section a valid run, ensemble sizes for every N, seeds
-within int64, the lattice and FD-domain experiments, the shear cases, the adaptive searches (each
-when a target first uses it: `Searches`) and, where jobs run locally, every job within memory.
-Each refusal is a SettingError naming the key path, the value and the allowed range."""
+"""The rules between config sections and runs, checked before any job runs, on the typed config
+(pipeline/config.py; the rules a section can see alone are its model's validators): every number
+finite, every case of every section a valid run, ensemble sizes for every N, seeds within int64,
+the lattice and FD-domain experiments, the shear cases, the adaptive searches (each when a target
+first uses it: `Searches`) and, where jobs run locally, every job within memory. Each refusal is a
+SettingError naming the key path, the value and the allowed range.
+
+Each check takes the config as the workflow holds it (a mapping: the case sections, searches and
+scenes are still planned from it by pipeline/sweeps.py, analysis/optimum.py and
+experiments/scene.py) and reads its own values from the typed config, given or parsed here."""
 
 from __future__ import annotations
 
@@ -12,7 +17,9 @@ from collections.abc import Mapping
 from ..core.case import Case, SettingError
 from ..core.labels import case_label
 from ..core.runconfig import FD_MIN_INTERVALS, MAX_SEED, RunConfig, first_step_key
-from ..core.settings import PAPER, SETTINGS
+from ..core.settings import SETTINGS
+from .config import Config
+from .configcheck import parse
 from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
     Ensemble,
@@ -26,17 +33,16 @@ from .sweeps import (
 )
 
 
-def check_lattice(config: Mapping) -> None:
-    """A lattice run needs an odd N and mtpt cases at eta = 1 (random walks leave the lattice)."""
-    mech = config.get("mechanism", {})
-    if "lattice" not in mech:
+def check_lattice(config: Mapping, typed: Config | None = None) -> None:
+    """A lattice run needs mtpt cases at eta = 1 (random walks leave the lattice) that run (its odd
+    N: the Lattice model)."""
+    cfg = typed or parse(config)
+    lattice = cfg.mechanism.lattice if cfg.mechanism else None
+    if lattice is None:
         return
-    n = mech["lattice"]["n"]
-    if int(n) % 2 == 0:
-        raise SettingError("mechanism.lattice.n", n, "an odd integer >= 3, so that a particle sits at x = 0")
-    for i, spec in enumerate(mech["lattice"].get("cases", [])):
+    for i, spec in enumerate(lattice.cases or []):
         try:
-            case = Case.from_spec(spec, int(n), config.get("case_defaults", {}))
+            case = Case.from_spec(spec.model_dump(exclude_unset=True), lattice.n, cfg.case_defaults.model_dump())
             run_config(case, config)
         except SettingError as e:
             raise SettingError(f"mechanism.lattice.cases[{i}].{e.name}", e.value, e.allowed) from None
@@ -49,30 +55,31 @@ def check_lattice(config: Mapping) -> None:
             )
 
 
-def check_fd_domain(config: Mapping) -> None:
+def check_fd_domain(config: Mapping, typed: Config | None = None) -> None:
     """Every grid of `mechanism.fd_domain` runs on every length: an even whole number of intervals
     at dx = physics.fd_length / n (fd_domain.grid_intervals), on a domain the plume fits (RunConfig)."""
-    spec = config.get("mechanism", {}).get("fd_domain")
-    if not spec:
+    cfg = typed or parse(config)
+    spec = cfg.mechanism.fd_domain if cfg.mechanism else None
+    if spec is None:
         return
     from ..experiments.fd_domain import grid_intervals
 
-    physics, fd_dt = config["physics"], float(config["time"]["fd_dt"])
-    ref = float(physics.get("fd_length", PAPER["fd_length"]))
-    settings = {"D": float(physics["D"]), "t_final": float(physics["t_final"]), "dt0": fd_dt}
-    for length in spec["lengths"]:  # a domain the plume fits, whatever the grid
+    ref = cfg.physics.fd_length
+    settings = {"D": cfg.physics.D, "t_final": cfg.physics.t_final, "dt0": cfg.time.fd_dt}
+    raw = config["mechanism"]["fd_domain"]  # the values as written, for the messages
+    for length, written in zip(spec.lengths, raw["lengths"]):  # a domain the plume fits, whatever the grid
         try:
-            cfg = RunConfig.of(method="fd", kernel="implicit", n=FD_MIN_INTERVALS, fd_length=float(length), **settings)
-            cfg.check_domain()
+            run = RunConfig.of(method="fd", kernel="implicit", n=FD_MIN_INTERVALS, fd_length=length, **settings)
+            run.check_domain()
         except SettingError as e:
-            raise SettingError("mechanism.fd_domain.lengths", length, e.allowed) from None
-    for n in spec["n"]:  # each grid as it runs: a dx that resolves the plume
-        for length in spec["lengths"]:
+            raise SettingError("mechanism.fd_domain.lengths", written, e.allowed) from None
+    for n in spec.n:  # each grid as it runs: a dx that resolves the plume
+        for length, written in zip(spec.lengths, raw["lengths"]):
             try:
-                n_int = grid_intervals(int(n), float(length), ref)
-                RunConfig.of(method="fd", kernel="implicit", n=n_int, fd_length=float(length), **settings).check()
+                n_int = grid_intervals(n, length, ref)
+                RunConfig.of(method="fd", kernel="implicit", n=n_int, fd_length=length, **settings).check()
             except SettingError as e:
-                key, value = ("lengths", length) if e.name == "fd_length" else ("n", n)
+                key, value = ("lengths", written) if e.name == "fd_length" else ("n", n)
                 raise SettingError(f"mechanism.fd_domain.{key}", value, e.allowed) from None
 
 
@@ -95,10 +102,10 @@ SHARED_KEYS = {s.name: s.key for s in SETTINGS if s.section in ("physics", "nume
 SHARED_KEYS["dt0"] = lambda case: "time." + first_step_key(case.method, case.dt_growth)
 
 
-def check_seeds(config: Mapping) -> None:
+def check_seeds(config: Mapping, typed: Config | None = None) -> None:
     """Realisation r of every case uses seed base_seed + r, stored as int64 in every table (an
     adaptive search's seeds, up to its max_realisations: check_search)."""
-    base = int(config["base_seed"])
+    base = (typed or parse(config)).base_seed
     counts = [e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)]
     _check_seed_count(base, max(counts, default=1))
 
@@ -126,18 +133,20 @@ def _check_max_realisations(key: str, most: int, base: int) -> None:
         ) from None
 
 
-def check_shear(config: Mapping) -> None:
+def check_shear(config: Mapping, typed: Config | None = None) -> None:
     """Every shear case must build a valid ShearConfig (strip inside the domain, whole steps, ...)."""
-    if "shear" not in config:
+    shear = (typed or parse(config)).shear
+    if shear is None:
         return
     from ..models.shear2d import ShearConfig
 
-    settings = {k: v for k, v in config["shear"].items() if k != "cases"}
-    for case in config["shear"]["cases"]:
+    settings = shear.model_dump(exclude={"cases"})
+    for case in shear.cases:
         try:
             ShearConfig(case=case, **settings)
-        except SettingError as e:
-            raise SettingError(f"shear.{e.name}", e.value, f"{e.allowed} (shear case {case})") from None
+        except SettingError as e:  # named with the value as the config wrote it
+            written = config["shear"].get(e.name, e.value)
+            raise SettingError(f"shear.{e.name}", written, f"{e.allowed} (shear case {case})") from None
 
 
 class Searches(Mapping):
@@ -176,7 +185,7 @@ def optimum_largest_jobs(search) -> list[Ensemble]:
     return [Ensemble(search.case_at(x), seeds) for x in search.grid(2)]
 
 
-def check_memory(config: Mapping, available: float) -> None:
+def check_memory(config: Mapping, available: float, typed: Config | None = None) -> None:
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
     of its seed block; each run of the lattice floors; the shear jobs: shear_memory_mb; an adaptive
     search's jobs: check_search)."""
@@ -188,7 +197,7 @@ def check_memory(config: Mapping, available: float) -> None:
     # the floors job runs its lattice cases one after another in one process: each must fit
     jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(config)]
     _check_jobs_fit(jobs, config, available)
-    if "shear" in config:
+    if (typed or parse(config)).shear is not None:
         need = shear_memory_mb(config) * 2**20
         if need > available:
             raise SettingError(
@@ -280,46 +289,39 @@ def check_optimum(config: Mapping, available: float | None = None) -> None:
         check_search(name, config, available)
 
 
-def check_sweeps(config: Mapping) -> None:
-    """Checks the JSON schema cannot express, before any job runs: every number finite, every
-    case of every section must build a valid run (kernel for its method, dimensions that apply,
-    FD grids, explicit FD stability, an ensemble size for each N). The message names the
-    section, key and value."""
-    check_finite(config)
-    seen: dict[int, int] = {}
-    for i, entry in enumerate(config.get("realisations", [])):
-        n = int(entry["n"])
-        if n in seen:
-            raise SettingError(f"realisations[{i}].n", n, f"each N once (also at realisations[{seen[n]}])")
-        seen[n] = i
-    for key, value in config.get("claims", {}).items():
-        if isinstance(value, (list, tuple)) and len(value) == 2 and value[0] > value[1]:
-            raise SettingError(f"claims.{key}", list(value), "a range [low, high] with low <= high")
-    for name, spec in case_sections(config).items():
-        for i, c in enumerate(spec["cases"]):
+def check_sweeps(config: Mapping, typed: Config | None = None) -> None:
+    """Checks between sections and runs, before any job runs: every number finite, every case of
+    every section must build a valid run (kernel for its method, dimensions that apply, FD grids,
+    explicit FD stability, an ensemble size for each N), the lattice, the FD domains, the seeds and
+    the shear cases. ``typed``: the config's typed form (validate_config), else parsed here. The
+    message names the section, key and value."""
+    check_finite(config)  # first: a config not yet parsed (common.smk) has its .nan named so
+    cfg = typed or parse(config)
+    defaults = cfg.case_defaults.model_dump()
+    for name, spec in cfg.case_sections().items():
+        for i, c in enumerate(spec.cases):
             where = f"{name}.cases[{i}]"
             case = None
             try:
-                for n in spec["n"]:
-                    case = Case.from_spec(c, int(n), config.get("case_defaults", {}))
+                for n in spec.n:
+                    case = Case.from_spec(c.model_dump(exclude_unset=True), n, defaults)
                     run_config(case, config)
             except SettingError as e:
                 raise _case_error(e, where, case) from None  # a shared setting names its key and the case
-        particles = any(c.get("method") != "fd" for c in spec["cases"])  # FD runs once whatever the ensemble
-        for n in spec["n"] if particles else []:
+        particles = any(c.method != "fd" for c in spec.cases)  # FD runs once whatever the ensemble
+        for n in spec.n if particles else []:
             try:
-                realisations_for(spec, int(n), config)
+                realisations_for(spec.model_dump(exclude_none=True), n, config)
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
-    check_lattice(config)
-    check_fd_domain(config)
-    check_seeds(config)
-    check_shear(config)  # the optimum searches are checked when a target uses them (Searches)
-    t_final = float(config["physics"]["t_final"])
-    for key, times in (
-        ("comic_times", config.get("comic_times", [])),
-        ("tradeoff.times", config.get("tradeoff", {}).get("times", [])),
-    ):
-        for t in times:
-            if not (math.isfinite(float(t)) and 0 <= float(t) <= t_final):
-                raise SettingError(key, t, f"a time in [0, physics.t_final = {t_final:g}]")
+    check_lattice(config, cfg)
+    check_fd_domain(config, cfg)
+    check_seeds(config, cfg)
+    check_shear(config, cfg)  # the optimum searches are checked when a target uses them (Searches)
+    t_final = cfg.physics.t_final
+    written = {"comic_times": config["comic_times"], "tradeoff.times": config.get("tradeoff", {}).get("times", [])}
+    times = [("comic_times", cfg.comic_times), ("tradeoff.times", cfg.tradeoff.times if cfg.tradeoff else [])]
+    for key, values in times:
+        for t, as_written in zip(values, written[key]):
+            if not 0 <= t <= t_final:
+                raise SettingError(key, as_written, f"a time in [0, physics.t_final = {t_final:g}]")

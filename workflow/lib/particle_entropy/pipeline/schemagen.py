@@ -1,56 +1,37 @@
-"""Write the config schema's entries from their one declaration (core/settings.py).
+"""Write the config schema (workflow/schemas/config.schema.yaml), the whole file, from the typed config.
 
-The schema (workflow/schemas/config.schema.yaml) is hand-written except between the lines
-``# BEGIN generated: <block>`` and ``# END generated: <block>``: there this module writes, from
-the declarations of core/settings.py, the registry and the list of figures (figures.FIGURES),
-the entries of physics, time, numerics and case_defaults, the $defs of the case dimensions and
-of a section of cases, and the whole objects of figures, tradeoff, mechanism, shear, an adaptive
-search, a scene, the Peclet sweep (its base a scene without v) and a `realisations` entry (type,
-range or enum, default, description, required keys).
-What stays hand-written is the frame: the top-level keys and the few rules between keys a schema
-can say (a search's budget and range). Snakemake reads the schema from a file, so the generated
-lines are committed; ``python -m particle_entropy.pipeline.schemagen --check`` (and
-tests/test_settings.py) fails when they are stale, ``--write`` rewrites them.
+The schema is a rendering of the section models of pipeline/config.py (themselves derived from the
+declarations of core/settings.py): each model an object (its docstring the description, unknown
+keys refused, its required keys), each field its type, range or enum, default and description,
+the shared definitions ($defs: a case's dimensions, a case, the lists of cases and of N, a
+section of cases) referenced where a field has their type. Nothing in it is written by hand.
+Snakemake reads the schema from a file (common.smk: ``validate``), so the file is committed;
+``python -m particle_entropy.pipeline.schemagen --check`` (and tests/test_settings.py) fails when
+it is stale, ``--write`` rewrites it.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 import sys
-from dataclasses import replace
+import types
+import typing
 from pathlib import Path
 
+import annotated_types as at
+from pydantic import BaseModel, StrictBool, StrictInt
+from pydantic.fields import FieldInfo
+
 from ..core.case import NONE
-from ..core.registry import ALL_KERNELS, METHODS, PRESETS
-from ..core.settings import (
-    BY_KEY,
-    CASE_SECTION,
-    CASE_SETTINGS,
-    CLAIMS,
-    COMIC_TIMES,
-    FIGURE_OPTIONS,
-    MAX_REALISATIONS,
-    MECHANISM,
-    REALISATIONS_DOC,
-    REALISATIONS_ENTRY,
-    SCENE,
-    SCENES_PECLET,
-    SEARCH,
-    SECTION_DOCS,
-    SEEDS,
-    SETTINGS,
-    SHEAR,
-    TRADEOFF,
-    Setting,
-)
-from ..figures import PAPER_FIGURES
+from ..core.settings import SETTINGS, UNIQUE
+from . import config as typed
 from .configcheck import SCHEMA_PATH
 
 COMMAND = "python -m particle_entropy.pipeline.schemagen --write"
-_BLOCK = re.compile(r"^([ \t]*)# BEGIN generated: (\w+)\n.*?^[ \t]*# END generated: \2\n", re.M | re.S)
+HEADER = f"# Generated from pipeline/config.py (core/settings.py) by `{COMMAND}`; do not edit.\n"
+FLOW_DEPTH = 3  # mappings nested deeper than this, and every entry of a setting, are written on one line
 
 
 def _yaml(value) -> str:
@@ -62,7 +43,7 @@ def _yaml(value) -> str:
             text = text.replace("e", ".0e", 1)
         return text
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{k}: {_yaml(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{_yaml(k)}: {_yaml(v)}" for k, v in value.items()) + "}"
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_yaml(v) for v in value) + "]"
     if isinstance(value, str) and not re.fullmatch(r"[A-Za-z_][\w-]*", value):
@@ -70,221 +51,265 @@ def _yaml(value) -> str:
     return str(value) if not isinstance(value, bool) else str(value).lower()
 
 
-def _number(value: float):
-    return int(value) if float(value).is_integer() else value
-
-
-def description(s: Setting) -> str:
-    """The schema's description: the meaning, the unit and the allowed values (configcheck
-    quotes it when a value is refused)."""
-    unit = "" if s.unit == "-" else f" [{s.unit}]"
-    return f"{s.doc[0].upper()}{s.doc[1:]}{unit}; {s.allowed()}."
+def _number(value):
+    return int(value) if isinstance(value, float) and value.is_integer() else value
 
 
 class Block(dict):
     """A mapping the schema writes in block style, one key a line (other mappings: flow style)."""
 
 
-def entry(s: Setting, default: bool = True) -> dict:
-    """The JSON-schema entry of one setting."""
-    out: dict = {}
-    if s.kind == "shape":
-        out = dict(s.shape)
-    elif s.kind == "boolean":
-        out = {"type": "boolean"}
-    elif s.choices is not None:
-        out = {"type": "string", "enum": list(s.choices)}
-    else:
-        number = {"type": "integer" if s.kind == "integer" else "number"}
-        if s.low is not None and s.low != -math.inf:
-            number["exclusiveMinimum" if s.open_low else "minimum"] = _number(s.low)
-        if s.high != math.inf:
-            number["maximum"] = _number(s.high)
-        out = {"oneOf": [{"type": "string", "enum": [NONE]}, number]} if s.none else number
-    if default and s.has_default and "$ref" not in out:  # a referenced definition carries its own default
-        out["default"] = NONE if s.none and s.default is None else s.default
-    out["description"] = description(s)
+_BOUNDS = {at.Gt: ("exclusiveMinimum", "gt"), at.Ge: ("minimum", "ge"), at.Le: ("maximum", "le")}
+_LENGTHS = {at.MinLen: ("minItems", "min_length"), at.MaxLen: ("maxItems", "max_length")}
+
+
+def _constraints(metadata) -> dict:
+    """The JSON-schema keywords of pydantic's constraints (bounds, lengths, uniqueness)."""
+    out = {}
+    for m in metadata:
+        if isinstance(m, FieldInfo):
+            out.update(_constraints(m.metadata))
+        for kinds in (_BOUNDS, _LENGTHS):
+            if type(m) in kinds:
+                key, attr = kinds[type(m)]
+                out[key] = _number(getattr(m, attr))
+        if m is UNIQUE:
+            out["uniqueItems"] = True
     return out
 
 
-def object_body(section: str, settings) -> Block:
-    """The schema of the object at config key ``section``: its meaning (settings.SECTION_DOCS),
-    an entry per setting directly in it, the objects nested in it (``section.sub``, in the order
-    of their first setting) and the keys it requires."""
-    props, required = Block(), []
-    for s in settings:
-        if s.section == section:
-            props[s.name] = entry(s)
-            if s.required:
-                required.append(s.name)
-        elif s.section.startswith(section + "."):
-            sub = s.section[len(section) + 1 :].split(".")[0]
-            if sub not in props:
-                props[sub] = object_body(f"{section}.{sub}", settings)
-    out = Block(type="object", description=SECTION_DOCS[section], additionalProperties=False, properties=props)
-    if required:
-        out["required"] = required
-    return out
+class Writer:
+    """The schema of the models of ``build(settings)``: ``entry`` of a type, ``body`` of a model."""
+
+    def __init__(self, settings: tuple):
+        self.m = typed.build(settings)
+        self.names = {id(t): name for name, t in self.m.defs.items()}
+
+    def _inline(self, tp) -> bool:
+        """Whether ``tp`` is a section model written in place (not a shared definition, not a shape)."""
+        return _is_model(tp) and not issubclass(tp, typed._OneOf) and self.ref(tp) is None
+
+    def ref(self, tp) -> dict | None:
+        name = self.names.get(id(tp))
+        return None if name is None else {"$ref": f"#/$defs/{name}"}
+
+    def entry(self, tp, metadata=(), top: bool = False) -> dict:
+        """The JSON-schema entry of a value of type ``tp`` (constraints ``metadata``); a shared
+        definition is referenced unless ``top`` (its own entry in $defs)."""
+        if not top and (ref := self.ref(tp)) is not None:
+            return ref
+        origin, args = typing.get_origin(tp), typing.get_args(tp)
+        if origin is typing.Annotated:
+            return self.entry(args[0], [*args[1:], *metadata])
+        if origin in (typing.Union, types.UnionType):
+            kinds = [a for a in args if a is not type(None)]
+            if len(kinds) == 1:  # optional: the key may be left out
+                return self.entry(kinds[0], metadata)
+            return {"oneOf": [self.entry(a) for a in kinds]}
+        if origin is typing.Literal:
+            return {"type": "string", "enum": list(args)}
+        if origin is list:
+            return {"type": "array", "items": self.entry(args[0]), **_constraints(metadata)}
+        if tp in (int, StrictInt):
+            return {"type": "integer", **_constraints(metadata)}
+        if tp is float:
+            return {"type": "number", **_constraints(metadata)}
+        if tp in (bool, StrictBool):
+            return {"type": "boolean"}
+        if tp is dict:
+            return {"type": "object"}
+        if origin is dict:  # keys of an enum, each with a value of one type
+            keys = self.entry(args[0])
+            return {"type": "object", "propertyNames": keys, "additionalProperties": self.entry(args[1])}
+        if isinstance(tp, type) and issubclass(tp, BaseModel):
+            return self.body(tp, flow=True)
+        raise TypeError(f"no schema entry for {tp!r}")
+
+    def field(self, info: FieldInfo) -> dict:
+        """A field's entry, its default (a required key's documented one too) and description."""
+        extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+        out = {"$ref": extra["ref"]} if "ref" in extra else dict(self.entry(info.annotation, info.metadata))
+        default = extra.get("default", info.default)
+        if "$ref" in out:  # the referenced definition carries its own default
+            default = None
+        if default is not None and repr(default) != "PydanticUndefined":
+            out["default"] = NONE if default is None else default
+        if info.description:
+            out["description"] = info.description
+        return out
+
+    def body(self, model, flow: bool = False) -> dict:
+        """The object of a section model: its meaning, a key per field, the keys it requires."""
+        props = {}
+        for name, info in model.model_fields.items():
+            tp = info.annotation
+            nested = [t for t in _members(tp) if _is_model(t) and not issubclass(t, typed._OneOf)]
+            if model is self.m.CaseDefaults:  # each dimension: its $defs entry and its default
+                props[name] = {"$ref": f"#/$defs/{name}", "default": NONE if info.default is None else info.default}
+            elif nested and self._inline(nested[0]) and not flow:
+                props[name] = self.body(nested[0])
+                extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+                if "default" in extra:  # written after the type
+                    props[name] = Block(
+                        type="object", default=extra["default"], **{k: v for k, v in props[name].items() if k != "type"}
+                    )
+                if info.description and nested[0].__doc__ != info.description:
+                    props[name]["description"] = info.description
+            elif typing.get_origin(tp) is dict and _is_model(typing.get_args(tp)[1]):  # one per name
+                pattern = typing.get_args(typing.get_args(tp)[0])[1].metadata[0].pattern
+                value = typing.get_args(tp)[1]
+                props[name] = Block(
+                    type="object",
+                    description=info.description,
+                    additionalProperties=False,
+                    patternProperties=Block({pattern: self.body(value)}),
+                )
+            elif typing.get_origin(tp) is list and self._inline(typing.get_args(tp)[0]) and not flow:
+                item = typing.get_args(tp)[0]
+                props[name] = Block(type="array", description=info.description, items=self.body(item))
+            else:
+                props[name] = self.field(info)
+        shape = issubclass(model, typed._OneOf)  # a structured value's mapping: described by its field
+        out = {"type": "object", "description": _doc(model), "additionalProperties": False, "properties": props}
+        if shape:
+            del out["description"]
+        required = [n for n, info in model.model_fields.items() if info.is_required()]
+        if required:
+            out["required"] = required
+        if shape and model.one_of:
+            out["oneOf"] = [{"required": [k]} for k in model.one_of]
+        extra = model.model_config.get("json_schema_extra")
+        if isinstance(extra, dict):
+            out.update(extra)
+        return out if flow else Block(out, properties=Block(props))
+
+    def schema(self) -> Block:
+        """The whole schema: the config's object and the shared definitions."""
+        out = Block({"$schema": "https://json-schema.org/draft/2020-12/schema"})
+        out.update(self.body(self.m.Config))
+        defs = Block()
+        for name, tp in self.m.defs.items():
+            if _is_model(tp):
+                defs[name] = self.body(tp)
+                continue
+            entry = self.entry(tp, top=True)
+            if name in typed.DEF_DOCS:
+                entry = {"description": typed.DEF_DOCS[name], **entry}
+            if name == "realisations":
+                entry = {**entry, "default": 1}
+            setting = typed.BY_KEY.get(f"case_defaults.{name}")
+            if setting is not None:
+                entry["description"] = typed.description(setting)
+            defs[name] = entry
+        out["$defs"] = defs
+        return out
 
 
-def case_section(section: str, extra=()) -> tuple[Setting, ...]:
-    """The settings of a section of cases at config key ``section`` (settings.CASE_SECTION), and ``extra``."""
-    return tuple(replace(s, key=f"{section}.{s.name}") for s in CASE_SECTION) + tuple(extra)
+def _members(tp) -> list:
+    """The types a value of type ``tp`` may have (Annotated and unions unwrapped)."""
+    origin = typing.get_origin(tp)
+    if origin is typing.Annotated:
+        return _members(typing.get_args(tp)[0])
+    if origin in (typing.Union, types.UnionType):
+        return [m for a in typing.get_args(tp) for m in _members(a)]
+    return [tp]
 
 
-def figures_body() -> Block:
-    """The `figures` object: one entry per paper figure (figures.PAPER_FIGURES), a section of cases
-    with the figure's drawing options where it has some (settings.FIGURE_OPTIONS)."""
-    props = Block()
-    for fig in PAPER_FIGURES:
-        options = [s for s in FIGURE_OPTIONS if s.section == f"figures.{fig}"]
-        if options:
-            body = object_body(
-                "<section>", case_section("<section>", [replace(s, key=f"<section>.{s.name}") for s in options])
-            )
-            props[fig] = body
-        else:
-            props[fig] = {"$ref": "#/$defs/case_section"}
-    return Block(type="object", description=SECTION_DOCS["figures"], additionalProperties=False, properties=props)
+def _is_model(tp) -> bool:
+    return isinstance(tp, type) and issubclass(tp, BaseModel)
 
 
-def peclet_body() -> Block:
-    """The `scenes_peclet` object: its base is a scene's object without v (the sweep sets it), so
-    that a typo there is refused as it is under scenes.<name>."""
-    body = object_body("scenes_peclet", SCENES_PECLET)
-    base = object_body("scenes.<name>", [s for s in SCENE if s.name != "v"])
-    base["description"] = description(BY_KEY["scenes_peclet.base"])
-    body["properties"]["base"] = base
-    return body
+def _doc(model) -> str:
+    return " ".join((model.__doc__ or "").split())
 
 
-def blocks() -> dict[str, Block]:
-    """Every generated block: its keys and their values, as the schema writes them."""
-    out: dict[str, list[tuple[str, dict]]] = {"physics": [], "time": [], "numerics": [], "case_defaults": []}
-    defs = [
-        ("method", {"type": "string", "enum": list(METHODS), "description": "pt, mtpt or fd (registry.METHODS)."}),
-        (
-            "kernel",
-            {"type": "string", "enum": list(ALL_KERNELS), "description": "The method's kernel (registry.KERNELS)."},
-        ),
-    ]
-    presets = "; ".join(
-        f"{k}: {', '.join(f'{d} {v:g}' if isinstance(v, float) else f'{d} {v}' for d, v in dims.items())}"
-        for k, dims in PRESETS.items()
-    )
-    defs.append(
-        (
-            "preset",
-            {
-                "type": "string",
-                "enum": list(PRESETS),
-                "description": f"Named case dimensions (registry.PRESETS; a dimension the case sets wins): {presets}.",
-            },
-        )
-    )
-    for s in SETTINGS:
-        key = s.key.split(".", 1)[1]
-        if s.section == "case_defaults":
-            defs.append((key, entry(s, default=False)))
-            d = NONE if s.none and s.default is None else s.default
-            out["case_defaults"].append((key, {"$ref": f"#/$defs/{key}", "default": d}))
-        else:
-            out[s.section].append((key, entry(s)))
-    case = {k: {"$ref": f"#/$defs/{k}"} for k in ("method", "kernel", "preset", *CASE_SETTINGS)}
-    defs.append(
-        (
-            "case",
-            Block(
-                type="object",
-                description=f"One model: method and kernel, and the dimensions {', '.join(CASE_SETTINGS)} that apply "
-                "to it "
-                "(unset ones come from case_defaults).",
-                additionalProperties=False,
-                properties=Block(case),
-                required=["method", "kernel"],
-            ),
-        )
-    )
-    defs.append(("case_section", object_body("<section>", CASE_SECTION)))
-    defs.append(
-        (
-            "realisations",
-            {
-                "description": f"Realisations per N, {REALISATIONS_DOC}.",
-                "default": BY_KEY["<section>.realisations"].default,
-                "oneOf": [
-                    {"type": "integer", "minimum": 1, "maximum": MAX_REALISATIONS},
-                    {"type": "string", "enum": ["ensemble"]},
-                ],
-            },
-        )
-    )
-    out["defs"] = defs
-    generated = {name: Block(pairs) for name, pairs in out.items()}
-    generated["seeds"] = Block(base_seed=entry(SEEDS[0]), seed_blocks=object_body("seed_blocks", SEEDS))
-    generated["comic_times"] = Block(comic_times=entry(COMIC_TIMES[0]))
-    generated["claims"] = object_body("claims", CLAIMS)
-    generated["figures"] = figures_body()
-    generated["tradeoff"] = object_body("tradeoff", case_section("tradeoff", TRADEOFF))
-    generated["mechanism"] = object_body("mechanism", MECHANISM)
-    generated["shear"] = object_body("shear", SHEAR)
-    generated["search"] = object_body("optimum.<name>", SEARCH)
-    generated["scene"] = object_body("scenes.<name>", SCENE)
-    generated["scenes_peclet"] = peclet_body()
-    generated["realisations_entry"] = Block(items=object_body("realisations[]", REALISATIONS_ENTRY))
-    return generated
-
-
-def _lines(block: Block, indent: str) -> list[str]:
-    """``block`` as schema lines at ``indent``: nested Blocks in block style, other values in flow style."""
+def _lines(block: dict, indent: str = "") -> list[str]:
+    """``block`` as schema lines at ``indent``: Blocks in block style, other values in flow style."""
     out = []
     for key, value in block.items():
         if isinstance(value, Block):
-            out += [f"{indent}{key}:\n", *_lines(value, indent + "  ")]
+            out += [f"{indent}{_yaml(key)}:\n", *_lines(value, indent + "  ")]
         else:
-            out.append(f"{indent}{key}: {_yaml(value)}\n")
+            out.append(f"{indent}{_yaml(key)}: {_yaml(value)}\n")
     return out
 
 
-def render(text: str) -> str:
-    """``text`` (the schema) with every generated block written afresh."""
-    generated = blocks()
-    seen = set()
+def _cell(value) -> str:
+    return str(value).replace("|", "\\|").replace("\n", " ")
 
-    def fill(match: re.Match) -> str:
-        indent, name = match.group(1), match.group(2)
-        if name not in generated:
-            raise ValueError(f"schema block {name!r} is not one this module writes: {', '.join(generated)}")
-        seen.add(name)
-        lines = [f"{indent}# BEGIN generated: {name} (from core/settings.py by `{COMMAND}`; do not edit)\n"]
-        lines += _lines(generated[name], indent)
-        return "".join(lines) + f"{indent}# END generated: {name}\n"
 
-    out = _BLOCK.sub(fill, re.sub(r"# BEGIN generated: (\w+) \(.*\)\n", r"# BEGIN generated: \1\n", text))
-    missing = set(generated) - seen
-    if missing:
-        raise ValueError(f"the schema has no generated block for {', '.join(sorted(missing))}")
-    return out
+def docs(settings: tuple = SETTINGS) -> str:
+    """docs/config.md: a table per section (each model once, at the first key it sits at) of its
+    keys, defaults, units and meanings with their allowed values."""
+    m = typed.build(settings)
+    names = {id(t): f"$defs.{n}" for n, t in m.defs.items()}
+    out = [
+        "# Config settings\n\n",
+        f"Generated from the typed config (pipeline/config.py, declared in core/settings.py) by `{COMMAND}`;\n",
+        "do not edit. `workflow/schemas/config.schema.yaml` is generated from the same models.\n",
+    ]
+    seen, todo = set(), [("config", m.Config)]
+    while todo:
+        path, model = todo.pop(0)
+        if id(model) in seen:
+            continue
+        seen.add(id(model))
+        out += [f"\n## `{names.get(id(model), path)}`\n\n{_doc(model)}\n\n"]
+        out += ["| key | default | unit | meaning; allowed values |\n", "|---|---|---|---|\n"]
+        nested = []
+        for name, info in model.model_fields.items():
+            tp = info.annotation
+            inner = typing.get_args(tp)[1] if typing.get_origin(tp) is dict else tp
+            inner = typing.get_args(inner)[0] if typing.get_origin(inner) is list else inner
+            models = [t for t in _members(inner) if _is_model(t) and not issubclass(t, typed._OneOf)]
+            where = f"{path}.{name}" if path != "config" else name
+            if models:
+                key = where + (".<name>" if typing.get_origin(tp) is dict else "[]" if inner is not tp else "")
+                nested.append((key, models[0]))
+                shown = names.get(id(models[0]), key)
+                out.append(
+                    f"| `{name}` | | | section `{shown}`{': ' + info.description if info.description else ''} |\n"
+                )
+                continue
+            extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+            default = extra.get("default", info.default)
+            default = "" if default is None or repr(default) == "PydanticUndefined" else f"`{_yaml(default)}`"
+            if info.is_required():
+                default = (default + " " if default else "") + "(required)"
+            unit = "" if extra.get("unit", "-") == "-" else extra["unit"]
+            out.append(f"| `{name}` | {_cell(default)} | {_cell(unit)} | {_cell(info.description or '')} |\n")
+        todo += nested
+    return "".join(out)
+
+
+def render(text: str = "") -> str:
+    """The schema's text, written afresh from the models (``text``, the file as it stands, is not
+    read: nothing in it is kept)."""
+    return HEADER + "".join(_lines(Writer(SETTINGS).schema()))
+
+
+DOCS_PATH = SCHEMA_PATH.parents[2] / "docs" / "config.md"
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m particle_entropy.pipeline.schemagen", description=__doc__)
-    p.add_argument("--check", action="store_true", help="exit 1 when the schema's generated lines are stale")
-    p.add_argument("--write", action="store_true", help="rewrite the generated lines in place")
+    p.add_argument("--check", action="store_true", help="exit 1 when the schema file or the docs table is stale")
+    p.add_argument("--write", action="store_true", help="rewrite the schema file and the docs table")
     p.add_argument("--schema", default=str(SCHEMA_PATH), help="schema file (default: the workflow's)")
+    p.add_argument("--docs", default=str(DOCS_PATH), help="docs table of the settings (default: docs/config.md)")
     a = p.parse_args(argv)
-    path = Path(a.schema)
-    text = path.read_text(encoding="utf-8")
-    new = render(text)
-    if a.write:
-        if new != text:
+    stale = []
+    for path, new in ((Path(a.schema), render()), (Path(a.docs), docs())):
+        text = path.read_text(encoding="utf-8") if path.exists() else ""
+        if a.write and new != text:
             path.write_text(new, encoding="utf-8")
-        return 0
-    if a.check and new != text:
-        print(f"{path}: the generated settings are stale; run `{COMMAND}`", file=sys.stderr)
+        elif new != text:
+            stale.append(path)
+        if not (a.write or a.check) and path == Path(a.schema):
+            sys.stdout.write(new)
+    if a.check and stale:
+        print(f"{', '.join(map(str, stale))}: stale; run `{COMMAND}`", file=sys.stderr)
         return 1
-    if not a.check:
-        sys.stdout.write(new)
     return 0
 
 
