@@ -301,7 +301,10 @@ def test_shear_n_is_checked_against_memory_by_arithmetic():
     The estimate is arithmetic, so a dry run and check-config refuse it at once, naming shear.n."""
     import time
 
+    from particle_entropy.pipeline.config import build
     from particle_entropy.pipeline.memory import shear_memory_mb
+
+    shear_section = build().Shear
 
     cfg = copy.deepcopy(BASE)
     check_config(cfg, available=24e9)
@@ -311,9 +314,9 @@ def test_shear_n_is_checked_against_memory_by_arithmetic():
         check_config(cfg, available=24e9)
     assert time.perf_counter() - start < 5.0
     # pairs grow as N^2: four times the particles, about sixteen times the pair memory
-    small, large = (shear_memory_mb({**BASE, "shear": {**BASE["shear"], "n": n}}) for n in (10**6, 4 * 10**6))
+    small, large = (shear_memory_mb(shear_section(**{**BASE["shear"], "n": n})) for n in (10**6, 4 * 10**6))
     assert 14 < (large - 300) / (small - 300) < 17
-    no_mt = {**BASE, "shear": {**BASE["shear"], "n": 10**6, "cases": ["rw_drift"]}}
+    no_mt = shear_section(**{**BASE["shear"], "n": 10**6, "cases": ["rw_drift"]})
     assert shear_memory_mb(no_mt) < 1000  # random walks only: no pairs
 
 

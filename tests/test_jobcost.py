@@ -11,6 +11,7 @@ from conftest import ROOT, run_snakemake
 
 from particle_entropy.core.case import Case
 from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.pipeline.config import build
 from particle_entropy.pipeline.jobcost import estimated_seconds, pairs_per_step, shear_seconds
 from particle_entropy.pipeline.sweeps import run_config
 
@@ -61,7 +62,7 @@ def test_the_paper_run_s_longest_jobs_come_first_in_its_order():
 
 
 def test_the_shear_estimate_puts_mass_transfer_first():
-    shear = CONFIG["shear"]
+    shear = build().Shear(**CONFIG["shear"])
     assert shear_seconds("mt", shear) > 5 and shear_seconds("mt", shear) > 20 * shear_seconds("rw_drift", shear)
 
 

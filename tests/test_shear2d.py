@@ -260,6 +260,7 @@ def test_shear_memory_estimate_is_above_a_measured_peak():
 
     import yaml
 
+    from particle_entropy.pipeline.config import build
     from particle_entropy.pipeline.memory import shear_memory_mb
 
     shear = {**yaml.safe_load(open("config.yaml"))["shear"], "n": 80_000, "t_final": 2, "cases": ["mt"]}
@@ -270,6 +271,6 @@ def test_shear_memory_estimate_is_above_a_measured_peak():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     peak = int(out.stdout.split()[-1]) * 1024  # kB
-    estimate = shear_memory_mb({"shear": shear}) * 2**20
+    estimate = shear_memory_mb(build().Shear(**shear)) * 2**20
     assert peak > 350e6  # the pairs do cost memory: the check is not vacuous
     assert peak < estimate < 3 * peak

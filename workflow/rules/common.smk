@@ -44,8 +44,10 @@ from particle_entropy.pipeline.verify import CRATE_DIR
 AVAILABLE = available_bytes() if workflow.is_main_process and workflow.local_exec else None
 # The merged config (config.yaml, --configfile, --config) checked and its defaults filled in, each
 # problem in one short message naming its key path (pipeline/configcheck.check_parsed_config).
+# CONFIG: the same config parsed once, typed (pipeline/config.py), which the planning reads; the
+# mapping `config` stays what rule params that Snakemake records read as written.
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
-check_parsed_config(config, workflow.config_settings.config, SCHEMA, validate, AVAILABLE)
+CONFIG = check_parsed_config(config, workflow.config_settings.config, SCHEMA, validate, AVAILABLE)
 # The adaptive COMIC searches (workflow/rules/optimum.smk), by name; each is checked when a
 # requested target first needs it, so a config layered over config.yaml's searches runs.
 OPTIMUM = optimum_searches(config, AVAILABLE)

@@ -15,11 +15,11 @@ if "shear" in config:  # Fig. 10 exists only with a shear section
             "results/benchmarks/simulate_shear/{case}/seed~{seed}.tsv"
         wildcard_constraints:
             case="|".join(SHEAR_CASES),
-        priority: lambda w: shear_seconds(w.case, config["shear"])  # the longest first
+        priority: lambda w: shear_seconds(w.case, CONFIG.shear)  # the longest first
         conda:
             "../../envs/particle-entropy.yaml"
         resources:
-            mem_mb=max(2000, shear_memory_mb(config)),
+            mem_mb=max(2000, shear_memory_mb(CONFIG.shear)),
             runtime=10,
         params:
             **{k: config["shear"][k] for k in SHEAR_PARAMS if k in config.get("shear", {})},

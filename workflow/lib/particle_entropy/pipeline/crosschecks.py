@@ -28,7 +28,6 @@ from .sweeps import (
     lattice_cases,
     realisations_for,
     run_config,
-    shear_n,
     spec_ensembles,
 )
 
@@ -197,12 +196,13 @@ def check_memory(config: Mapping, available: float, typed: Config | None = None)
     # the floors job runs its lattice cases one after another in one process: each must fit
     jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(config)]
     _check_jobs_fit(jobs, config, available)
-    if (typed or parse(config)).shear is not None:
-        need = shear_memory_mb(config) * 2**20
+    shear = (typed or parse(config)).shear
+    if shear is not None:
+        need = shear_memory_mb(shear) * 2**20
         if need > available:
             raise SettingError(
                 "shear.n",
-                shear_n(config),
+                shear.n,
                 f"an N whose shear job fits in this machine's memory: it needs about {need / 1e9:.3g} GB, "
                 f"{available / 1e9:.1f} GB are available (or run it on a cluster)",
             )

@@ -53,9 +53,7 @@ def estimated_seconds(cfg: RunConfig, seeds: int = 1) -> float:
 SHEAR_PARTICLE_STEP_S = {"mt": 1.2e-6, "rw_nodrift": 1e-8, "rw_drift": 1e-8}
 
 
-def shear_seconds(case: str, shear: dict) -> float:
-    """Estimated seconds of one shear job (config `shear`, settings.SHEAR defaults where unset)."""
-    from ..core.settings import SHEAR, defaults
-
-    s = defaults(SHEAR) | dict(shear)
-    return SHEAR_PARTICLE_STEP_S[case] * float(s["n"]) * float(s["t_final"]) / float(s["dt"])
+def shear_seconds(case: str, shear) -> float:
+    """Estimated seconds of one shear job of the typed section ``shear`` (Config.shear, its
+    defaults filled in by its model)."""
+    return SHEAR_PARTICLE_STEP_S[case] * float(shear.n) * float(shear.t_final) / float(shear.dt)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
 
 from ..core.runconfig import RunConfig
 from ..core.timegrid import step_count
@@ -57,19 +56,18 @@ SHEAR_PAIR_BYTES = 64.0
 SHEAR_PARTICLE_BYTES = 400.0
 
 
-def shear_memory_mb(config: Mapping) -> int:
-    """Estimated peak memory of the largest shear job (Fig. 10), in MB, by arithmetic: the base of
+def shear_memory_mb(shear) -> int:
+    """Estimated peak memory of the largest shear job (Fig. 10) of the typed section ``shear``
+    (pipeline/config.py: Config.shear), in MB, by arithmetic: the base of
     every run (memory.BASE_BYTES), its particles' arrays and, for mass transfer, its neighbour pairs:
     N^2 / 2 x the kernel's share of the domain, pi s_c^2 / (L / sqrt(alpha_L) / sqrt(alpha_T)) in
     scaled distance (2 s_c / (L / sqrt(alpha_L)) for alpha_T = 0; shear2d.kernel_cutoff)."""
     from ..models.shear2d import ShearConfig, kernel_cutoff
-    from .sweeps import shear_n
 
-    shear = config["shear"]
-    n = float(shear_n(config))
+    n = float(shear.n)
     need = BASE_BYTES + SHEAR_PARTICLE_BYTES * n
-    if "mt" in shear["cases"]:
-        cfg = ShearConfig(case="mt", **{k: v for k, v in shear.items() if k not in ("cases", "n")})
+    if "mt" in shear.cases:
+        cfg = ShearConfig(case="mt", **shear.model_dump(exclude={"cases", "n"}))
         cut, width = kernel_cutoff(cfg), cfg.length / math.sqrt(cfg.alpha_L)
         share = math.pi * cut**2 / (width / math.sqrt(cfg.alpha_T)) if cfg.alpha_T > 0 else 2.0 * cut / width
         need += SHEAR_PAIR_BYTES * n * n / 2.0 * min(share, 1.0)

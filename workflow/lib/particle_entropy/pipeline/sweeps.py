@@ -146,10 +146,3 @@ def run_settings(case: Case, config: Mapping) -> dict:
 def run_config(case: Case, config: Mapping, seed: int = 0) -> RunConfig:
     """The checked RunConfig of one realisation of ``case``."""
     return RunConfig.for_case(case, seed=seed, **run_settings(case, config)).resolved()
-
-
-def shear_n(config: Mapping) -> int:
-    """The shear section's particle count (ShearConfig's default when the section leaves it out)."""
-    from ..models.shear2d import ShearConfig
-
-    return config["shear"].get("n", ShearConfig.n)
