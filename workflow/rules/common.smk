@@ -69,7 +69,7 @@ DRY_RUN = bool(getattr(workflow.output_settings, "dryrun", False))  # from a pro
 CORRUPT = preflight(DRY_RUN, sys.argv, workflow.local_exec, LIB, WorkflowError) if workflow.is_main_process else []
 RUN_RECORDS = []  # the record of this run of jobs (Snakefile: onstart), ended on success or error
 
-INPUTS = inputs.Inputs(config, WorkflowError)  # the rules' input, params and resources functions
+INPUTS = inputs.Inputs(config, WorkflowError, CONFIG)  # the rules' input, params and resources functions
 PLOTTED = inputs.plotted_figures(config)  # the figures that the shared plot rule draws (figures.smk)
 figure_labels = partial(inputs.figure_labels, config=config, checkout=workflow.basedir)  # report labels
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"  # a rule's code: script_code(SCRIPTS / its script)

@@ -90,21 +90,28 @@ def figure_labels(figure: str, rule: str, data: str, drawn_by: str | None = None
 
 
 class Inputs:
-    """The input, params and resources functions of the rules, for one ``config`` (see the module)."""
+    """The input, params and resources functions of the rules, for one ``config`` (see the module):
+    which sections there are and the shared settings are read from ``typed``, the config parsed
+    once (pipeline/config.py; parsed here when not given); the cases, seed blocks and run settings
+    are still planned from the mapping by sweeps.py, whose run settings are the simulations'
+    params as the config writes them."""
 
-    def __init__(self, config: Mapping, error: type[Exception] = ValueError):
+    def __init__(self, config: Mapping, error: type[Exception] = ValueError, typed=None):
+        from .configcheck import parse
+
         self.config = config
+        self.typed = typed if typed is not None else parse(config)
         self.error = error
 
     # --------------------------------------------------------------- sections and figures
     def ensembles(self, section: str) -> list[Ensemble]:
         """The ensembles of a figure (fig1 ... fig9), of `tradeoff` or of `mechanism`."""
-        config = self.config
+        config, typed = self.config, self.typed
         if section == "tradeoff":
-            return spec_ensembles(config["tradeoff"], config) if "tradeoff" in config else []
+            return spec_ensembles(config["tradeoff"], config) if typed.tradeoff is not None else []
         if section == "mechanism":
             return mechanism_ensembles(config)
-        return figure_ensembles(config, section) if section in config["figures"] else []
+        return figure_ensembles(config, section) if getattr(typed.figures, section, None) is not None else []
 
     def section_inputs(self, section: str) -> list[str]:
         """What a figure reads, in the order of its cases: single runs, final states, the COMIC
@@ -133,7 +140,7 @@ class Inputs:
 
     def fd_report_times(self, count: int = 20) -> list[float]:
         """Times of the FD domain experiment: count even steps to t_final, on the FD time grid."""
-        t_final, dt = float(self.config["physics"]["t_final"]), float(self.config["time"]["fd_dt"])
+        t_final, dt = self.typed.physics.t_final, self.typed.time.fd_dt
         return [round(k * t_final / count / dt) * dt for k in range(1, count + 1)]
 
     # --------------------------------------------------------------- one job, from its wildcards
