@@ -12,7 +12,7 @@ from conftest import ROOT, TINY
 
 from particle_entropy.cli import main
 from particle_entropy.core.case import SettingError
-from particle_entropy.pipeline.configcheck import ConfigFileError, check_config, load_yaml
+from particle_entropy.pipeline.configcheck import ConfigFileError, check_config, load_yaml, parse
 
 BASE = yaml.safe_load((ROOT / "config.yaml").read_text())
 
@@ -279,11 +279,12 @@ def test_the_largest_seed_block_is_computed_not_built_and_the_caps_agree():
     from particle_entropy.core.settings import MAX_REALISATIONS
     from particle_entropy.pipeline.sweeps import Ensemble, block_size, seed_blocks
 
+    typed = parse(BASE)
     for n, count in [(30, 80), (300, 7), (3000, 1), (30000, 4), (100, 33)]:
         ens = Ensemble(Case("mtpt", "collision", n), count)
-        assert block_size(ens, BASE) == max(b - a + 1 for a, b in seed_blocks(ens, BASE))
+        assert block_size(ens, typed) == max(b - a + 1 for a, b in seed_blocks(ens, typed))
     # arithmetic: building the 10**12 / size blocks would exhaust memory here
-    assert block_size(Ensemble(Case("mtpt", "collision", 30), 10**12), BASE) == BASE["seed_blocks"]["size"]
+    assert block_size(Ensemble(Case("mtpt", "collision", 30), 10**12), typed) == BASE["seed_blocks"]["size"]
     schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     caps = [
         schema["properties"]["realisations"]["items"]["properties"]["count"]["maximum"],

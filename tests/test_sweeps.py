@@ -10,6 +10,8 @@ import yaml
 from conftest import ROOT
 
 from particle_entropy.core.case import Case, SettingError
+from particle_entropy.pipeline.config import build
+from particle_entropy.pipeline.configcheck import parse
 from particle_entropy.pipeline.crosschecks import check_sweeps
 from particle_entropy.pipeline.sweeps import (
     Ensemble,
@@ -25,6 +27,8 @@ from particle_entropy.pipeline.sweeps import (
 )
 
 SHIPPED = yaml.safe_load((ROOT / "config.yaml").read_text())
+TYPED = parse(SHIPPED)  # the planning helpers read the typed config (pipeline/config.py)
+section = build().CaseSection  # a section of cases, typed
 PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric/grid~exact"
 
 
@@ -33,7 +37,7 @@ PAPER_DIR = "mtpt/collision/n~30/eta~1/trunc~none/growth~1.05/scheme~symmetric/g
 @pytest.mark.parametrize("size", [1, 2, 3, 20])
 @pytest.mark.parametrize("count", [1, 2, 5, 19, 20, 21, 60, 80])
 def test_seed_blocks_are_aligned_and_cover_each_seed_once(base, size, count):
-    config = {"base_seed": base, "seed_blocks": {"size": size, "max_n": 1000}}
+    config = parse({**SHIPPED, "base_seed": base, "seed_blocks": {"size": size, "max_n": 1000}})
     blocks = seed_blocks(Ensemble(Case("mtpt", "collision", 300), count), config)
     seeds = [s for a, b in blocks for s in range(a, b + 1)]
     assert seeds == list(range(base, base + count))  # exactly these, in order, none twice
@@ -47,7 +51,7 @@ def test_seed_blocks_are_aligned_and_cover_each_seed_once(base, size, count):
 
 @pytest.mark.parametrize("size", [1, 3, 20])
 def test_smaller_ensembles_share_the_first_blocks_of_larger_ones(size):
-    config = {"base_seed": 0, "seed_blocks": {"size": size, "max_n": 1000}}
+    config = parse({**SHIPPED, "base_seed": 0, "seed_blocks": {"size": size, "max_n": 1000}})
     blocks = {r: seed_blocks(Ensemble(Case("pt", "bins", 30), r), config) for r in (20, 60, 80)}
     for small, large in ((20, 60), (60, 80), (20, 80)):
         full = [(a, b) for a, b in blocks[small] if b - a + 1 == size]  # a short last block cannot be shared
@@ -56,18 +60,18 @@ def test_smaller_ensembles_share_the_first_blocks_of_larger_ones(size):
 
 
 def test_one_seed_per_job_above_max_n():
-    config = {"base_seed": 3, "seed_blocks": {"size": 20, "max_n": 1000}}
+    config = parse({**SHIPPED, "base_seed": 3, "seed_blocks": {"size": 20, "max_n": 1000}})
     assert seed_blocks(Ensemble(Case("mtpt", "sph", 1001), 4), config) == [(3, 3), (4, 4), (5, 5), (6, 6)]
     assert seed_blocks(Ensemble(Case("mtpt", "sph", 1000), 4), config) == [(3, 6)]
 
 
 def test_case_run_paths_written_by_hand():
     ens = Ensemble(Case("mtpt", "collision", 30), 80)
-    assert case_run_paths(ens, SHIPPED) == [
+    assert case_run_paths(ens, TYPED) == [
         f"results/runs/{PAPER_DIR}/seeds~{a}-{a + 19}.parquet" for a in (0, 20, 40, 60)
     ]
     big = Ensemble(Case("mtpt", "collision", 30000), 4)  # 30000 <= max_n: one block of 4
-    assert case_run_paths(big, SHIPPED) == [f"results/runs/{PAPER_DIR.replace('n~30/', 'n~30000/')}/seeds~0-3.parquet"]
+    assert case_run_paths(big, TYPED) == [f"results/runs/{PAPER_DIR.replace('n~30/', 'n~30000/')}/seeds~0-3.parquet"]
     assert (
         run_path(Case("mtpt", "collision", 30), 5, kind="snapshots")
         == f"results/snapshots/{PAPER_DIR}/seeds~5-5.parquet"
@@ -86,15 +90,16 @@ ENSEMBLE = {"cases": [{"method": "mtpt", "kernel": "collision"}], "n": [30, 1000
 
 def test_realisations_from_the_table_and_capped():
     # config.yaml: {n: 30, count: 80}, {n: 10000, count: 6}, {n: 30000, count: 4}
-    assert realisations_for(ENSEMBLE, 30, SHIPPED) == 80
-    assert realisations_for(ENSEMBLE, 10000, SHIPPED) == 6
-    capped = {**ENSEMBLE, "max_realisations": 20}
-    assert realisations_for(capped, 30, SHIPPED) == 20
-    assert realisations_for(capped, 10000, SHIPPED) == 6
-    assert realisations_for({**ENSEMBLE, "realisations": 5}, 30, SHIPPED) == 5
-    assert realisations_for({"cases": [], "n": [30]}, 30, SHIPPED) == 1  # unset: one realisation
+    assert realisations_for(section(**ENSEMBLE), 30, TYPED) == 80
+    assert realisations_for(section(**ENSEMBLE), 10000, TYPED) == 6
+    capped = section(**ENSEMBLE, max_realisations=20)
+    assert realisations_for(capped, 30, TYPED) == 20
+    assert realisations_for(capped, 10000, TYPED) == 6
+    assert realisations_for(section(**{**ENSEMBLE, "realisations": 5}), 30, TYPED) == 5
+    unset = section(cases=ENSEMBLE["cases"], n=[30])
+    assert realisations_for(unset, 30, TYPED) == 1  # unset: one realisation
     with pytest.raises(SettingError):
-        realisations_for(ENSEMBLE, 31, SHIPPED)
+        realisations_for(section(**ENSEMBLE), 31, TYPED)
 
 
 def test_fd_gets_one_realisation():
@@ -103,12 +108,12 @@ def test_fd_gets_one_realisation():
         "n": [30, 100],
         "realisations": "ensemble",
     }
-    got = {(e.case.method, e.case.n): e.realisations for e in spec_ensembles(spec, SHIPPED)}
+    got = {(e.case.method, e.case.n): e.realisations for e in spec_ensembles(section(**spec), TYPED)}
     assert got == {("fd", 30): 1, ("fd", 100): 1, ("mtpt", 30): 80, ("mtpt", 100): 80}
 
 
 def test_shipped_fig9_expands_to_the_realisations_table():
-    ens = figure_ensembles(SHIPPED, "fig9")
+    ens = figure_ensembles(TYPED, "fig9")
     # config.yaml: 6 cases (3 models: the equations and the authors' preset) x 7 N; counts 80, 80, 60,
     # 50, 20, 6, 4 for N = 30 ... 30000
     counts = {30: 80, 100: 80, 300: 60, 1000: 50, 3000: 20, 10000: 6, 30000: 4}
@@ -122,7 +127,7 @@ def test_shipped_fig9_expands_to_the_realisations_table():
 
 
 def test_shipped_fig3_is_capped_at_20():
-    assert {(e.case.kernel, e.case.n): e.realisations for e in figure_ensembles(SHIPPED, "fig3")} == {
+    assert {(e.case.kernel, e.case.n): e.realisations for e in figure_ensembles(TYPED, "fig3")} == {
         ("adaptive", 300): 20,
         ("adaptive", 30000): 4,
         ("sph", 300): 20,
@@ -140,32 +145,32 @@ def test_spec_ensembles_take_case_defaults_where_they_apply(tiny_config):
         ],
         "n": [30],
     }
-    growth = [e.case.dt_growth for e in spec_ensembles(spec, config)]
+    growth = [e.case.dt_growth for e in spec_ensembles(section(**spec), parse(config))]
     assert growth == [1.0, 1.3, 1.01]
 
 
 def test_case_sections_of_the_shipped_config():
-    assert list(case_sections(SHIPPED)) == [f"figures.fig{k}" for k in range(1, 10)] + ["tradeoff"] + [
+    assert list(case_sections(TYPED)) == [f"figures.fig{k}" for k in range(1, 10)] + ["tradeoff"] + [
         f"mechanism.sweeps[{i}]" for i in range(3)
     ]
-    assert "tradeoff" not in case_sections({"figures": {}})
+    assert "tradeoff" not in case_sections(parse({k: v for k, v in SHIPPED.items() if k != "tradeoff"}))
 
 
 def test_mechanism_cases_shared_with_fig9_are_the_same_ensembles():
     from particle_entropy.pipeline.sweeps import mechanism_ensembles
 
-    mech = set(mechanism_ensembles(SHIPPED))
-    fig9 = set(figure_ensembles(SHIPPED, "fig9"))
+    mech = set(mechanism_ensembles(TYPED))
+    fig9 = set(figure_ensembles(TYPED, "fig9"))
     shared = mech & fig9
     # from N = 3,000 the same ensembles (same summaries); below, the mechanism's 20 seeds are the
     # first blocks of Fig. 9's larger ensemble: no run of the equations or the authors' loop is extra
     assert {(e.case.scheme, e.case.n) for e in shared} == {
         (s, n) for s in ("symmetric", "authors") for n in (3000, 10000, 30000)
     }
-    fig9_runs = {p for e in fig9 for p in case_run_paths(e, SHIPPED)}
+    fig9_runs = {p for e in fig9 for p in case_run_paths(e, TYPED)}
     for e in mech:
         if e.case.model in {f.case.model for f in fig9} and e.case.n <= 30000:
-            assert set(case_run_paths(e, SHIPPED)) <= fig9_runs, e
+            assert set(case_run_paths(e, TYPED)) <= fig9_runs, e
     assert {e.case.n for e in mech - fig9} >= {100000, 300000}
 
 
@@ -278,7 +283,7 @@ def test_fd_only_section_needs_no_realisations_entry(tiny_config):
     cfg = tiny_config
     cfg["figures"]["fig8"].update(realisations="ensemble", n=[30, 40])  # no realisations entry for n = 40
     check_sweeps(cfg)
-    assert [e.realisations for e in figure_ensembles(cfg, "fig8")] == [1, 1]
+    assert [e.realisations for e in figure_ensembles(parse(cfg), "fig8")] == [1, 1]
 
 
 def test_physics_settings_from_config_reach_the_run(tiny_config):
@@ -290,16 +295,16 @@ def test_physics_settings_from_config_reach_the_run(tiny_config):
 
 def test_a_case_listed_twice_is_one_ensemble(tiny_config):
     cfg = tiny_config
-    once = len(figure_ensembles(cfg, "fig9"))
+    once = len(figure_ensembles(parse(cfg), "fig9"))
     cases = cfg["figures"]["fig9"]["cases"]
     cases.append({**cases[0], "eta": 1.0, "scheme": "symmetric"})  # the first case again, written another way
-    assert len(figure_ensembles(cfg, "fig9")) == once
+    assert len(figure_ensembles(parse(cfg), "fig9")) == once
 
 
 def test_lattice_cases_and_their_checks(tiny_config):
     from particle_entropy.pipeline.sweeps import lattice_cases
 
-    cases = lattice_cases(SHIPPED)
+    cases = lattice_cases(TYPED)
     assert {c.n for c in cases} == {3001} and all(c.eta == 1.0 and c.method == "mtpt" for c in cases)
     assert any(c.dt_growth == 1.01 for c in cases) and len(cases) == len(set(cases))
     config = copy.deepcopy(tiny_config)

@@ -24,6 +24,7 @@ from particle_entropy.core.labels import case_label
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.figures import CASE_FIGURES, FIGURES
 from particle_entropy.numerics.compiled import CACHE_ENV
+from particle_entropy.pipeline.configcheck import parse
 from particle_entropy.pipeline.sweeps import (
     Ensemble,
     case_run_paths,
@@ -625,7 +626,7 @@ def test_a_config_without_shear_or_tradeoff_plans_without_them(tmp_path, tiny_co
 
 
 def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run, tiny_config):
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]  # a table Fig. 9 reads
     good = run.read_bytes()
     before = pd.read_parquet(run).drop(columns=list(TIMING_COLUMNS))
@@ -641,7 +642,7 @@ def test_a_truncated_run_table_is_set_aside_and_rebuilt(tiny_run, tiny_config):
 
 
 def test_a_dry_run_only_looks_at_a_truncated_table(tiny_run, tiny_config):
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[-1], cfg)[-1]
     good = run.read_bytes()
     run.write_bytes(good[:100])
@@ -675,7 +676,7 @@ def test_set_aside_derived_tables_are_rebuilt_by_the_next_run(tiny_run):
 
 
 def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_run, tiny_config):
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig9")[0], cfg)[0]
     good = run.read_bytes()
     run.write_bytes(good[:100])
@@ -702,7 +703,7 @@ def test_a_run_refused_by_a_lock_changes_no_table_and_unlock_always_works(tiny_r
 
 
 def test_another_cases_run_table_in_its_place_is_set_aside_and_rebuilt(tiny_run, tiny_config):
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     ensembles = figure_ensembles(cfg, "fig9")
     here, there = (tiny_run / case_run_paths(e, cfg)[0] for e in (ensembles[0], ensembles[1]))
     assert pd.read_parquet(here)["n"].iloc[0] != pd.read_parquet(there)["n"].iloc[0] or here.parent != there.parent
@@ -1086,7 +1087,7 @@ def test_a_run_keeps_every_table_digest_and_still_finds_a_truncated_table(tiny_r
     kept = digests.stat().st_mtime_ns
     run_snakemake(tiny_run, configfile=TINY)
     assert digests.stat().st_mtime_ns == kept  # nothing changed, nothing rewritten
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     run = tiny_run / case_run_paths(figure_ensembles(cfg, "fig3")[0], cfg)[0]
     run.write_bytes(run.read_bytes()[:100])  # in place: the same inode
     proc = run_snakemake(tiny_run, configfile=TINY)
@@ -1186,7 +1187,7 @@ def test_a_run_table_decayed_on_the_disk_fails_its_reader_then_is_set_aside_and_
 
     import pyarrow.parquet as pq
 
-    cfg = tiny_config
+    cfg = parse(tiny_config)
     ensemble = figure_ensembles(cfg, "fig3")[0]
     run = tiny_run / case_run_paths(ensemble, cfg)[0]
     rel = run.relative_to(tiny_run).as_posix()

@@ -71,7 +71,7 @@ if "mechanism" in config:
         conda:
             "../../envs/particle-entropy.yaml"
         params:
-            runs=[{"case": c.wildcards(), "settings": run_settings(c, config)} for c in lattice_cases(config)],
+            runs=[{"case": c.wildcards(), "settings": run_settings(c, config)} for c in lattice_cases(CONFIG)],
             times=config["comic_times"],
             code=script_code(SCRIPTS / "mechanism_floors.py"),
         script:

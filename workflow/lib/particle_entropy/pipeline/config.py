@@ -262,7 +262,7 @@ class _Config(Section):
 
     def case_sections(self) -> dict:
         """Every section that lists cases, by its key: each figure, `tradeoff` and each sweep of
-        `mechanism` (as sweeps.case_sections names them)."""
+        `mechanism` (what pipeline/sweeps.py plans)."""
         out = {f"figures.{fig}": spec for fig, spec in self.figures if spec is not None}
         if self.tradeoff is not None:
             out["tradeoff"] = self.tradeoff

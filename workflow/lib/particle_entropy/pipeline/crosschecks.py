@@ -5,9 +5,10 @@ the lattice and FD-domain experiments, the shear cases, the adaptive searches (e
 first uses it: `Searches`) and, where jobs run locally, every job within memory. Each refusal is a
 SettingError naming the key path, the value and the allowed range.
 
-Each check takes the config as the workflow holds it (a mapping: the case sections, searches and
-scenes are still planned from it by pipeline/sweeps.py, analysis/optimum.py and
-experiments/scene.py) and reads its own values from the typed config, given or parsed here."""
+Each check takes the config as the workflow holds it (a mapping: a run's settings are read from it
+as written by sweeps.run_config, and the searches and scenes are built from it by
+analysis/optimum.py and experiments/scene.py) and plans the case sections and reads its own values
+from the typed config, given or parsed here."""
 
 from __future__ import annotations
 
@@ -24,10 +25,10 @@ from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
     Ensemble,
     block_size,
-    case_sections,
     lattice_cases,
     realisations_for,
     run_config,
+    spec_case,
     spec_ensembles,
 )
 
@@ -41,11 +42,11 @@ def check_lattice(config: Mapping, typed: Config | None = None) -> None:
         return
     for i, spec in enumerate(lattice.cases or []):
         try:
-            case = Case.from_spec(spec.model_dump(exclude_unset=True), lattice.n, cfg.case_defaults.model_dump())
+            case = spec_case(spec, lattice.n, cfg)
             run_config(case, config)
         except SettingError as e:
             raise SettingError(f"mechanism.lattice.cases[{i}].{e.name}", e.value, e.allowed) from None
-    for case in lattice_cases(config):
+    for case in lattice_cases(cfg):
         if case.method != "mtpt" or case.eta != 1.0:
             raise SettingError(
                 "mechanism.lattice",
@@ -104,9 +105,9 @@ SHARED_KEYS["dt0"] = lambda case: "time." + first_step_key(case.method, case.dt_
 def check_seeds(config: Mapping, typed: Config | None = None) -> None:
     """Realisation r of every case uses seed base_seed + r, stored as int64 in every table (an
     adaptive search's seeds, up to its max_realisations: check_search)."""
-    base = (typed or parse(config)).base_seed
-    counts = [e.realisations for s in case_sections(config).values() for e in spec_ensembles(s, config)]
-    _check_seed_count(base, max(counts, default=1))
+    cfg = typed or parse(config)
+    counts = [e.realisations for s in cfg.case_sections().values() for e in spec_ensembles(s, cfg)]
+    _check_seed_count(cfg.base_seed, max(counts, default=1))
 
 
 def _check_seed_count(base: int, most: int) -> None:
@@ -188,15 +189,16 @@ def check_memory(config: Mapping, available: float, typed: Config | None = None)
     """Every simulation job of the case sections must fit in ``available`` bytes (memory.estimate_mb
     of its seed block; each run of the lattice floors; the shear jobs: shear_memory_mb; an adaptive
     search's jobs: check_search)."""
+    cfg = typed or parse(config)
     jobs = [
-        (f"{name}.n", ens, block_size(ens, config))
-        for name, spec in case_sections(config).items()
-        for ens in spec_ensembles(spec, config)
+        (f"{name}.n", ens, block_size(ens, cfg))
+        for name, spec in cfg.case_sections().items()
+        for ens in spec_ensembles(spec, cfg)
     ]
     # the floors job runs its lattice cases one after another in one process: each must fit
-    jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(config)]
+    jobs += [("mechanism.lattice.n", Ensemble(case, 1), 1) for case in lattice_cases(cfg)]
     _check_jobs_fit(jobs, config, available)
-    shear = (typed or parse(config)).shear
+    shear = cfg.shear
     if shear is not None:
         need = shear_memory_mb(shear) * 2**20
         if need > available:
@@ -297,21 +299,20 @@ def check_sweeps(config: Mapping, typed: Config | None = None) -> None:
     message names the section, key and value."""
     check_finite(config)  # first: a config not yet parsed (common.smk) has its .nan named so
     cfg = typed or parse(config)
-    defaults = cfg.case_defaults.model_dump()
     for name, spec in cfg.case_sections().items():
         for i, c in enumerate(spec.cases):
             where = f"{name}.cases[{i}]"
             case = None
             try:
                 for n in spec.n:
-                    case = Case.from_spec(c.model_dump(exclude_unset=True), n, defaults)
+                    case = spec_case(c, n, cfg)
                     run_config(case, config)
             except SettingError as e:
                 raise _case_error(e, where, case) from None  # a shared setting names its key and the case
         particles = any(c.method != "fd" for c in spec.cases)  # FD runs once whatever the ensemble
         for n in spec.n if particles else []:
             try:
-                realisations_for(spec.model_dump(exclude_none=True), n, config)
+                realisations_for(spec, n, cfg)
             except SettingError as e:
                 raise SettingError(f"{name}.n", n, e.allowed) from None
     check_lattice(config, cfg)

@@ -91,10 +91,9 @@ def figure_labels(figure: str, rule: str, data: str, drawn_by: str | None = None
 
 class Inputs:
     """The input, params and resources functions of the rules, for one ``config`` (see the module):
-    which sections there are and the shared settings are read from ``typed``, the config parsed
-    once (pipeline/config.py; parsed here when not given); the cases, seed blocks and run settings
-    are still planned from the mapping by sweeps.py, whose run settings are the simulations'
-    params as the config writes them."""
+    the sections, cases and seed blocks are planned from ``typed``, the config parsed once
+    (pipeline/config.py; parsed here when not given); a run's settings from the mapping as written
+    (sweeps.run_settings: the simulate jobs' params)."""
 
     def __init__(self, config: Mapping, error: type[Exception] = ValueError, typed=None):
         from .configcheck import parse
@@ -106,12 +105,12 @@ class Inputs:
     # --------------------------------------------------------------- sections and figures
     def ensembles(self, section: str) -> list[Ensemble]:
         """The ensembles of a figure (fig1 ... fig9), of `tradeoff` or of `mechanism`."""
-        config, typed = self.config, self.typed
+        typed = self.typed
         if section == "tradeoff":
-            return spec_ensembles(config["tradeoff"], config) if typed.tradeoff is not None else []
+            return spec_ensembles(typed.tradeoff, typed) if typed.tradeoff is not None else []
         if section == "mechanism":
-            return mechanism_ensembles(config)
-        return figure_ensembles(config, section) if getattr(typed.figures, section, None) is not None else []
+            return mechanism_ensembles(typed)
+        return figure_ensembles(typed, section) if getattr(typed.figures, section, None) is not None else []
 
     def section_inputs(self, section: str) -> list[str]:
         """What a figure reads, in the order of its cases: single runs, final states, the COMIC
@@ -122,7 +121,7 @@ class Inputs:
         if reads == "tradeoff":
             return ["results/tables/tradeoff.parquet"]
         if reads in ("runs", "snapshots"):
-            return [run_path(e.case, self.config["base_seed"], kind=reads) for e in self.ensembles(section)]
+            return [run_path(e.case, self.typed.base_seed, kind=reads) for e in self.ensembles(section)]
         return [e.summary_path() for e in self.ensembles(section)]
 
     def section_cases(self, section: str) -> list[dict]:
@@ -135,8 +134,8 @@ class Inputs:
 
     def runs_of(self, *sections: str) -> list[str]:
         """The run tables behind the ensembles of these sections (per-realisation values), each once."""
-        config = self.config
-        return list(dict.fromkeys(p for s in sections for e in self.ensembles(s) for p in case_run_paths(e, config)))
+        paths = (p for s in sections for e in self.ensembles(s) for p in case_run_paths(e, self.typed))
+        return list(dict.fromkeys(paths))
 
     def fd_report_times(self, count: int = 20) -> list[float]:
         """Times of the FD domain experiment: count even steps to t_final, on the FD time grid."""
@@ -165,7 +164,7 @@ class Inputs:
     def summary_runs(self, wildcards) -> list[str]:
         """The run tables that one case summary averages."""
         self.target_case(wildcards, SUMMARY_PATTERN)
-        return case_run_paths(Ensemble.from_wildcards(wildcards), self.config)
+        return case_run_paths(Ensemble.from_wildcards(wildcards), self.typed)
 
     def sim_mem_mb(self, wildcards) -> int:
         """Estimated peak memory of a job's runs (memory.py, fitted to measured peaks)."""
