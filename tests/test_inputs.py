@@ -9,6 +9,7 @@ import pytest
 import yaml
 from conftest import ROOT
 
+from particle_entropy.pipeline.configcheck import parse
 from particle_entropy.pipeline.inputs import (
     Inputs,
     beyond_default_target,
@@ -37,12 +38,13 @@ def _run_wildcards(**changes) -> Wildcards:
 
 
 def test_in_config_follows_a_dotted_key(config):
-    assert in_config(config, "figures.fig3") and in_config(config, "shear")
-    assert not in_config(config, "figures.nosuch") and not in_config(config, "base_seed.x")
+    cfg = parse(config)
+    assert in_config(cfg, "figures.fig3") and in_config(cfg, "shear")
+    assert not in_config(cfg, "figures.nosuch") and not in_config(cfg, "base_seed.x")
 
 
 def test_the_default_target_follows_the_config_s_sections(config):
-    targets = default_targets(config)
+    targets = default_targets(parse(config))
     assert {"figures/fig3.png", "figures/fig10.pdf", "results/tables/tradeoff.parquet"} <= set(targets)
     assert targets[-4:] == [
         "results/tables/comic.parquet",
@@ -51,9 +53,9 @@ def test_the_default_target_follows_the_config_s_sections(config):
         "results/paper_claims.md",
     ]
     del config["shear"], config["tradeoff"], config["figures"]["fig3"]
-    fewer = default_targets(config)
+    fewer = default_targets(parse(config))
     assert not any("fig10" in t or "tradeoff" in t or "fig3." in t for t in fewer)
-    assert "fig3" not in plotted_figures(config) and "fig4" in plotted_figures(config)
+    assert "fig3" not in plotted_figures(parse(config)) and "fig4" in plotted_figures(parse(config))
 
 
 def test_a_section_reads_its_tables_in_the_order_of_its_cases(config):

@@ -70,7 +70,7 @@ CORRUPT = preflight(DRY_RUN, sys.argv, workflow.local_exec, LIB, WorkflowError) 
 RUN_RECORDS = []  # the record of this run of jobs (Snakefile: onstart), ended on success or error
 
 INPUTS = inputs.Inputs(config, WorkflowError, CONFIG)  # the rules' input, params and resources functions
-PLOTTED = inputs.plotted_figures(config)  # the figures that the shared plot rule draws (figures.smk)
+PLOTTED = inputs.plotted_figures(CONFIG)  # the figures that the shared plot rule draws (figures.smk)
 figure_labels = partial(inputs.figure_labels, config=config, checkout=workflow.basedir)  # report labels
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"  # a rule's code: script_code(SCRIPTS / its script)
 
@@ -98,7 +98,7 @@ def all_targets():
     COMIC table). A path of an older layout, which no rule writes, is left. Called once every
     rule is defined."""
     rebuilt = [t for t in CORRUPT if any(r.is_producer(t) for r in workflow.rules)]
-    return rebuilt + inputs.default_targets(config)
+    return rebuilt + inputs.default_targets(CONFIG)
 
 
 # summarise.smk's text is the summaries' code (a run: block, no script): it names these two, so

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+from pydantic import BaseModel
+
 from ..core.case import Case, SettingError
 from ..core.settings import MAX_REALISATIONS
 from ..figures import BY_NAME as FIGURE
@@ -39,28 +41,29 @@ COMIC_TABLES = ("results/tables/comic.parquet", "results/tables/comic_minima.par
 CLAIMS = ("results/tables/paper_claims.parquet", "results/paper_claims.md")
 
 
-def in_config(config: Mapping, section: str) -> bool:
-    """Whether ``config`` has ``section``, a dotted key (figures.fig3, tradeoff, shear)."""
-    node = config
+def in_config(cfg, section: str) -> bool:
+    """Whether the typed config ``cfg`` (pipeline/config.py) has ``section``, a dotted key
+    (figures.fig3, tradeoff, shear): a section the config leaves out is None in it."""
+    node = cfg
     for part in section.split("."):
-        if not isinstance(node, Mapping) or part not in node:
+        node = getattr(node, part, None) if isinstance(node, BaseModel) else None
+        if node is None:
             return False
-        node = node[part]
     return True
 
 
-def plotted_figures(config: Mapping) -> list[str]:
+def plotted_figures(cfg) -> list[str]:
     """The figures of the default target drawn from their cases by the shared plot rule
-    (figures.smk), those whose section the config has (figures.FIGURES, the one list)."""
-    return [f for f in CASE_FIGURES if in_config(config, FIGURE[f].section)]
+    (figures.smk), those whose section the typed config has (figures.FIGURES, the one list)."""
+    return [f for f in CASE_FIGURES if in_config(cfg, FIGURE[f].section)]
 
 
-def default_targets(config: Mapping) -> list[str]:
+def default_targets(cfg) -> list[str]:
     """The default target's files: the figures whose section the config has (the shared plot
     rule's and the shear flow's), the trade-off table, the COMIC tables and the paper's claims."""
-    shear = [f.name for f in ALL_FIGURES if f.section == "shear" and in_config(config, f.section)]
-    figs = [f"figures/{f}.{ext}" for f in plotted_figures(config) + shear for ext in ("png", "pdf")]
-    if in_config(config, "tradeoff"):
+    shear = [f.name for f in ALL_FIGURES if f.section == "shear" and in_config(cfg, f.section)]
+    figs = [f"figures/{f}.{ext}" for f in plotted_figures(cfg) + shear for ext in ("png", "pdf")]
+    if in_config(cfg, "tradeoff"):
         figs.append("results/tables/tradeoff.parquet")
     return figs + [*COMIC_TABLES, *CLAIMS]
 
