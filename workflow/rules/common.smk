@@ -55,7 +55,7 @@ OPTIMUM = optimum_searches(config, AVAILABLE)
 # it; their runs are keyed by a digest of their physics (scenes share equal runs: SCENES.settings).
 SCENES = scenes(
     config,
-    partial(check_scene, base_seed=config["base_seed"], available=AVAILABLE),
+    partial(check_scene, base_seed=CONFIG.base_seed, available=AVAILABLE),
     paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
 )
 # A scene's name: a user's (the schema's pattern) or one of the Peclet sweep's, peclet-<k>.
