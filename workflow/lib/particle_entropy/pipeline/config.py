@@ -32,6 +32,8 @@ from __future__ import annotations
 
 import functools
 import math
+import types
+import typing
 from types import SimpleNamespace
 from typing import Annotated, ClassVar, Literal
 
@@ -410,3 +412,18 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
 
 _MODELS = build()
 Config = _MODELS.Config  # the whole config; its sections' models: build()
+
+
+def members(tp) -> list:
+    """The types a value of type ``tp`` may have (Annotated and unions unwrapped)."""
+    origin = typing.get_origin(tp)
+    if origin is Annotated:
+        return members(typing.get_args(tp)[0])
+    if origin in (typing.Union, types.UnionType):
+        return [m for a in typing.get_args(tp) for m in members(a)]
+    return [tp]
+
+
+def is_model(tp) -> bool:
+    """Whether ``tp`` is a model class (a section or an item of one)."""
+    return isinstance(tp, type) and issubclass(tp, BaseModel)

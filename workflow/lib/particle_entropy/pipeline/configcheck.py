@@ -380,7 +380,7 @@ def _located(loc, config, model, missing: bool = False):
     path (pydantic's tags of union members and validators left out), the raw value there (as
     written), the field there (its description) and the type there (its known keys). ``missing``:
     the location's last key is one the config does not hold."""
-    from pydantic import BaseModel
+    from .config import is_model
 
     path, value, info, kind = [], config, None, model
     for i, part in enumerate(loc):
@@ -396,32 +396,19 @@ def _located(loc, config, model, missing: bool = False):
         path.append(step)
         value = value.get(step, _MISSING) if isinstance(value, Mapping) else value[step]
         kind, holder = _inner(kind, step)
-        if isinstance(holder, type) and issubclass(holder, BaseModel) and step in holder.model_fields:
+        if is_model(holder) and step in holder.model_fields:
             info = holder.model_fields[step]
     return path, value, info, kind
-
-
-def _members(t) -> list:
-    """The types a value of type ``t`` may have (Annotated and unions unwrapped)."""
-    import types
-    import typing
-
-    origin = typing.get_origin(t)
-    if origin is typing.Annotated:
-        return _members(typing.get_args(t)[0])
-    if origin in (typing.Union, types.UnionType):
-        return [m for a in typing.get_args(t) for m in _members(a)]
-    return [t]
 
 
 def _inner(kind, step):
     """(type of the value at ``step`` inside a value of type ``kind``, the model that declares it)."""
     import typing
 
-    from pydantic import BaseModel
+    from .config import is_model, members
 
-    for t in _members(kind):
-        if isinstance(t, type) and issubclass(t, BaseModel) and isinstance(step, str) and step in t.model_fields:
+    for t in members(kind):
+        if is_model(t) and isinstance(step, str) and step in t.model_fields:
             return t.model_fields[step].annotation, t
         origin = typing.get_origin(t)
         if origin is dict and isinstance(step, str):
@@ -435,6 +422,7 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
     """One pydantic ValidationError as today's SettingError: key path, value, allowed values
     (the field's description, and jsonschema's wording of the refusal)."""
     from .config import Config
+    from .config import members as type_members
 
     errors = error.errors()
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
@@ -448,7 +436,7 @@ def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
         kind, ctx = (first["type"], first.get("ctx", {})) if typed else ("union", {})
     if kind == "extra_forbidden" or "[key]" in first["loc"]:
         parent = _located(first["loc"][:-1], config, Config)
-        models = [t for t in _members(parent[3]) if hasattr(t, "model_fields")]
+        models = [t for t in type_members(parent[3]) if hasattr(t, "model_fields")]
         known = list(models[0].model_fields) if models and "[key]" not in first["loc"] else []
         if "[key]" in first["loc"]:
             key = first["loc"][first["loc"].index("[key]") - 1]

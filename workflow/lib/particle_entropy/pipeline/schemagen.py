@@ -21,7 +21,7 @@ import typing
 from pathlib import Path
 
 import annotated_types as at
-from pydantic import BaseModel, StrictBool, StrictInt
+from pydantic import StrictBool, StrictInt
 from pydantic.fields import FieldInfo
 
 from ..core.case import NONE
@@ -87,7 +87,7 @@ class Writer:
 
     def _inline(self, tp) -> bool:
         """Whether ``tp`` is a section model written in place (not a shared definition, not a shape)."""
-        return _is_model(tp) and not issubclass(tp, typed._OneOf) and self.ref(tp) is None
+        return typed.is_model(tp) and not issubclass(tp, typed._OneOf) and self.ref(tp) is None
 
     def ref(self, tp) -> dict | None:
         name = self.names.get(id(tp))
@@ -121,7 +121,7 @@ class Writer:
         if origin is dict:  # keys of an enum, each with a value of one type
             keys = self.entry(args[0])
             return {"type": "object", "propertyNames": keys, "additionalProperties": self.entry(args[1])}
-        if isinstance(tp, type) and issubclass(tp, BaseModel):
+        if typed.is_model(tp):
             return self.body(tp, flow=True)
         raise TypeError(f"no schema entry for {tp!r}")
 
@@ -143,7 +143,7 @@ class Writer:
         props = {}
         for name, info in model.model_fields.items():
             tp = info.annotation
-            nested = [t for t in _members(tp) if _is_model(t) and not issubclass(t, typed._OneOf)]
+            nested = [t for t in typed.members(tp) if typed.is_model(t) and not issubclass(t, typed._OneOf)]
             if model is self.m.CaseDefaults:  # each dimension: its $defs entry and its default
                 props[name] = {"$ref": f"#/$defs/{name}", "default": NONE if info.default is None else info.default}
             elif nested and self._inline(nested[0]) and not flow:
@@ -155,7 +155,7 @@ class Writer:
                     )
                 if info.description and nested[0].__doc__ != info.description:
                     props[name]["description"] = info.description
-            elif typing.get_origin(tp) is dict and _is_model(typing.get_args(tp)[1]):  # one per name
+            elif typing.get_origin(tp) is dict and typed.is_model(typing.get_args(tp)[1]):  # one per name
                 pattern = typing.get_args(typing.get_args(tp)[0])[1].metadata[0].pattern
                 value = typing.get_args(tp)[1]
                 props[name] = Block(
@@ -189,7 +189,7 @@ class Writer:
         out.update(self.body(self.m.Config))
         defs = Block()
         for name, tp in self.m.defs.items():
-            if _is_model(tp):
+            if typed.is_model(tp):
                 defs[name] = self.body(tp)
                 continue
             entry = self.entry(tp, top=True)
@@ -203,20 +203,6 @@ class Writer:
             defs[name] = entry
         out["$defs"] = defs
         return out
-
-
-def _members(tp) -> list:
-    """The types a value of type ``tp`` may have (Annotated and unions unwrapped)."""
-    origin = typing.get_origin(tp)
-    if origin is typing.Annotated:
-        return _members(typing.get_args(tp)[0])
-    if origin in (typing.Union, types.UnionType):
-        return [m for a in typing.get_args(tp) for m in _members(a)]
-    return [tp]
-
-
-def _is_model(tp) -> bool:
-    return isinstance(tp, type) and issubclass(tp, BaseModel)
 
 
 def _doc(model) -> str:
@@ -261,7 +247,7 @@ def docs(settings: tuple = SETTINGS) -> str:
             tp = info.annotation
             inner = typing.get_args(tp)[1] if typing.get_origin(tp) is dict else tp
             inner = typing.get_args(inner)[0] if typing.get_origin(inner) is list else inner
-            models = [t for t in _members(inner) if _is_model(t) and not issubclass(t, typed._OneOf)]
+            models = [t for t in typed.members(inner) if typed.is_model(t) and not issubclass(t, typed._OneOf)]
             where = f"{path}.{name}" if path != "config" else name
             if models:
                 key = where + (".<name>" if typing.get_origin(tp) is dict else "[]" if inner is not tp else "")
