@@ -1,0 +1,61 @@
+"""The closed-form kinetics of core/reactions.py against independent solutions: the ODE integrated
+by scipy, the textbook C0 / (1 + k C0 t), the exponential decay and the limits of the exact step."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from particle_entropy.core.reactions import bimolecular_reacted, bimolecular_step, decay_factor, well_mixed
+
+
+@pytest.mark.parametrize(("a", "b", "k", "dt"), [(1.0, 0.5, 2.0, 0.7), (0.3, 2.0, 1.0, 3.0), (1.0, 1.0, 5.0, 0.2)])
+def test_bimolecular_step_solves_the_rate_equations(a, b, k, dt):
+    sol = solve_ivp(lambda t, y: [-k * y[0] * y[1], -k * y[0] * y[1]], (0, dt), [a, b], rtol=1e-12, atol=1e-14)
+    r = float(bimolecular_reacted(a, b, k, dt))
+    assert r == pytest.approx(a - sol.y[0, -1], rel=1e-9)
+    assert r == pytest.approx(b - sol.y[1, -1], rel=1e-9)
+
+
+def test_equal_concentrations_give_the_well_mixed_law():
+    t = np.array([0.0, 0.1, 1.0, 10.0, 1e6])
+    a, b = well_mixed(2.0, 2.0, 0.5, t)
+    np.testing.assert_allclose(a, 2.0 / (1.0 + 0.5 * 2.0 * t), rtol=1e-14)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_nearly_equal_concentrations_are_continuous_across_the_series():
+    # d k dt straddles the switch to the series: no jump beyond round-off
+    r = bimolecular_reacted(1.0 + np.array([0.0, 1e-7, 2e-5, 1e-4]), 1.0, 1.0, 0.5)
+    exact = 0.5 / 1.5
+    np.testing.assert_allclose(r, exact, rtol=1e-4)
+    assert np.all(np.diff(r) >= 0)
+
+
+def test_no_mass_goes_negative_and_the_scarce_species_runs_out():
+    rng = np.random.default_rng(1)
+    a, b = rng.exponential(size=10_000), rng.exponential(size=10_000)
+    for dt in (1e-12, 1.0, 1e3, 1e300):
+        r = bimolecular_reacted(a, b, 3.0, dt)
+        assert np.all(r >= 0) and np.all(r <= np.minimum(a, b))
+    np.testing.assert_allclose(bimolecular_reacted(a, b, 3.0, 1e300), np.minimum(a, b), rtol=1e-15)
+
+
+def test_step_conserves_each_pair_and_matches_the_reacted_amount():
+    rng = np.random.default_rng(2)
+    a, b = rng.exponential(size=1000), rng.exponential(size=1000)
+    a2, b2 = bimolecular_step(a, b, 2.0, 0.3)
+    r = bimolecular_reacted(a, b, 2.0, 0.3)
+    np.testing.assert_allclose(a - a2, r, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(b - b2, r, rtol=1e-12, atol=1e-15)
+    assert np.all(a2 >= 0) and np.all(b2 >= 0)
+
+
+def test_small_steps_react_k_a_b_dt():
+    assert float(bimolecular_reacted(2.0, 3.0, 0.5, 1e-9)) == pytest.approx(0.5 * 2 * 3 * 1e-9, rel=1e-8)
+
+
+def test_decay_factor_is_the_exponential():
+    assert decay_factor(0.3, 2.0) == pytest.approx(math.exp(-0.6), rel=1e-15)
+    assert decay_factor(0.0, 5.0) == 1.0
