@@ -487,12 +487,16 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
 # One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
 # (core/reference.py), the candidate models and the accuracy they must reach.
 SCENE_MEASURES = ("rmse", "entropy", "dilution")
+# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
+# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
+SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 SOURCE_SHAPE = source_shape()  # the kinds of core/sources.py
 CANDIDATE_SHAPE = {
     "type": "array",
     "minItems": 1,
     "items": {
         "type": "object",
+        "x-model": "Candidate",  # core/typed.py's, with the rules between these keys
         "additionalProperties": False,
         "required": ["method", "kernel"],
         "properties": {
@@ -507,6 +511,7 @@ CANDIDATE_SHAPE = {
             "courant": {"type": "number", "exclusiveMinimum": 0},
             "n_range": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2, "maxItems": 2},
             "ladder": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2},
+            "time_grid": {"type": "string", "enum": ["exact"], "description": SCENE_TIME_GRID_TEXT},
         },
         "oneOf": [{"required": ["n_range"]}, {"required": ["ladder"]}],
     },

@@ -11,9 +11,7 @@ around the one useful line.
 
 from __future__ import annotations
 
-import difflib
 import json
-import math
 import os
 import re
 import stat
@@ -23,12 +21,22 @@ from pathlib import Path
 import yaml
 
 from ..core.case import SettingError
+from ..core.typed import (  # noqa: F401  (re-exported: the messages' helpers, where they were)
+    ALLOWED_CHARS,
+    MESSAGE_CHARS,
+    SAFE_LOADER,
+    bounded,
+    clip,
+    float_spelling,
+    key_path,
+    setting_error,
+    short,
+)
 
 SCHEMA_PATH = Path(__file__).resolve().parents[3] / "schemas" / "config.schema.yaml"
 _NUMBER_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 
 
-SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's, where PyYAML has it: 10x faster
 YTE_KEY = "__use_yte__"  # Snakemake runs a config file holding this key as a yte template: Python code
 
 
@@ -39,36 +47,8 @@ class ConfigFileError(ValueError):
 MAX_CONFIG_BYTES = 1_000_000  # a config file is read only up to this size: config.yaml is ~20 kB
 MAX_VALUES = 100_000  # values a file may hold once its aliases are expanded: config.yaml has ~2,000
 MAX_DEPTH = 40  # nesting levels of mappings and lists: config.yaml has 6
-MESSAGE_CHARS = 300  # a value (or a quoted schema message) longer than this is abbreviated in a message
-ALLOWED_CHARS = 1000  # the allowed text: a schema description (the longest ~400) and a hint
 _MERGE_TAG = "tag:yaml.org,2002:merge"
 _OCTAL_1_1 = re.compile(r"[-+]?0[0-7]+")  # YAML 1.1 octal (0-prefixed); 1.2's 0o17 is text to YAML 1.1
-
-
-class _Abbreviated(str):
-    """A value too long for a message, shown as its abbreviated repr (no quotes around it)."""
-
-    def __repr__(self) -> str:
-        return str(self)
-
-
-def _short(value, limit: int = 60):
-    """``value`` itself, or its repr abbreviated to ``limit`` characters."""
-    text = repr(value)
-    return value if len(text) <= limit else _Abbreviated(text[: limit - 3] + "...")
-
-
-def _clip(text: str, limit: int = MESSAGE_CHARS) -> str:
-    text = " ".join(str(text).split())  # one line
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def bounded(error: SettingError) -> SettingError:
-    """``error`` with its name, value and allowed text abbreviated: at most ~1,600 characters."""
-    value, allowed = _short(error.value, MESSAGE_CHARS), _clip(error.allowed, ALLOWED_CHARS)
-    if value is error.value and allowed == error.allowed and len(error.name) <= MESSAGE_CHARS:
-        return error
-    return SettingError(_clip(error.name), value, allowed)
 
 
 class _StrictLoader(SAFE_LOADER):
@@ -104,8 +84,7 @@ class _StrictLoader(SAFE_LOADER):
             seen[key] = line
             if first is not None:  # on any line, a flow mapping's too
                 raise ConfigFileError(
-                    f"line {line}: key {_short(key)!r} given twice in one mapping (first at line {first}); "
-                    "each key once"
+                    f"line {line}: key {short(key)!r} given twice in one mapping (first at line {first}); each key once"
                 )
         return super().construct_mapping(node, deep=deep)
 
@@ -132,14 +111,14 @@ def _refuse_yaml11_number(node, number) -> None:
     digits = text.replace("_", "")
     if ":" in digits:
         raise ConfigFileError(
-            f"line {line}: {_short(text)} is a YAML 1.1 base-60 number, read as {number!r}; write {number!r} "
-            f"(or quote it, '{_clip(text, 60)}', for text)"
+            f"line {line}: {short(text)} is a YAML 1.1 base-60 number, read as {number!r}; write {number!r} "
+            f"(or quote it, '{clip(text, 60)}', for text)"
         )
     if _OCTAL_1_1.fullmatch(digits):
         decimal = int(digits.lstrip("+-").lstrip("0") or "0") * (-1 if digits.startswith("-") else 1)
         spelling = f"write {decimal}" if decimal == number else f"write {decimal} for ten-based or {number!r}"
         raise ConfigFileError(
-            f"line {line}: {_short(text)} is a YAML 1.1 octal number, read as {number!r}; {spelling} (no leading zero)"
+            f"line {line}: {short(text)} is a YAML 1.1 octal number, read as {number!r}; {spelling} (no leading zero)"
         )
 
 
@@ -217,7 +196,7 @@ def _json_object(pairs):
     out = {}
     for key, value in pairs:
         if key in out:
-            raise ConfigFileError(f"key {_short(key)!r} given twice in one JSON object; each key once")
+            raise ConfigFileError(f"key {short(key)!r} given twice in one JSON object; each key once")
         out[key] = value
     return out
 
@@ -245,12 +224,10 @@ def load_yaml(path: str | Path) -> Mapping:
         if context and start is not None:
             context += f" started at line {start.line + 1}, column {start.column + 1}"
         raise ConfigFileError(
-            _clip(f"{path}: not valid YAML at {where}: {problem}" + (f" ({context})" if context else ""))
+            clip(f"{path}: not valid YAML at {where}: {problem}" + (f" ({context})" if context else ""))
         ) from None
     if not isinstance(data, Mapping):
-        raise ConfigFileError(
-            f"{path}: a config is a YAML mapping of keys (physics:, time:, ...), got {_short(data)!r}"
-        )
+        raise ConfigFileError(f"{path}: a config is a YAML mapping of keys (physics:, time:, ...), got {short(data)!r}")
     return data
 
 
@@ -289,52 +266,6 @@ def _merge_typed(into: dict, key, value) -> None:
         into[key] = value
 
 
-def key_path(parts) -> str:
-    """('figures', 'fig9', 'cases', 3, 'eta') -> 'figures.fig9.cases[3].eta'."""
-    out = ""
-    for p in parts:
-        if isinstance(p, int):
-            out += f"[{p}]"
-        elif not re.fullmatch(r"[A-Za-z0-9_.-]+", str(p)):  # a newline, a space: shown, not printed
-            out += f"[{str(p)!r}]"
-        else:
-            out += f".{p}" if out else str(p)
-    return out or "(top level)"
-
-
-_NUMBER_PARTS = re.compile(r"([+-]?)(\d*)(?:\.(\d*))?(?:[eE]([+-]?)(\d+))?")
-
-
-def float_spelling(text: str) -> str | None:
-    """The number ``text`` spelt so that YAML 1.1 reads it as a float (a dot in the mantissa, a
-    sign in the exponent: 1e3 -> 1.0e+3, .5e-2 -> 0.5e-2), or None when it is not a number."""
-    m = _NUMBER_PARTS.fullmatch(text.strip())
-    if m is None or not (m[2] or m[3]):
-        return None
-    sign, whole, fraction, exponent_sign, exponent = m.groups()
-    out = f"{sign}{whole or '0'}.{fraction or '0'}" + (f"e{exponent_sign or '+'}{exponent}" if exponent else "")
-    return out if isinstance(yaml.load(out, Loader=SAFE_LOADER), float) else None
-
-
-def _number_hint(value, integer: bool = False) -> str:
-    """How to write ``value`` as the number it looks like: YAML 1.1 reads 1e-3 (no dot in the
-    mantissa, no sign in the exponent) and 0o17 as text; an ``integer`` setting takes no 1000.0."""
-    if isinstance(value, float) and integer and value.is_integer() and abs(value) < 2**63:
-        return f"; write {int(value)}: an integer, with no decimal point or exponent"
-    if not isinstance(value, str):
-        return ""
-    text = value.strip()
-    if re.fullmatch(r"[+-]?0o[0-7]+", text):
-        return f"; YAML 1.1 reads {_short(text)} as text: write {int(text.replace('0o', ''), 8)} (ten-based)"
-    spelling = float_spelling(text)
-    if spelling is None:
-        return ""
-    number = float(spelling)
-    if integer and number.is_integer() and abs(number) < 2**63:
-        return f"; YAML reads {_short(text)} as text: write {int(number)}"
-    return f"; YAML 1.1 reads {_short(text)} as text: write {spelling}"
-
-
 def check_schema(config: Mapping, schema: Mapping | None = None) -> None:
     """SettingError for the first way ``config`` breaks the workflow's schema (none if it conforms).
     The schema is generated from the typed config's models (schemagen), so the config is checked
@@ -351,129 +282,6 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
-# jsonschema's wording of each refusal, which the messages have quoted since the config was checked
-# against the schema alone (tests hold it)
-_WORDS = {
-    "greater_than": "{value!r} is less than or equal to the minimum of {gt}",
-    "greater_than_equal": "{value!r} is less than the minimum of {ge}",
-    "less_than_equal": "{value!r} is greater than the maximum of {le}",
-    "too_short": "{value!r} is too short",
-    "empty": "{value!r} should be non-empty",
-    "too_long": "{value!r} is too long",
-    "int_type": "{value!r} is not of type 'integer'",
-    "float_type": "{value!r} is not of type 'number'",
-    "bool_type": "{value!r} is not of type 'boolean'",
-    "list_type": "{value!r} is not of type 'array'",
-    "dict_type": "{value!r} is not of type 'object'",
-    "model_type": "{value!r} is not of type 'object'",
-    "string_type": "{value!r} is not of type 'string'",
-    "literal_error": "{value!r} is not one of {expected}",  # expected: the words, as a list
-    "unique_items": "{value!r} has non-unique elements",
-    "string_pattern_mismatch": "{value!r} does not match {pattern!r}",
-    "union": "{value!r} is not valid under any of the given schemas",
-}
-_MISSING = object()
-
-
-def _located(loc, config, model, missing: bool = False):
-    """Walk a pydantic error location through the raw ``config`` and the typed ``model``: the key
-    path (pydantic's tags of union members and validators left out), the raw value there (as
-    written), the field there (its description) and the type there (its known keys). ``missing``:
-    the location's last key is one the config does not hold."""
-    from .config import is_model
-
-    path, value, info, kind = [], config, None, model
-    for i, part in enumerate(loc):
-        if isinstance(value, Mapping) and isinstance(part, str):
-            absent = missing and i == len(loc) - 1
-            step = part if part in value or absent else None
-        elif isinstance(value, list) and isinstance(part, int) and 0 <= part < len(value):
-            step = part
-        else:
-            step = None
-        if step is None:  # a tag: a union's member, a validator
-            continue
-        path.append(step)
-        value = value.get(step, _MISSING) if isinstance(value, Mapping) else value[step]
-        kind, holder = _inner(kind, step)
-        if is_model(holder) and step in holder.model_fields:
-            info = holder.model_fields[step]
-    return path, value, info, kind
-
-
-def _inner(kind, step):
-    """(type of the value at ``step`` inside a value of type ``kind``, the model that declares it)."""
-    import typing
-
-    from .config import is_model, members
-
-    for t in members(kind):
-        if is_model(t) and isinstance(step, str) and step in t.model_fields:
-            return t.model_fields[step].annotation, t
-        origin = typing.get_origin(t)
-        if origin is dict and isinstance(step, str):
-            return typing.get_args(t)[1], None
-        if origin is list and isinstance(step, int):
-            return typing.get_args(t)[0], None
-    return None, None
-
-
-def _pydantic_error_to_setting(error, config: Mapping) -> SettingError:
-    """One pydantic ValidationError as today's SettingError: key path, value, allowed values
-    (the field's description, and jsonschema's wording of the refusal)."""
-    from .config import Config
-    from .config import members as type_members
-
-    errors = error.errors()
-    first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
-    kind, ctx = first["type"], first.get("ctx", {})
-    path, value, info, _ = _located(first["loc"], config, Config, missing=kind == "missing")
-    members = [e for e in errors if _located(e["loc"], config, Config)[0] == path]
-    if len(members) > 1 and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it:
-        # a member of its type names the bound it breaks, else none is of its type
-        typed = [e for e in members if not e["type"].endswith("_type") and e["type"] != "literal_error"]
-        first = typed[0] if typed else first
-        kind, ctx = (first["type"], first.get("ctx", {})) if typed else ("union", {})
-    if kind == "extra_forbidden" or "[key]" in first["loc"]:
-        parent = _located(first["loc"][:-1], config, Config)
-        models = [t for t in type_members(parent[3]) if hasattr(t, "model_fields")]
-        known = list(models[0].model_fields) if models and "[key]" not in first["loc"] else []
-        if "[key]" in first["loc"]:
-            key = first["loc"][first["loc"].index("[key]") - 1]
-            path = list(path if path and path[-1] == key else [*path, key])
-            allowed = parent[2].description if parent[2] is not None and parent[2].description else "a known key"
-        else:
-            allowed = "a known key: " + ", ".join(known)
-            key = path[-1]
-        near = difflib.get_close_matches(str(key), known, n=1)
-        return SettingError(key_path(path), "(unknown key)", allowed + (f"; did you mean {near[0]}?" if near else ""))
-    described = info.description if info is not None and info.description else ""
-    if kind == "missing":
-        return SettingError(key_path(path), "(missing)", "a required key" + (f": {described}" if described else ""))
-    if kind == "each_once":
-        return SettingError(f"realisations[{ctx['index']}].n", config["realisations"][ctx["index"]]["n"], first["msg"])
-    if kind == "rule":
-        return SettingError(key_path([*path, ctx["key"]]), value[ctx["key"]], first["msg"])
-    if kind in ("one_of", "missing_one_of"):
-        return SettingError(key_path(path), "(missing)", first["msg"])
-    bound = kind in ("greater_than", "greater_than_equal", "less_than_equal")
-    if bound and isinstance(value, float) and math.isnan(value):  # nan passes every bound in the schema:
-        # refused as not finite, as crosschecks.check_finite does
-        return SettingError(key_path(path), value, "a finite number (YAML .nan and .inf are not settings)")
-    ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
-    if kind == "literal_error":  # jsonschema's words: a type, then the enum
-        kind = "string_type" if not isinstance(value, str) else kind
-        ctx = {"expected": re.findall(r"'([^']*)'", str(ctx.get("expected", "")))}
-    if kind == "too_short" and ctx.get("min_length") == 1:
-        kind = "empty"
-    words = _WORDS.get(kind)
-    message = _clip(words.format(value=_short(value), **ctx) if words else first["msg"])
-    allowed = f"{described} ({message})" if described else message
-    if kind in ("int_type", "float_type", "string_type", "literal_error", "union"):
-        allowed += _number_hint(value, integer=kind == "int_type")
-    return SettingError(key_path(path), _short(value), allowed)
-
-
 def parse(config: Mapping):
     """The config as its typed form (pipeline.config.Config): each section by its model (types,
     ranges, required and unknown keys, the rules within a section); SettingError names the key
@@ -486,7 +294,7 @@ def parse(config: Mapping):
     try:
         return Config.model_validate(dict(config))
     except ValidationError as e:
-        raise bounded(_pydantic_error_to_setting(e, config)) from None
+        raise bounded(setting_error(e, config, Config)) from None
 
 
 def validate_config(config: Mapping):

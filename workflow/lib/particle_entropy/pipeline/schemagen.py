@@ -87,7 +87,7 @@ class Writer:
 
     def _inline(self, tp) -> bool:
         """Whether ``tp`` is a section model written in place (not a shared definition, not a shape)."""
-        return typed.is_model(tp) and not issubclass(tp, typed._OneOf) and self.ref(tp) is None
+        return typed.is_model(tp) and not issubclass(tp, typed.OneOf) and self.ref(tp) is None
 
     def ref(self, tp) -> dict | None:
         name = self.names.get(id(tp))
@@ -143,7 +143,7 @@ class Writer:
         props = {}
         for name, info in model.model_fields.items():
             tp = info.annotation
-            nested = [t for t in typed.members(tp) if typed.is_model(t) and not issubclass(t, typed._OneOf)]
+            nested = [t for t in typed.members(tp) if typed.is_model(t) and not issubclass(t, typed.OneOf)]
             if model is self.m.CaseDefaults:  # each dimension: its $defs entry and its default
                 props[name] = {"$ref": f"#/$defs/{name}", "default": NONE if info.default is None else info.default}
             elif nested and self._inline(nested[0]) and not flow:
@@ -169,7 +169,7 @@ class Writer:
                 props[name] = Block(type="array", description=info.description, items=self.body(item))
             else:
                 props[name] = self.field(info)
-        shape = issubclass(model, typed._OneOf)  # a structured value's mapping: described by its field
+        shape = issubclass(model, typed.OneOf)  # a structured value's mapping: described by its field
         out = {"type": "object", "description": _doc(model), "additionalProperties": False, "properties": props}
         if shape:
             del out["description"]
@@ -247,7 +247,7 @@ def docs(settings: tuple = SETTINGS) -> str:
             tp = info.annotation
             inner = typing.get_args(tp)[1] if typing.get_origin(tp) is dict else tp
             inner = typing.get_args(inner)[0] if typing.get_origin(inner) is list else inner
-            models = [t for t in typed.members(inner) if typed.is_model(t) and not issubclass(t, typed._OneOf)]
+            models = [t for t in typed.members(inner) if typed.is_model(t) and not issubclass(t, typed.OneOf)]
             where = f"{path}.{name}" if path != "config" else name
             if models:
                 key = where + (".<name>" if typing.get_origin(tp) is dict else "[]" if inner is not tp else "")
