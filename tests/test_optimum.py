@@ -167,7 +167,7 @@ def test_full_sweep_estimate_is_a_grid_giving_the_same_bracket():
         ({"budget_core_s": 0, "cost": [[30, 1]]}, "budget_core_s"),
         ({"budget_core_s": 60}, "cost"),  # a core-second budget needs a cost model
         ({"budget_core_s": 60, "cost": [[30, 1], [30, 2]]}, "cost"),
-        ({"budget_core_s": 60, "cost": [[30, 0]]}, "cost"),
+        ({"budget_core_s": 60, "cost": [[30, 0]]}, "cost[0][1]"),  # the item, as the workflow names it
         ({"budget_core_s": 60, "cost": [[0.5, 1]]}, "cost"),
         ({"case": {"method": "pt", "kernel": "sph"}}, "case.kernel"),
     ],
@@ -378,7 +378,7 @@ def test_a_search_over_the_dt_growth_finds_its_minimum():
 @pytest.mark.parametrize(
     "spec,key",
     [
-        ({"growth_range": [1.0, 1.2]}, "growth_range"),  # 1 = a fixed step
+        ({"growth_range": [1.0, 1.2]}, "growth_range[0]"),  # 1 = a fixed step
         ({"growth_range": [1.2, 1.1]}, "growth_range"),
         ({"growth_range": [1.01, 1.2], "n_range": [30, 300]}, "n_range"),
         ({"growth_range": [1.01, 1.2], "n": None}, "n"),
@@ -484,7 +484,7 @@ _SPEC = {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range":
     [
         ({"n_range": [30]}, "n_range"),
         ({"n_range": "abc"}, "n_range"),
-        ({"n_range": [30.5, 300]}, "n_range"),
+        ({"n_range": [30.5, 300]}, "n_range[0]"),
         ({"time": None}, "time"),
         ({"time": "x"}, "time"),
         ({"case": None}, "case"),
@@ -495,7 +495,7 @@ _SPEC = {"case": {"method": "fd", "kernel": "implicit"}, "time": 250, "n_range":
         ({"initial_points": 4.5}, "initial_points"),
         ({"n_range": None, "growth_range": [1.1], "n": 300}, "growth_range"),
         ({"n_range": None, "growth_range": [1.01, 1.5], "n": "a"}, "n"),
-        ({"cost": [[30]], "budget_core_s": 10}, "cost"),
+        ({"cost": [[30]], "budget_core_s": 10}, "cost[0]"),
         ({"budget_core_s": "x"}, "budget_core_s"),
         ({"time_volume": "yes"}, "time_volume"),
         ({"budjet_runs": 3}, "budjet_runs"),

@@ -53,6 +53,7 @@ from ..core.runconfig import first_step
 from ..core.runcost import Tabulated
 from ..core.settings import PAPER, SEARCH, defaults
 from ..core.timegrid import step_count
+from ..core.typed import key_path, shared, validate
 from .aggregate import CONVENTIONS, RUN_COLUMNS, convention_samples, realisations_table
 from .resampling import argmin_bootstrap, bootstrap_of_means, lowest, nan_argmin
 from .search import (
@@ -69,6 +70,7 @@ from .search import (
 )
 
 SEARCH_DEFAULTS = defaults(SEARCH)  # settings.SEARCH: one search's keys, defaults and ranges
+SPEC = shared().Search  # a search's model: its keys, their ranges and the rules between them (core/typed.py)
 MEASURES = dict(
     zip(
         MEASURE_NAMES,  # own, points
@@ -248,45 +250,39 @@ class Search(AdaptiveSearch):
         return self.grid(self.initial_points)
 
     @classmethod
-    def from_config(cls, name: str, spec: Mapping, config: Mapping) -> Search:
-        """The search ``optimum.<name>`` of a workflow config; SettingError names the key path."""
+    def from_config(cls, name: str, spec, config: Mapping) -> Search:
+        """The search ``optimum.<name>`` of a workflow config: ``spec`` as written (parsed here by the
+        search's model, core/typed.py, as the workflow parses it) or that model parsed; SettingError
+        names the key path, also for the rules that need its numbers (check)."""
         where = f"optimum.{name}"
-        _check_spec(where, spec)
-        over = "dt_growth" if "growth_range" in spec else "n"
-        if over == "dt_growth" and "n_range" in spec:
-            raise SettingError(f"{where}.n_range", spec["n_range"], "absent when growth_range is set (one dimension)")
-        if over == "dt_growth" and "n" not in spec:
+        s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, lambda path: key_path(["optimum", name, *path]))
+        over = "n" if s.growth_range is None else "dt_growth"
+        if over == "dt_growth" and s.n is None:
             raise SettingError(f"{where}.n", None, "the N at which a growth_range search runs, an integer >= 1")
-        if over == "n" and "n_range" not in spec:
-            raise SettingError(f"{where}.n_range", None, "[low, high]: the N searched (or growth_range)")
         try:
-            n = int(spec["n"]) if over == "dt_growth" else None
-            model = Case.from_spec(spec["case"], n, config.get("case_defaults", {}))
+            n = s.n if over == "dt_growth" else None
+            model = Case.from_spec(s.case.model_dump(exclude_unset=True), n, config.get("case_defaults", {}))
         except SettingError as e:
             raise SettingError(f"{where}.case.{e.name}", e.value, e.allowed) from None
-        if over == "dt_growth":
-            lo, hi = (float(v) for v in spec["growth_range"])
-        else:
-            lo, hi = (int(v) for v in spec["n_range"])
-        steps = dict(config.get("time", {})) if spec.get("time_volume", SEARCH_DEFAULTS["time_volume"]) else None
+        lo, hi = s.growth_range if over == "dt_growth" else s.n_range
         search = cls(
             name=name,
             model=model,
-            time=float(spec["time"]),
+            time=s.time,
             lo=lo,
             hi=hi,
             over=over,
-            width=float(spec.get("width", cls.width)),
-            budget_runs=int(spec["budget_runs"]) if "budget_runs" in spec else math.inf,
-            budget_core_s=float(spec.get("budget_core_s", cls.budget_core_s)),
-            cost=tuple((float(x), float(c)) for x, c in spec.get("cost", ())),
-            initial_points=int(spec.get("initial_points", cls.initial_points)),
-            start_points=int(spec.get("start_points", cls.start_points)),
-            initial_realisations=int(spec.get("realisations", cls.initial_realisations)),
-            max_realisations=int(spec.get("max_realisations", cls.max_realisations)),
-            convention=str(spec.get("convention", cls.convention)),
-            measure=str(spec.get("measure", cls.measure)),
-            steps=steps,
+            width=s.width,
+            budget_runs=math.inf if s.budget_runs is None else s.budget_runs,
+            budget_core_s=math.inf if s.budget_core_s is None else s.budget_core_s,
+            cost=tuple(tuple(p) for p in s.cost or ()),
+            initial_points=s.initial_points,
+            start_points=s.start_points,
+            initial_realisations=s.realisations,
+            max_realisations=s.max_realisations,
+            convention=s.convention,
+            measure=s.measure,
+            steps=dict(config.get("time", {})) if s.time_volume else None,
         )
         search.check(where, float(config["physics"]["t_final"]))
         return search
@@ -361,52 +357,6 @@ class Search(AdaptiveSearch):
         bad = len(set(xs)) != len(xs) or any(not (math.isfinite(c) and c > 0) for _, c in self.cost)
         if bad or any(not (math.isfinite(x) and valid(x)) for x in xs):
             raise SettingError(f"{where}.cost", [list(p) for p in self.cost], wanted)
-
-
-_SETTINGS = {s.name: s for s in SEARCH}
-_PAIRS = {"n_range": (int,), "growth_range": (int, float)}  # [low, high] of these types
-_RANGE_LATER = ("time", "width", "initial_points", "start_points", "budget_runs")  # Search.check, with its numbers
-
-
-def _check_spec(where: str, spec) -> None:
-    """Each key of the search ``where`` = optimum.<name> as its declaration (settings.SEARCH) types
-    it: SettingError naming ``where.<key>``, the value and what is allowed, before any value is
-    read. The JSON schema says the same in a run; this holds for every caller (scripts, tests)."""
-    if not isinstance(spec, Mapping):
-        raise SettingError(where, spec, "a mapping: case, time, n_range or growth_range, ...")
-    for key in spec:
-        if key not in _SETTINGS:
-            raise SettingError(f"{where}.{key}", spec[key], f"a known key: {', '.join(_SETTINGS)}")
-    for key in ("case", "time"):
-        if key not in spec:
-            raise SettingError(f"{where}.{key}", None, f"{_SETTINGS[key].allowed()} (required)")
-    for key, value in spec.items():
-        setting = _SETTINGS[key]
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if key in _PAIRS:
-            ok = isinstance(value, (list, tuple)) and len(value) == 2
-            ok = ok and all(isinstance(v, _PAIRS[key]) and not isinstance(v, bool) for v in value)
-            ok = ok and all(math.isfinite(v) for v in value)
-        elif key == "cost":
-            ok = isinstance(value, (list, tuple)) and all(
-                isinstance(p, (list, tuple)) and len(p) == 2 and all(isinstance(v, (int, float)) for v in p)
-                for p in value
-            )
-        elif key == "case":
-            ok = isinstance(value, Mapping)
-        elif setting.kind == "boolean":
-            ok = isinstance(value, bool)
-        elif setting.choices is not None:
-            ok = value in setting.choices
-        elif setting.kind == "integer":
-            ok = isinstance(value, int) and not isinstance(value, bool)
-            ok = ok and (key in _RANGE_LATER or setting.low <= value <= setting.high)
-        else:
-            ok = number and math.isfinite(value)
-            ok = ok and (key in _RANGE_LATER or (value > setting.low if setting.open_low else value >= setting.low))
-        if not ok:
-            allowed = setting.allowed() if key != "case" else "a mapping: method, kernel and the dimensions that apply"
-            raise SettingError(f"{where}.{key}", value, allowed)
 
 
 def _block(search: Search, k: int, x, base: int, have: int, count: int) -> tuple:

@@ -506,11 +506,37 @@ CANDIDATE_SHAPE = {
             "truncation": _ref("truncation"),
             "dt_growth": _ref("dt_growth"),
             "scheme": _ref("scheme"),
-            "advection": {"type": "string", "enum": list(ADVECTION_SCHEMES)},
-            "fd_dt": {"type": "number", "exclusiveMinimum": 0},
-            "courant": {"type": "number", "exclusiveMinimum": 0},
-            "n_range": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2, "maxItems": 2},
-            "ladder": {"type": "array", "items": {"type": "integer", "minimum": 2}, "minItems": 2},
+            "advection": {
+                "type": "string",
+                "enum": list(ADVECTION_SCHEMES),
+                "description": f"FD's advection scheme in a flow; one of {', '.join(ADVECTION_SCHEMES)}",
+            },
+            "fd_dt": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "description": "FD's step, fixed in time [T]; a number > 0",
+            },
+            "courant": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "description": "FD's step in a flow as its Courant number |v| dt / dx; a number > 0 ("
+                + ", ".join(f"<= {limit:g} for {scheme}" for scheme, limit in COURANT_LIMIT.items())
+                + ")",
+            },
+            "n_range": {
+                "type": "array",
+                "items": {"type": "integer", "minimum": 2},
+                "minItems": 2,
+                "maxItems": 2,
+                "description": "the resolutions searched: [low, high], integers with 2 <= low < high (FD: even)",
+            },
+            "ladder": {
+                "type": "array",
+                "items": {"type": "integer", "minimum": 2},
+                "minItems": 2,
+                "description": "the resolutions searched, written out: at least two integers >= 2, ascending "
+                "(instead of n_range)",
+            },
             "time_grid": {"type": "string", "enum": ["exact"], "description": SCENE_TIME_GRID_TEXT},
         },
         "oneOf": [{"required": ["n_range"]}, {"required": ["ladder"]}],

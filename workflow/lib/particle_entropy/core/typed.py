@@ -51,6 +51,7 @@ from .settings import (
     MAX_REALISATIONS,
     REALISATIONS_DOC,
     SCENE,
+    SCENES_PECLET,
     SEARCH,
     SECTION_DOCS,
     UNIQUE,
@@ -413,7 +414,7 @@ def setting_error(error: ValidationError, config: Mapping, model) -> SettingErro
         return SettingError(key_path(path), "(missing)", first["msg"])
     bound = kind in ("greater_than", "greater_than_equal", "less_than_equal")
     if bound and isinstance(value, float) and math.isnan(value):  # nan passes every bound in the schema:
-        # refused as not finite, as crosschecks.check_finite does
+        # refused as not finite, as check_finite does
         return SettingError(key_path(path), value, "a finite number (YAML .nan and .inf are not settings)")
     ctx = {k: int(v) if isinstance(v, float) and v.is_integer() else v for k, v in ctx.items()}
     if kind == "literal_error":  # jsonschema's words: a type, then the enum
@@ -484,7 +485,9 @@ class _Search(Section):
     def _budget_and_range(self):
         if self.budget_runs is None and self.budget_core_s is None:
             raise PydanticCustomError("missing_one_of", "a budget: budget_runs, budget_core_s or both")
-        if (self.n_range is None) == (self.growth_range is None):
+        if self.n_range is not None and self.growth_range is not None:  # named by the key the user added
+            raise refuse("n_range", "absent when growth_range is set (one dimension)")
+        if self.n_range is None and self.growth_range is None:
             raise PydanticCustomError("missing_one_of", "exactly one of n_range and growth_range")
         return self
 
@@ -531,6 +534,27 @@ class _Scene(Section):
                 f"a multiple of realisations ({r}) in [{r}, {MAX_REALISATIONS:,}]: "
                 "rungs are refined a seed block of realisations at a time",
             )
+        return self
+
+
+class _SceneBase(_Scene):
+    """The Peclet sweep's base: a scene without v."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_v(cls, data):
+        if isinstance(data, Mapping) and "v" in data:
+            raise refuse("v", "no v: the sweep sets it (scenes_peclet.v)")
+        return data
+
+
+class _ScenesPeclet(Section):
+    """The Peclet sweep: its velocities ascend."""
+
+    @model_validator(mode="after")
+    def _ascending(self):
+        if any(b <= a for a, b in zip(self.v, self.v[1:])):
+            raise refuse("v", "at least two numbers >= 0, ascending")
         return self
 
 
@@ -581,9 +605,16 @@ def shared(settings: tuple = SETTINGS) -> SimpleNamespace:
     m.Target = of("Target", keys_in("scenes.<name>.target", SCENE), SECTION_DOCS["scenes.<name>.target"])
     scene = keys_in("scenes.<name>", SCENE)
     order = key_order("scenes.<name>", SCENE)
-    target = (m.Target, None)
+    target = (m.Target, Field(..., description=SECTION_DOCS["scenes.<name>.target"]))
     m.Scene = of("Scene", scene, SECTION_DOCS["scenes.<name>"], parent=_Scene, order=order, target=target)
     base = BY_KEY["scenes_peclet.base"]
     without_v = [s for s in scene if s.name != "v"]
-    m.SceneBase = of("SceneBase", without_v, description(base), parent=_Scene, order=order, target=target)
+    m.SceneBase = of("SceneBase", without_v, description(base), parent=_SceneBase, order=order, target=target)
+    m.ScenesPeclet = of(
+        "ScenesPeclet",
+        SCENES_PECLET,
+        SECTION_DOCS["scenes_peclet"],
+        parent=_ScenesPeclet,
+        base=(m.SceneBase, Field(..., description=description(base))),
+    )
     return m

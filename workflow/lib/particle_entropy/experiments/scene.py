@@ -5,7 +5,7 @@ the ladder of resolutions its search may visit (analysis/scene_search.py)."""
 
 from __future__ import annotations
 
-import difflib
+import functools
 import hashlib
 import json
 import math
@@ -16,12 +16,14 @@ from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reference import Reference
-from ..core.registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION
-from ..core.runconfig import RunConfig, check_plume_width, check_setting
+from ..core.registry import DEFAULT_ADVECTION
+from ..core.runconfig import RunConfig, check_plume_width
 from ..core.runcost import StepWork, Tally
-from ..core.settings import BY_KEY, MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
+from ..core.settings import MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
+from ..core.typed import FD_ONLY, shared, validate
+from ..core.typed import key_path as typed_key_path
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -34,11 +36,8 @@ MAX_BLOCKS = 4
 # [-6, 6] its plume at t = 1000; they move with the plume and never depend on the FD window, which
 # must reach as far beyond the source (settings.SCENE_REACH).
 REACH = SCENE_REACH
-# a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
-# the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
-SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 _DEFAULTS = defaults(SCENE)
-_TARGET = {s.name: s.default for s in SCENE if s.section == "scenes.<name>.target" and s.has_default}
+SPEC = shared().Scene  # a scene's model: its keys, their ranges and the rules between them (core/typed.py)
 
 
 SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
@@ -223,76 +222,41 @@ class Scene:
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
     @classmethod
-    def from_config(cls, name: str, spec: Mapping, case_defaults: Mapping | None = None) -> Scene:
-        """The scene at config key scenes.<name>; SettingError naming the key path of a bad value."""
-        spec = dict(spec)
-        _known_keys(name, spec)
-        D, v, t_final, margin, r = (
-            _checked(name, k, spec.get(k, _DEFAULTS[k])) for k in ("D", "v", "t_final", "margin", "realisations")
-        )
-        budget = _checked(name, "budget", spec["budget"]) if spec.get("budget") is not None else math.inf
-        source = _source(name, spec.get("source", _DEFAULTS["source"]))
-        span = 2.0 * (source.half_width + margin * math.sqrt(2.0 * D * t_final))
-        omega = _checked(name, "omega", spec.get("omega", span))
-        fd_length = _checked(name, "fd_length", spec.get("fd_length", span))
-        if "fd_length" in spec:  # from the margin it holds the plume by the margin's range
+    def from_config(cls, name: str, spec, case_defaults: Mapping | None = None) -> Scene:
+        """The scene at config key scenes.<name>: ``spec`` as written (parsed here by the scene's model,
+        core/typed.py, as the workflow parses it) or that model parsed; SettingError naming the key
+        path of a bad value, also for the rules that need the built scene and its runs."""
+        s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, functools.partial(_where, name))
+        D, v, t_final, r = s.D, s.v, s.t_final, s.realisations
+        source = _source(name, s.source)
+        span = 2.0 * (source.half_width + s.margin * math.sqrt(2.0 * D * t_final))
+        omega = span if s.omega is None else s.omega
+        fd_length = span if s.fd_length is None else s.fd_length
+        if s.fd_length is not None:  # from the margin it holds the plume by the margin's range
             _check_window(name, fd_length, source, D, t_final)
-        target = {**_TARGET, **dict(spec.get("target") or {})}
-        measure = _checked(name, "target.measure", target.get("measure"))
-        value = _checked(name, "target.value", target.get("value"))
-        raw = spec.get("candidates")
-        if not isinstance(raw, list) or not raw:
-            raise SettingError(_key(name, "candidates"), raw, "a list of at least one model")
-        cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(raw))
+        cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(s.candidates))
         _distinct(name, cands)
         if v == 0:  # nothing to advect: FD's scheme and Courant number are no part of the runs (the step is
             # fd_dt, its own or the default); twins keep their index (same_as)
             cands = tuple(replace(c, advection="none", courant=None) for c in cands)
-        cost = _cost(name, spec.get("cost"))
-        most = _max_realisations(name, spec.get("max_realisations"), r)
-        scene = cls(name, D, v, t_final, source, omega, fd_length, measure, value, r, cands, cost, budget)
-        scene = replace(scene, max_realisations=most)
+        cost = tuple((m, tuple(pair)) for m, pair in sorted({**_DEFAULTS["cost"], **s.cost}.items()))
+        budget = math.inf if s.budget is None else s.budget
+        most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
+        scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
+        scene = replace(scene, budget=budget, max_realisations=most)
         _check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             for n in dict.fromkeys((c.n_lo, c.ladder()[-1])):
                 try:
                     scene.run_config(c, n)
                 except SettingError as e:
-                    raise _candidate_error(scene, i, raw[i], e) from None
+                    raise _candidate_error(scene, i, s.candidates[i].model_fields_set, e) from None
         return scene
 
 
-def _max_realisations(name: str, value, realisations: int) -> int:
-    """scenes.<name>.max_realisations as given (default MAX_BLOCKS x realisations, within
-    MAX_REALISATIONS), else SettingError naming it: a multiple of realisations, at least one block."""
-    if value is None:
-        return min(MAX_BLOCKS, MAX_REALISATIONS // realisations) * realisations
-    most = _checked(name, "max_realisations", value)
-    if most < realisations or most % realisations:
-        raise SettingError(
-            _key(name, "max_realisations"),
-            value,
-            f"a multiple of realisations ({realisations}) in [{realisations}, {MAX_REALISATIONS:,}]: "
-            "rungs are refined a seed block of realisations at a time",
-        )
-    return most
-
-
-def _known_keys(name: str, spec: Mapping) -> None:
-    """SettingError naming the first key of a scene (or of its target) that settings.SCENE does not
-    declare, with the nearest declared one (a typo is refused, not dropped)."""
-    declared = [s.key.split(".", 2)[2] for s in SCENE]  # 'D', 'target.measure', ...
-    for where, mapping in (("", spec), ("target.", spec.get("target"))):
-        if not isinstance(mapping, Mapping):
-            continue
-        known = list(dict.fromkeys(k[len(where) :].split(".")[0] for k in declared if k.startswith(where)))
-        for key in mapping:
-            if key not in known:
-                near = difflib.get_close_matches(str(key), known, n=1)
-                hint = f"; did you mean {near[0]}?" if near else ""
-                raise SettingError(
-                    _key(name, f"{where}{key}"), "(unknown key)", f"a known key: {', '.join(known)}{hint}"
-                )
+def _where(name: str, path: list) -> str:
+    """The config key of the key ``path`` (keys and indexes) within scene ``name`` (key_path)."""
+    return key_path(name, typed_key_path(path)) if path else key_path(name, "")[:-1]
 
 
 def _distinct(name: str, cands: tuple[Candidate, ...]) -> None:
@@ -339,7 +303,7 @@ def _check_reach(scene: Scene) -> None:
 _CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
 
 
-def _candidate_error(scene: Scene, i: int, spec: Mapping, e: SettingError) -> SettingError:
+def _candidate_error(scene: Scene, i: int, spec, e: SettingError) -> SettingError:
     """A SettingError of candidate i's run, named by the key the user wrote: its n_range or ladder for
     a resolution, its fd_dt or else the scene's t_final for a step count, its own dimension or else
     case_defaults' for a case dimension, the scene's key for the physics."""
@@ -391,34 +355,8 @@ def _check_window(name: str, fd_length: float, source: Source, D: float, t_final
         )
 
 
-def _cost(name: str, spec) -> tuple:
-    out = dict(_DEFAULTS["cost"])
-    if spec is not None:
-        if not isinstance(spec, Mapping) or set(spec) - set(out):
-            raise SettingError(_key(name, "cost"), spec, BY_KEY["scenes.<name>.cost"].allowed())
-        out.update(spec)
-    for method, pair in out.items():
-        ok = isinstance(pair, (list, tuple)) and len(pair) == 2
-        ok = ok and all(isinstance(x, (int, float)) and not isinstance(x, bool) and 0 <= x < math.inf for x in pair)
-        if not ok:
-            raise SettingError(_key(name, f"cost.{method}"), pair, "[seconds a step, seconds a unit of work], >= 0")
-    return tuple((m, (float(a), float(b))) for m, (a, b) in sorted(out.items()))
-
-
-def _checked(name: str, key: str, value):
-    """``value`` of scenes.<name>.<key> as its declaration (settings.SCENE) allows it (check_setting: a
-    number as a float), else SettingError naming the key path."""
-    setting = BY_KEY[f"scenes.<name>.{key}"]
-    try:
-        return check_setting(setting, value)
-    except SettingError as e:
-        raise SettingError(_key(name, key), value, setting.range_text or e.allowed) from None
-
-
 def _source(name: str, spec) -> Source:
     """The source at scenes.<name>.source (Source.from_spec), else SettingError naming its key path."""
-    if not isinstance(spec, Mapping):
-        raise SettingError(_key(name, "source"), spec, BY_KEY["scenes.<name>.source"].allowed())
     try:
         return Source.from_spec(spec)
     except SourceError as e:
@@ -426,68 +364,20 @@ def _source(name: str, spec) -> Source:
 
 
 def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
-    where = f"candidates[{i}]"
-    if not isinstance(spec, Mapping):
-        raise SettingError(_key(name, where), spec, "a model: method, kernel, n_range and its dimensions")
-    spec = dict(spec)
-    fd_only = [k for k in ("advection", "fd_dt", "courant") if k in spec]
-    if "ladder" in spec:
-        rungs = spec.pop("ladder")
-        ok = isinstance(rungs, list) and len(rungs) >= 2 and "n_range" not in spec
-        ok = ok and all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in rungs)
-        if not ok or any(b <= a for a, b in zip(rungs, rungs[1:])):
-            raise SettingError(
-                _key(name, f"{where}.ladder"), rungs, "at least two integers >= 2, ascending (instead of n_range)"
-            )
-        spec["n_range"] = [rungs[0], rungs[-1]]
-    else:
-        rungs = []
-    n_range = spec.pop("n_range", None)
-    advection = spec.pop("advection", DEFAULT_ADVECTION)
-    fd_dt = spec.pop("fd_dt", PAPER["fd_dt"])
-    courant = spec.pop("courant", None)
-    ok = (
-        isinstance(n_range, list)
-        and len(n_range) == 2
-        and all(isinstance(n, int) and not isinstance(n, bool) for n in n_range)
-        and 2 <= n_range[0] < n_range[1]
-    )
-    if not ok:
-        raise SettingError(_key(name, f"{where}.n_range"), n_range, "[low, high], integers with 2 <= low < high")
-    if spec.get("method") == "fd" and not rungs and any(n % 2 for n in n_range):
-        raise SettingError(
-            _key(name, f"{where}.n_range"),
-            n_range,
-            "for fd [low, high], even numbers of intervals (a node at x = 0) with 4 <= low < high",
-        )
-    if advection not in ADVECTION_SCHEMES:
-        raise SettingError(_key(name, f"{where}.advection"), advection, f"one of {', '.join(ADVECTION_SCHEMES)}")
-    if not (isinstance(fd_dt, (int, float)) and not isinstance(fd_dt, bool) and 0 < fd_dt < math.inf):
-        raise SettingError(_key(name, f"{where}.fd_dt"), fd_dt, "a number > 0 [T]")
-    if courant is not None:
-        ok = isinstance(courant, (int, float)) and not isinstance(courant, bool)
-        limit = COURANT_LIMIT.get(advection, math.inf)
-        if not (ok and 0 < courant < math.inf and courant <= limit):
-            most = "" if limit == math.inf else f" and <= {limit:g} for advection {advection} (explicit)"
-            raise SettingError(
-                _key(name, f"{where}.courant"), courant, f"a number > 0{most}: the step's Courant number |v| dt / dx"
-            )
-    if spec.get("time_grid", "exact") != "exact":
-        raise SettingError(_key(name, f"{where}.time_grid"), spec["time_grid"], SCENE_TIME_GRID_TEXT)
-    # case_defaults' time_grid is the paper figures': a scene's runs end at t_final, where they are judged
+    """Candidate i of scene ``name`` from its parsed model (its keys' rules held there, core/typed.py):
+    its case built with case_defaults (not their time_grid: a scene's runs end at t_final, where they
+    are judged), else SettingError naming the candidate's key or case_defaults'."""
+    dims = spec.model_dump(exclude_unset=True, exclude={*FD_ONLY, "n_range", "ladder"})
     case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
     try:
-        case = Case.from_spec(spec, None, case_defaults)
+        case = Case.from_spec(dims, None, case_defaults)
     except SettingError as e:
-        raise SettingError(_key(name, f"{where}.{e.name}"), e.value, e.allowed) from None
-    if case.method != "fd" and fd_only:
-        key = fd_only[0]
-        value = {"advection": advection, "fd_dt": fd_dt, "courant": courant}[key]
-        raise SettingError(_key(name, f"{where}.{key}"), value, "fd candidates only")
-    if case.method == "fd" and any(n % 2 for n in rungs):
-        raise SettingError(_key(name, f"{where}.ladder"), rungs, "for fd even numbers of intervals")
-    courant = None if courant is None else float(courant)
-    return Candidate(case, int(n_range[0]), int(n_range[1]), advection, float(fd_dt), tuple(rungs), courant)
+        raise SettingError(_key(name, f"candidates[{i}].{e.name}"), e.value, e.allowed) from None
+    rungs = tuple(spec.ladder or ())
+    lo, hi = (rungs[0], rungs[-1]) if rungs else spec.n_range
+    advection = spec.advection or DEFAULT_ADVECTION
+    fd_dt = PAPER["fd_dt"] if spec.fd_dt is None else spec.fd_dt
+    return Candidate(case, lo, hi, advection, fd_dt, rungs, spec.courant)
 
 
 class Scenes(Mapping):
@@ -561,20 +451,14 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
 
 
 def peclet_scenes(config: Mapping) -> dict[str, dict]:
-    """The scenes of config `scenes_peclet`: its base at each velocity, named peclet-<k> (SWEEP_PREFIX,
-    a name no scene of config `scenes` can have); SettingError
-    naming the key when the velocities are not ascending numbers >= 0 or the base sets v."""
+    """The scenes of config `scenes_peclet` as written: its base at each velocity, named peclet-<k>
+    (SWEEP_PREFIX, a name no scene of config `scenes` can have). The sweep is parsed by its model
+    (core/typed.py: a base without v, velocities ascending >= 0); SettingError names the key."""
     sweep = config.get("scenes_peclet")
     if not sweep:
         return {}
-    base, vs = dict(sweep.get("base") or {}), sweep.get("v")
-    if "v" in base:
-        raise SettingError("scenes_peclet.base.v", base["v"], "no v: the sweep sets it (scenes_peclet.v)")
-    ok = isinstance(vs, list) and len(vs) >= 2
-    ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) and 0 <= v < math.inf for v in vs)
-    if not ok or any(b <= a for a, b in zip(vs, vs[1:])):
-        raise SettingError("scenes_peclet.v", vs, "at least two numbers >= 0, ascending")
-    return {f"{SWEEP_PREFIX}{k}": {**base, "v": float(v)} for k, v in enumerate(vs)}
+    parsed = validate(shared().ScenesPeclet, sweep, lambda path: typed_key_path(["scenes_peclet", *path]))
+    return {f"{SWEEP_PREFIX}{k}": {**sweep["base"], "v": v} for k, v in enumerate(parsed.v)}
 
 
 def scenes(config: Mapping, check=None, paper=None) -> Scenes:

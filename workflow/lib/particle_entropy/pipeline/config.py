@@ -30,13 +30,11 @@ from pydantic import ConfigDict, Field, create_model, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..core.settings import (
-    BY_KEY,
     CLAIMS,
     COMIC_TIMES,
     FIGURE_OPTIONS,
     MECHANISM,
     REALISATIONS_ENTRY,
-    SCENES_PECLET,
     SECTION_DOCS,
     SEEDS,
     SETTINGS,
@@ -111,7 +109,7 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
     """Every section's model, from the run settings ``settings`` (settings.SETTINGS) and the other
     sections' declarations; the shared definitions (``defs``: a case's dimensions, a case, a list
     of cases, of N, a section of cases) by name, as the schema's $defs names them."""
-    m = SimpleNamespace(**vars(shared(settings)))  # defs, CaseSection, Search, Target, Scene, SceneBase
+    m = SimpleNamespace(**vars(shared(settings)))  # defs, CaseSection, Search, the scenes'
     defs = m.defs
 
     def of(name: str, keys, doc: str, parent=Section, order=(), **extra):
@@ -151,13 +149,6 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         SECTION_DOCS["mechanism"],
         lattice=(m.Lattice, None),
         fd_domain=(m.FdDomain, None),
-    )
-    base = BY_KEY["scenes_peclet.base"]
-    m.ScenesPeclet = of(
-        "ScenesPeclet",
-        SCENES_PECLET,
-        SECTION_DOCS["scenes_peclet"],
-        base=(m.SceneBase, Field(..., description=description(base))),
     )
     name = Annotated[str, Field(pattern=NAME_PATTERN)]
     m.Config = create_model(

@@ -12,13 +12,13 @@ from the typed config, given or parsed here."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 from ..core.case import Case, SettingError
 from ..core.labels import case_label
 from ..core.runconfig import FD_MIN_INTERVALS, MAX_SEED, RunConfig, first_step_key
 from ..core.settings import SETTINGS
+from ..core.typed import check_finite
 from .config import Config
 from .configcheck import parse
 from .memory import estimate_mb, shear_memory_mb
@@ -81,19 +81,6 @@ def check_fd_domain(config: Mapping, typed: Config | None = None) -> None:
             except SettingError as e:
                 key, value = ("lengths", written) if e.name == "fd_length" else ("n", n)
                 raise SettingError(f"mechanism.fd_domain.{key}", value, e.allowed) from None
-
-
-def check_finite(value, where: str = "") -> None:
-    """Every number of the config must be finite: YAML's .nan and .inf pass the schema's
-    `number` but no setting means them. SettingError names the key path."""
-    if isinstance(value, Mapping):
-        for k, v in value.items():
-            check_finite(v, f"{where}.{k}" if where else str(k))
-    elif isinstance(value, (list, tuple)):
-        for i, v in enumerate(value):
-            check_finite(v, f"{where}[{i}]")
-    elif isinstance(value, float) and not math.isfinite(value):
-        raise SettingError(where, value, "a finite number (YAML .nan and .inf are not settings)")
 
 
 # RunConfig settings that come from a shared config key, not from the case: a SettingError about

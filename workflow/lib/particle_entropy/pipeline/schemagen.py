@@ -25,7 +25,7 @@ from pydantic import StrictBool, StrictInt
 from pydantic.fields import FieldInfo
 
 from ..core.case import NONE
-from ..core.settings import SETTINGS, UNIQUE
+from ..core.settings import BY_KEY, SETTINGS, UNIQUE
 from . import config as typed
 from .configcheck import SCHEMA_PATH
 
@@ -197,7 +197,7 @@ class Writer:
                 entry = {"description": typed.DEF_DOCS[name], **entry}
             if name == "realisations":
                 entry = {**entry, "default": 1}
-            setting = typed.BY_KEY.get(f"case_defaults.{name}")
+            setting = BY_KEY.get(f"case_defaults.{name}")
             if setting is not None:
                 entry["description"] = typed.description(setting)
             defs[name] = entry
