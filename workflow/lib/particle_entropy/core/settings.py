@@ -53,15 +53,16 @@ MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB 
 
 
 def _ref(name: str) -> dict:
-    """The shape of a value of a shared definition (pipeline/config.py builds them: a case, the
+    """The shape of a value of a shared definition (core/typed.shared builds them: a case, the
     lists of cases and of N, a section of cases), as the schema's $defs name it."""
     return {"$ref": f"#/$defs/{name}"}
 
 
-# A structured value's shape is a pydantic type made of these (pipeline/config.py validates by it,
+# A structured value's shape is a pydantic type made of these (core/typed.py validates by it,
 # schemagen writes its schema entry), or, for the shapes built from other declarations, a
-# JSON-schema fragment read by pipeline/config.annotation: a shared definition (_ref), a scene's
-# source and candidates (their owner, experiments/scene.py, checks them further), the shear cases.
+# JSON-schema fragment read by core/typed.annotation: a shared definition (_ref), a scene's source
+# (a plain dict, which its kind's class checks further, core/sources.py), a scene's candidates (the
+# model core/typed.py names by x-model, with the rules between their keys), the shear cases.
 def number(**bounds):
     """A real number (an int is one too; not a bool or a string) within ``bounds`` (gt, ge, le)."""
     return Annotated[float, Field(strict=True, **bounds)]
