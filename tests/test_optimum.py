@@ -631,3 +631,31 @@ def test_an_unscored_point_is_never_the_optimum_and_none_scored_is_said():
     none = r"search t: no visited point scores a COMIC \(SSE = 0: ...\); try a later optimum.t.time \(now 1000\)"
     with pytest.raises(ValueError, match=none):
         evaluate(mtpt(budget_runs=100), table)
+
+
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("case", "mtpt"),  # not a mapping
+        ("n_range", [30.5, 300]),
+        ("cost", [[30, 0]]),
+        ("realisations", 0),
+        ("budjet_runs", 3),
+    ],
+)
+def test_a_search_and_the_workflow_refuse_a_value_in_the_same_words(key, value):
+    """One check: Search.from_config parses a search as written by the model the workflow's config
+    is made of (core/typed.py), so both name the same key and value, and say the same."""
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import check_config, load_yaml
+
+    config = dict(load_yaml(ROOT / "config.yaml"))
+    name = next(iter(config["optimum"]))
+    bad = {**config["optimum"][name], key: value}
+    with pytest.raises(SettingError) as alone:
+        Search.from_config(name, bad, config)
+    with pytest.raises(SettingError) as workflow:
+        check_config({**config, "optimum": {**config["optimum"], name: bad}})
+    assert alone.value.name.startswith(f"optimum.{name}.{key}")
+    assert str(alone.value) == str(workflow.value)

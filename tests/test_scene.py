@@ -659,3 +659,38 @@ def test_seeds_past_int64_are_refused_naming_max_realisations():
     with pytest.raises(SettingError) as e:
         check_scene(scene, 2**63 - 15, None)
     assert e.value.name == "scenes.s.max_realisations" and "<= 15 with base_seed" in e.value.allowed
+
+
+@pytest.mark.parametrize(
+    "key, value",
+    [
+        ("target", 0.1),  # a number where a section goes: a TypeError before scenes parsed by their model
+        ("target", ["value", 0.1]),
+        ("D", "1e-3"),
+        ("v", math.inf),
+        ("max_realisations", 12),
+        ("cost", {"fd": [1.0, -1.0]}),
+        ("source", {"kind": ["point"]}),
+        ("candidates", [{"method": "pt", "kernel": "adaptive", "n_range": [30, 300], "eta": None}]),
+        ("candidates", [{"method": "pt", "kernel": "adaptive", "n_range": [300, 30]}]),
+        ("candidates", [{"method": "pt", "kernel": "adaptive", "ladder": [30, 100], "n_range": [30, 100]}]),
+        ("candidates", [{"method": "pt", "kernel": "adaptive", "n_range": [30, 300], "courant": 0.5}]),
+        ("candidates", [{"method": "fd", "kernel": "implicit", "advection": "tvd", "n_range": [16, 64], "courant": 2}]),
+    ],
+)
+def test_a_scene_and_the_workflow_refuse_a_value_in_the_same_words(key, value):
+    """One check: Scene.from_config on a scene as written (a notebook, a job script) parses it by the
+    model the workflow's config is made of (core/typed.py), so both name the same key and value, and
+    say the same."""
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import check_config, load_yaml
+
+    config = dict(load_yaml(ROOT / "config.yaml"))
+    bad = {**config["scenes"]["carried"], key: value}
+    with pytest.raises(SettingError) as alone:
+        Scene.from_config("carried", bad, config["case_defaults"])
+    with pytest.raises(SettingError) as workflow:
+        check_config({**config, "scenes": {**config["scenes"], "carried": bad}})
+    assert alone.value.name.startswith(f"scenes.carried.{key}")
+    assert str(alone.value) == str(workflow.value)
