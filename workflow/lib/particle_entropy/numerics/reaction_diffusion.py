@@ -19,6 +19,7 @@ concentrations of A and C at given points."""
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -114,7 +115,7 @@ def solve(x, a0, b0, D: float, reaction, t_final: float, n_steps: int, times=())
     """A, B, C at t_final of dA/dt = D A_xx - R, dB/dt = D B_xx - R, dC/dt = D C_xx + R from
     concentrations a0, b0 (C = 0; b0 may be a float) on uniform cells centred at x, in n_steps
     Strang steps (reaction dt/2, Crank-Nicolson dt, reaction dt/2), with the total masses at
-    ``times`` (each a multiple of dt)."""
+    ``times`` (each a multiple of dt); every value stays >= 0 while D dt / dx^2 <= 1."""
     x = np.asarray(x, dtype=np.float64)
     a = np.array(a0, dtype=np.float64)
     b = np.array(b0, dtype=np.float64) * np.ones_like(a)
@@ -265,8 +266,6 @@ def reference(
     extrapolated by ``richardson``; A from mass_a of source_a, B from ``b`` as in initial_fields,
     points in the lab frame (the grid moves with v), concentrations interpolated by ``at_points``. The
     default n_steps makes r <= 1/4 and dt <= 1/8 of the fastest reaction time on the coarsest grid."""
-    import time
-
     sources = [source_a] + ([b[0]] if isinstance(b, tuple) else [])
     lo, hi = bounds if bounds is not None else window(sources, D, t_final)
     points = np.asarray(points, dtype=np.float64) - v * t_final
