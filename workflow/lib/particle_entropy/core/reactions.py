@@ -14,9 +14,16 @@ that no step makes a mass negative or loses one to round-off beyond the last dig
   which tends to q as dt grows (the scarcer species runs out) and to p q k dt as dt shrinks. For
   equal uniform concentrations C0 it is the well-mixed solution C(t) = C0 / (1 + k C0 t), which
   also solves the reaction-diffusion PDE exactly for uniform initial conditions.
+
+A reaction kind is a class (``Decay``, ``Bimolecular``, listed once in ``REACTIONS``) whose ``react``
+advances nodes or particles by these solutions and returns the product made.
 """
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -66,3 +73,51 @@ def well_mixed(a0: float, b0: float, k: float, t) -> tuple[np.ndarray, np.ndarra
     """The concentrations (A, B) at time t of a well-mixed A + B -> C from uniform a0, b0: with
     a0 = b0 = C0 the classical C0 / (1 + k C0 t)."""
     return bimolecular_step(a0, b0, k, t)
+
+
+@dataclass(frozen=True)
+class Decay:
+    """First-order decay A -> C, dA/dt = -lambda A, at ``rate`` lambda [1/T]; B takes no part."""
+
+    KIND: ClassVar[str] = "decay"
+    CONSUMES_B: ClassVar[bool] = False  # conserved: A + C and B
+    rate: float
+
+    def __post_init__(self):
+        if not (self.rate >= 0 and math.isfinite(self.rate)):
+            raise ValueError(f"decay rate must be >= 0 and finite, got {self.rate!r}")
+
+    def react(self, a, b, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, the A turned into C) after dt: A exp(-lambda dt), B as it was, A (1 - exp(-lambda dt))."""
+        a = np.asarray(a, dtype=np.float64)
+        return a * decay_factor(self.rate, dt), np.asarray(b, dtype=np.float64), -a * math.expm1(-self.rate * dt)
+
+    def fastest_rate(self, a, b) -> float:
+        """lambda: the fastest local rate of the kinetics [1/T]."""
+        return float(self.rate)
+
+
+@dataclass(frozen=True)
+class Bimolecular:
+    """The irreversible A + B -> C, dA/dt = dB/dt = -k A B, at rate constant ``k`` [L/(M T) in 1-D]."""
+
+    KIND: ClassVar[str] = "bimolecular"
+    CONSUMES_B: ClassVar[bool] = True  # conserved: A + C and B + C
+    k: float
+
+    def __post_init__(self):
+        if not (self.k >= 0 and math.isfinite(self.k)):
+            raise ValueError(f"rate constant k must be >= 0 and finite, got {self.k!r}")
+
+    def react(self, a, b, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, the C made) after dt, each by the exact step (bimolecular_step, bimolecular_reacted)."""
+        a_new, b_new = bimolecular_step(a, b, self.k, dt)
+        return a_new, b_new, bimolecular_reacted(a, b, self.k, dt)
+
+    def fastest_rate(self, a, b) -> float:
+        """k max(A, B): the fastest local rate of the kinetics from (a, b) [1/T]."""
+        return float(self.k * max(np.max(a, initial=0.0), np.max(b, initial=0.0)))
+
+
+# The reaction kinds, each once.
+REACTIONS: dict[str, type] = {cls.KIND: cls for cls in (Decay, Bimolecular)}

@@ -1,0 +1,126 @@
+"""The reaction-diffusion reference (numerics/reaction_diffusion.py) against exact solutions: the
+well-mixed law for uniform fields, the decaying Gaussian, the conserved totals, and Richardson's
+estimates on plumes that meet."""
+
+import math
+
+import numpy as np
+import pytest
+
+from particle_entropy.core.reactions import Bimolecular, Decay
+from particle_entropy.core.sources import Source
+from particle_entropy.numerics import reaction_diffusion as RD
+
+D, T = 0.1, 2.0
+
+
+def test_uniform_equal_species_follow_the_well_mixed_law():
+    c0, k, steps = 2.0, 0.5, 400
+    x, dx = RD.cell_centres(0.0, 1.0, 64)
+    times = T * np.arange(0, steps + 1, 50) / steps
+    f = RD.solve(x, np.full(x.size, c0), c0, D, Bimolecular(k), T, steps, times)
+    exact = c0 / (1.0 + k * c0 * T)
+    np.testing.assert_allclose(f.a, exact, rtol=1e-12)
+    np.testing.assert_allclose(f.b, exact, rtol=1e-12)
+    np.testing.assert_allclose(f.c, c0 - exact, rtol=1e-12)
+    np.testing.assert_allclose(f.masses[:, 0], c0 / (1.0 + k * c0 * times), rtol=1e-12)
+
+
+def test_richardson_recovers_a_second_order_sequence():
+    h = np.array([0.4, 0.2, 0.1])
+    r = RD.richardson(*(1.5 + 3.0 * h**2))
+    assert r.order == pytest.approx(2.0, rel=1e-12)
+    assert r.value == pytest.approx(1.5, rel=1e-14)
+    assert r.error == pytest.approx(3.0 * 0.1**2, rel=1e-12)
+    wobble = RD.richardson(1.0, 1.1, 1.05)  # no asymptotic convergence: no order, the largest change
+    assert math.isnan(wobble.order) and wobble.value == 1.05 and wobble.error == pytest.approx(0.1)
+
+
+def test_cubic_interpolation_is_exact_for_cubics():
+    x, _ = RD.cell_centres(-1.0, 1.0, 40)
+    p = np.array([-0.99, -0.3, 0.013, 0.7, 0.98])
+    cubic = lambda z: 2.0 - z + 3.0 * z**2 - 0.5 * z**3
+    np.testing.assert_allclose(RD.at_points(p, x, cubic(x)), cubic(p), rtol=1e-13)
+
+
+def test_decaying_gaussian_matches_the_exact_solution_at_second_order():
+    lam, v = 0.7, 0.3
+    source = Source.of("gaussian", x0=0.0, sd=0.5)
+    points = np.array([-1.5, -0.3, 0.0, 0.4, 1.5]) + v * T  # lab frame, away from the inflections
+    ref = RD.reference(source, 0.0, D, Decay(lam), T, points, v=v, n_cells=128)
+    exact = source.density(points, D, v, T) * math.exp(-lam * T)
+    fine_error = np.abs(ref.a_points.values[2] - exact)
+    assert np.all((ref.a_points.order > 1.9) & (ref.a_points.order < 2.1))
+    assert np.all(fine_error <= 1.5 * ref.a_points.error)  # the estimate is the error's size ...
+    assert np.all(fine_error >= 0.5 * ref.a_points.error)  # ... not a loose bound
+    assert np.all(np.abs(ref.a_points.value - exact) < 0.05 * fine_error)
+    # decay commutes with diffusion: the product mass is exact to round-off on every grid
+    assert ref.product_mass.values[0] == pytest.approx(-math.expm1(-lam * T), rel=1e-12)
+
+
+class _Watched:
+    """Bimolecular kinetics that record the smallest concentration they are handed (every half step)."""
+
+    def __init__(self, k):
+        self.kinetics, self.smallest = Bimolecular(k), math.inf
+        self.CONSUMES_B = True
+
+    def react(self, a, b, dt):
+        self.smallest = min(self.smallest, float(a.min()), float(b.min()))
+        return self.kinetics.react(a, b, dt)
+
+
+def _boxes(n):
+    x, dx = RD.cell_centres(-8.0, 8.0, n)
+    a0 = Source.of("box", a=-1.0, b=0.0).masses(x, dx) / dx
+    b0 = 0.8 * Source.of("box", a=-0.5, b=1.0).masses(x, dx) / dx
+    return x, a0, b0
+
+
+def test_totals_are_conserved_and_nothing_goes_negative_every_step():
+    x, a0, b0 = _boxes(256)
+    steps = 200
+    watched = _Watched(3.0)
+    f = RD.solve(x, a0, b0, D, watched, T, steps, T * np.arange(steps + 1) / steps)
+    m_a, m_b, m_c = f.masses.T
+    np.testing.assert_allclose(m_a + m_c, 1.0, rtol=1e-13, atol=0)
+    np.testing.assert_allclose(m_b + m_c, 0.8, rtol=1e-13, atol=0)
+    assert np.all(np.diff(m_c) > 0) and m_c[-1] > 0.1  # the boxes overlap and keep reacting
+    assert watched.smallest >= 0.0
+    assert min(f.a.min(), f.b.min(), f.c.min()) >= 0.0
+
+
+def test_a_step_that_loses_mass_is_refused():
+    class Leaky:
+        CONSUMES_B = True
+
+        def react(self, a, b, dt):
+            a_new, b_new, made = Bimolecular(1.0).react(a, b, dt)
+            return a_new, b_new, 0.999 * made
+
+    x, a0, b0 = _boxes(64)
+    with pytest.raises(ArithmeticError, match="changed the total"):
+        RD.solve(x, a0, b0, D, Leaky(), T, 20)
+
+
+def test_a_gaussian_into_uniform_b_converges_within_its_bounds():
+    k, c0 = 2.0, 0.5
+    ref = RD.reference(Source.of("gaussian", x0=0.0, sd=0.5), c0, D, Bimolecular(k), T, [0.0, 0.5], n_cells=128)
+    m = ref.product_mass
+    assert m.error < abs(m.values[0] - m.values[2])
+    assert 1.9 < m.order < 2.1
+    # B <= C0 everywhere (B_t <= D B_xx), so dM_A/dt >= -k C0 M_A: at most 1 - exp(-k C0 T) of A reacts
+    assert 0.0 < m.value <= -math.expm1(-k * c0 * T)
+    assert np.all(ref.c_points.error < np.abs(ref.c_points.values[0] - ref.c_points.values[2]))
+
+
+def test_two_boxes_that_meet_converge_within_their_bounds():
+    k = 2.0
+    a, b = Source.of("box", a=-1.0, b=0.0), Source.of("box", a=0.0, b=1.0)
+    # bounds and cells put the boxes' edges on cell faces of every grid: second order from the start
+    ref = RD.reference(a, (b, 0.8), D, Bimolecular(k), T, [-0.3, 0.0, 0.4], bounds=(-8.0, 8.0), n_cells=128)
+    m = ref.product_mass
+    assert m.error < abs(m.values[0] - m.values[2])
+    assert 1.9 < m.order < 2.1
+    assert 0.0 < m.value <= 0.8  # the scarcer species' mass
+    assert np.all(ref.c_points.error < np.abs(ref.c_points.values[0] - ref.c_points.values[2]))

@@ -1,0 +1,288 @@
+"""The reference solution of a reactive scene: 1-D reaction-diffusion of A, B and their product C,
+
+    dA/dt = D A_xx - R,   dB/dt = D B_xx - R,   dC/dt = D C_xx + R,
+
+with R = k A B (A + B -> C) or R = lambda A (decay A -> C, B inert), on a uniform fine grid in the
+frame that moves with the uniform velocity v, so that no advection term, and none of its numerical
+dispersion, enters. Strang splitting (Strang 1968, SIAM J. Numer. Anal. 5: 506-517): half a step of
+reaction by the closed-form kinetics (core/reactions), a Crank-Nicolson diffusion step, half a step
+of reaction; second order in dt. The grid is cell-centred (finite volumes) with zero-flux (Neumann)
+ends on a window the plume never reaches: a uniform B stays uniform and the totals of A + C and of
+B + C are conserved to round-off, which every step checks. Crank-Nicolson keeps every value >= 0
+while r = D dt / dx^2 <= 1 (the explicit half's diagonal 1 - r >= 0; the implicit half an M-matrix).
+
+``richardson`` extrapolates a quantity from three grids, dx and dt halved each level (Richardson
+1911; the observed order as in Roache 1998, Verification and Validation in Computational Science),
+and ``reference`` runs the three grids of a scene and extrapolates its product mass and its
+concentrations of A and C at given points."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.sources import Source
+from .compiled import kernels
+
+# a step's change of a conserved total beyond this many ulps of the totals' magnitude (times sqrt of
+# the number of cells) is no round-off
+MASS_ULPS = 64.0
+# the default window reaches this many final spreads sqrt(2 D t) beyond the sources: exp(-32) there
+REACH = 8.0
+# the default coarsest grid: this many cells, and a time step with r <= 1/4 (so r <= 1 on the finest
+# of three grids) and at most 1/8 of the fastest reaction time
+COARSE_CELLS = 400
+COARSE_R = 0.25
+COARSE_KINETIC = 0.125
+
+
+@dataclass(frozen=True)
+class Fields:
+    """A solve's result: cell centres x (in the moving frame), the concentrations a, b, c at t_final,
+    the grid's dx, dt and number of steps, and the total masses (integral of A, B, C dx) at ``times``
+    (``masses[i]`` = (M_A, M_B, M_C) at times[i])."""
+
+    x: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    dx: float
+    dt: float
+    n_steps: int
+    times: np.ndarray
+    masses: np.ndarray
+
+    @property
+    def product_mass(self) -> float:
+        """M_C = sum c dx at t_final [M]."""
+        return float(self.c.sum() * self.dx)
+
+
+def cell_centres(lo: float, hi: float, n: int) -> tuple[np.ndarray, float]:
+    """The centres lo + (i + 1/2) dx, i = 0..n-1, of n cells of width dx = (hi - lo) / n [L]."""
+    dx = (hi - lo) / n
+    return lo + dx * (np.arange(n) + 0.5), dx
+
+
+class CrankNicolson:
+    """One Crank-Nicolson step of c_t = D c_xx with zero-flux ends on n cells,
+    (I - r/2 A) c^{n+1} = (I + r/2 A) c^n, r = D dt / dx^2, A the Neumann Laplacian (rows (1, -2, 1),
+    end rows (-1, 1)); factorised once by LAPACK's dgttrf, solved by thomas.gt_solve (subnormals
+    flushed). The columns of A sum to 0: the step conserves sum c to round-off."""
+
+    def __init__(self, n: int, r: float):
+        from scipy.linalg import lapack
+
+        if n < 2:
+            raise ValueError(f"a diffusion grid needs at least 2 cells, got {n}")
+        self.r = float(r)
+        h = 0.5 * self.r
+        d = np.full(n, 1.0 + 2.0 * h)
+        d[0] = d[-1] = 1.0 + h
+        self._factors = lapack.dgttrf(np.full(n - 1, -h), d, np.full(n - 1, -h))
+        if self._factors[-1] != 0:
+            raise ValueError(f"the Crank-Nicolson matrix is singular (dgttrf info {self._factors[-1]})")
+
+    def explicit(self, c: np.ndarray) -> np.ndarray:
+        """(I + r/2 A) c: c plus r/2 times the Neumann second difference."""
+        lap = np.empty_like(c)
+        lap[1:-1] = c[:-2] - 2.0 * c[1:-1] + c[2:]
+        lap[0] = c[1] - c[0]
+        lap[-1] = c[-2] - c[-1]
+        return c + 0.5 * self.r * lap
+
+    def step(self, c: np.ndarray) -> np.ndarray:
+        """c after one step dt."""
+        dl, d, du, du2, ipiv, _ = self._factors
+        return kernels().gt_solve(dl, d, du, du2, ipiv, self.explicit(c))
+
+
+def _check_totals(before: tuple[float, float], after: tuple[float, float], size: float, n: int, step: int) -> None:
+    """ArithmeticError unless the conserved totals (A + C, and B + C or B) did not change beyond round-off."""
+    tol = MASS_ULPS * np.finfo(np.float64).eps * size * math.sqrt(n)
+    for name, b, a in zip(("A + C", "B (+ C)"), before, after):
+        if not abs(a - b) <= tol:
+            raise ArithmeticError(
+                f"reaction-diffusion step {step} changed the total of {name}: {b:.17g} -> {a:.17g}, "
+                f"beyond round-off {tol:.3g}"
+            )
+
+
+def solve(x, a0, b0, D: float, reaction, t_final: float, n_steps: int, times=()) -> Fields:
+    """A, B, C at t_final of dA/dt = D A_xx - R, dB/dt = D B_xx - R, dC/dt = D C_xx + R from
+    concentrations a0, b0 (C = 0; b0 may be a float) on uniform cells centred at x, in n_steps
+    Strang steps (reaction dt/2, Crank-Nicolson dt, reaction dt/2), with the total masses at
+    ``times`` (each a multiple of dt); every value stays >= 0 while D dt / dx^2 <= 1."""
+    x = np.asarray(x, dtype=np.float64)
+    a = np.array(a0, dtype=np.float64)
+    b = np.array(b0, dtype=np.float64) * np.ones_like(a)
+    if x.ndim != 1 or x.size < 2 or a.shape != x.shape:
+        raise ValueError("x and a0 must be 1-D arrays of the same length, at least 2 cells")
+    dx = float(x[1] - x[0])
+    if not (dx > 0 and np.allclose(np.diff(x), dx, rtol=1e-9, atol=0.0)):
+        raise ValueError("the cells must be uniform and increasing")
+    if np.any(a < 0) or np.any(b < 0):
+        raise ValueError("initial concentrations must be >= 0")
+    if not (n_steps >= 1 and t_final > 0):
+        raise ValueError(f"need n_steps >= 1 and t_final > 0, got {n_steps}, {t_final}")
+    dt = t_final / n_steps
+    times = np.asarray(times, dtype=np.float64)
+    at_step = np.rint(times / dt).astype(np.int64)
+    if np.any(np.abs(at_step * dt - times) > 1e-9 * max(dt, 1.0)) or np.any((at_step < 0) | (at_step > n_steps)):
+        raise ValueError(f"each requested time must be a multiple of dt = {dt!r} in [0, t_final]")
+    c = np.zeros_like(a)
+    diffuse = CrankNicolson(a.size, D * dt / dx**2)
+    masses = np.empty((times.size, 3))
+
+    def record(step):
+        for i in np.flatnonzero(at_step == step):
+            masses[i] = a.sum() * dx, b.sum() * dx, c.sum() * dx
+
+    def half_reaction():
+        nonlocal a, b, c
+        a, b, made = reaction.react(a, b, 0.5 * dt)
+        c = c + made
+
+    def conserved():
+        return float(a.sum() + c.sum()), float(b.sum() + (c.sum() if reaction.CONSUMES_B else 0.0))
+
+    record(0)
+    totals = conserved()
+    size = float(a.sum() + b.sum())
+    for step in range(1, n_steps + 1):
+        half_reaction()
+        a, b, c = diffuse.step(a), diffuse.step(b), diffuse.step(c)
+        half_reaction()
+        now = conserved()
+        _check_totals(totals, now, size, a.size, step)
+        totals = now
+        record(step)
+    return Fields(x, a, b, c, dx, dt, int(n_steps), times, masses)
+
+
+@dataclass(frozen=True)
+class Richardson:
+    """A quantity extrapolated from three grids refined by ``ratio``: the extrapolated ``value``, the
+    ``error`` estimate of the finest grid's value |f_3 - f_2| / (ratio^p - 1), the observed ``order``
+    p, and the three grids' ``values`` (coarse, medium, fine). Arrays where the quantity is one."""
+
+    value: np.ndarray | float
+    error: np.ndarray | float
+    order: np.ndarray | float
+    values: tuple
+
+
+def richardson(coarse, medium, fine, ratio: float = 2.0) -> Richardson:
+    """Richardson extrapolation from three grids: p = ln((f_1 - f_2) / (f_2 - f_3)) / ln(ratio),
+    f = f_3 + (f_3 - f_2) / (ratio^p - 1), error |f_3 - f_2| / (ratio^p - 1). Where the differences
+    change sign or vanish (no asymptotic convergence) p is NaN, the value f_3 and the error
+    max(|f_1 - f_2|, |f_2 - f_3|)."""
+    f1, f2, f3 = (np.asarray(f, dtype=np.float64) for f in (coarse, medium, fine))
+    d12, d23 = f1 - f2, f2 - f3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = d12 / d23
+        monotone = np.isfinite(q) & (q > 1.0)
+        p = np.where(monotone, np.log(np.where(monotone, q, 2.0)) / math.log(ratio), np.nan)
+        gain = np.where(monotone, ratio**p - 1.0, 1.0)
+        value = np.where(monotone, f3 - d23 / gain, f3)
+        error = np.where(monotone, np.abs(d23) / gain, np.maximum(np.abs(d12), np.abs(d23)))
+
+    def out(z):
+        return float(z) if z.ndim == 0 else z
+
+    return Richardson(out(value), out(error), out(p), (out(f1), out(f2), out(f3)))
+
+
+@dataclass(frozen=True)
+class ReactiveReference:
+    """A reactive scene's reference at t_final: the product mass M_C and the concentrations of A and
+    C at the points (lab frame), each a Richardson over the three grids, the finest grid's Fields, and
+    the seconds each grid's solve took."""
+
+    product_mass: Richardson
+    a_points: Richardson
+    c_points: Richardson
+    fine: Fields
+    seconds: tuple[float, ...]
+
+
+def at_points(points, x: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """c at ``points`` by 4-point Lagrange (cubic) interpolation on the uniform cells x: error
+    O(dx^4), below the solve's O(dx^2), so that it does not blur Richardson's observed order (linear
+    interpolation's error s (1 - s) dx^2 c'' / 2 jumps with the point's place s in its cell)."""
+    points = np.asarray(points, dtype=np.float64)
+    dx = x[1] - x[0]
+    u = (points - x[0]) / dx
+    i = np.clip(np.floor(u).astype(np.int64) - 1, 0, x.size - 4)  # the stencil i .. i + 3
+    s = u - i  # the point's place on the stencil's nodes 0, 1, 2, 3
+    w = np.stack(
+        [
+            -(s - 1) * (s - 2) * (s - 3) / 6,
+            s * (s - 2) * (s - 3) / 2,
+            -s * (s - 1) * (s - 3) / 2,
+            s * (s - 1) * (s - 2) / 6,
+        ]
+    )
+    return np.sum(w * c[i[None, :] + np.arange(4)[:, None]], axis=0)
+
+
+def window(sources, D: float, t_final: float) -> tuple[float, float]:
+    """(lo, hi) reaching REACH final spreads sqrt(2 D t_final) beyond every source's half width [L]."""
+    reach = REACH * math.sqrt(2.0 * D * t_final)
+    lo = min(s.centre - s.half_width for s in sources) - reach
+    hi = max(s.centre + s.half_width for s in sources) + reach
+    return lo, hi
+
+
+def initial_fields(x: np.ndarray, dx: float, source_a: Source, mass_a: float, b) -> tuple[np.ndarray, np.ndarray]:
+    """(A, B) on cells at x: mass_a of source_a as cell masses over dx (Source.masses); B the same
+    for ``b`` = (Source, mass), or the uniform concentration ``b`` = C0."""
+    a = mass_a * source_a.masses(x, dx) / dx
+    if isinstance(b, tuple):
+        source_b, mass_b = b
+        return a, mass_b * source_b.masses(x, dx) / dx
+    return a, np.full_like(x, float(b))
+
+
+def reference(
+    source_a: Source,
+    b,
+    D: float,
+    reaction,
+    t_final: float,
+    points=(),
+    *,
+    mass_a: float = 1.0,
+    v: float = 0.0,
+    bounds: tuple[float, float] | None = None,
+    n_cells: int = COARSE_CELLS,
+    n_steps: int | None = None,
+) -> ReactiveReference:
+    """The reference of a reactive scene at t_final: ``solve`` on n_cells, 2 n_cells and 4 n_cells
+    (steps n_steps, 2 n_steps, 4 n_steps) over ``bounds`` (default ``window``), each quantity
+    extrapolated by ``richardson``; A from mass_a of source_a, B from ``b`` as in initial_fields,
+    points in the lab frame (the grid moves with v), concentrations interpolated by ``at_points``. The
+    default n_steps makes r <= 1/4 and dt <= 1/8 of the fastest reaction time on the coarsest grid."""
+    sources = [source_a] + ([b[0]] if isinstance(b, tuple) else [])
+    lo, hi = bounds if bounds is not None else window(sources, D, t_final)
+    points = np.asarray(points, dtype=np.float64) - v * t_final
+    if n_steps is None:
+        x, dx = cell_centres(lo, hi, n_cells)
+        a0, b0 = initial_fields(x, dx, source_a, mass_a, b)
+        by_r = D * t_final / (COARSE_R * dx * dx)
+        by_kinetics = t_final * reaction.fastest_rate(a0, b0) / COARSE_KINETIC
+        n_steps = max(1, math.ceil(max(by_r, by_kinetics)))
+    runs, seconds = [], []
+    for level in range(3):
+        x, dx = cell_centres(lo, hi, n_cells * 2**level)
+        a0, b0 = initial_fields(x, dx, source_a, mass_a, b)
+        start = time.perf_counter()
+        runs.append(solve(x, a0, b0, D, reaction, t_final, n_steps * 2**level))
+        seconds.append(time.perf_counter() - start)
+    mass = richardson(*(f.product_mass for f in runs))
+    a_pts = richardson(*(at_points(points, f.x, f.a) for f in runs))
+    c_pts = richardson(*(at_points(points, f.x, f.c) for f in runs))
+    return ReactiveReference(mass, a_pts, c_pts, runs[-1], tuple(seconds))
