@@ -121,3 +121,135 @@ class Bimolecular:
 
 # The reaction kinds, each once.
 REACTIONS: dict[str, type] = {cls.KIND: cls for cls in (Decay, Bimolecular)}
+
+
+# ------------------------------------------------------------------------------ a scene's reaction
+B_UNIFORM_MAX = 1e6  # a uniform B above this many units of mass per length is a typo [M/L]
+
+
+class ReactionError(ValueError):
+    """A bad reaction parameter: ``param`` (its key within the reaction), the value, what is allowed."""
+
+    def __init__(self, param: str, value, allowed: str):
+        super().__init__(f"{param}={value!r}: {allowed}")
+        self.param, self.value, self.allowed = param, value, allowed
+
+
+@dataclass(frozen=True)
+class Reaction:
+    """A scene's reaction (config ``scenes.<name>.reaction``): its kinetics, and for A + B -> C the
+    second species B's initial condition, a uniform background ``b_uniform`` [M/L] or a plume
+    ``b_source`` of mass ``b_mass`` [M]. A is the scene's own source, of unit mass."""
+
+    kinetics: Decay | Bimolecular
+    b_uniform: float = 0.0
+    b_source: object = None  # a core.sources.Source
+    b_mass: float = 0.0
+
+    @property
+    def kind(self) -> str:
+        return self.kinetics.KIND
+
+    @property
+    def well_mixed(self) -> bool:
+        """Whether the reference is closed-form: a decay (the conservative plume times exp(-lambda t))."""
+        return self.kind == "decay"
+
+    def record(self) -> dict:
+        """The reaction as a run's settings carry it and its identity digests it."""
+        if self.kind == "decay":
+            return {"kind": "decay", "rate": self.kinetics.rate}
+        if self.b_source is None:
+            b = {"uniform": self.b_uniform}
+        else:
+            b = {"source": self.b_source.record(), "mass": self.b_mass}
+        return {"kind": "bimolecular", "k": self.kinetics.k, "B": b}
+
+    @staticmethod
+    def from_spec(spec) -> Reaction:
+        """The reaction a config writes ({kind: decay, rate} or {kind: bimolecular, k, B: {uniform: C0} or
+        {source: <a source>, mass}}), its keys already typed (core/typed.py); ReactionError naming the
+        first bad parameter of B's source."""
+        from .sources import Source, SourceError
+
+        if spec["kind"] == "decay":
+            return Reaction(Decay(spec["rate"]))
+        b = spec["B"]
+        if "uniform" in b:
+            return Reaction(Bimolecular(spec["k"]), b_uniform=b["uniform"])
+        try:
+            source = Source.from_spec(b["source"])
+        except SourceError as e:
+            raise ReactionError(f"B.source.{e.param}", e.value, e.allowed) from None
+        return Reaction(Bimolecular(spec["k"]), b_source=source, b_mass=b.get("mass", 1.0))
+
+    @staticmethod
+    def of(record: dict | None) -> Reaction | None:
+        """The reaction of a run's settings (``record``), or None."""
+        if record is None:
+            return None
+        if record["kind"] == "decay":
+            return Reaction(Decay(record["rate"]))
+        from .sources import Source
+
+        b = record["B"]
+        if "uniform" in b:
+            return Reaction(Bimolecular(record["k"]), b_uniform=b["uniform"])
+        return Reaction(Bimolecular(record["k"]), b_source=Source.of(**b["source"]), b_mass=b["mass"])
+
+    def b_masses(self, x: np.ndarray, dV: float) -> np.ndarray:
+        """B's initial mass on particles or nodes at ``x`` with spacing dV [M]: C0 dV each, or the plume's
+        mass spread by its density (Source.masses); zero for a decay."""
+        x = np.asarray(x, dtype=np.float64)
+        if self.kind == "decay":
+            return np.zeros_like(x)
+        if self.b_source is None:
+            return np.full_like(x, self.b_uniform * dV)
+        return self.b_mass * self.b_source.masses(x, dV)
+
+
+def reaction_shape(source_shape: dict) -> dict:
+    """The JSON schema of a scene's reaction: {kind: decay, rate} or {kind: bimolecular, k, B}, B a
+    uniform background or a source with its mass (core/typed.py's Reaction and SpeciesB models hold
+    the rules between these keys)."""
+    b = {
+        "type": "object",
+        "x-model": "SpeciesB",
+        "additionalProperties": False,
+        "properties": {
+            "uniform": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "maximum": B_UNIFORM_MAX,
+                "description": f"B's uniform initial concentration C0 [M/L]; a number in (0, {B_UNIFORM_MAX:g}]",
+            },
+            "source": {**source_shape, "description": "B's initial plume: a source of the kinds scenes know"},
+            "mass": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "maximum": B_UNIFORM_MAX,
+                "description": "the mass of B's plume (A's is 1) [M]; a number > 0 (default 1)",
+            },
+        },
+    }
+    return {
+        "type": "object",
+        "x-model": "Reaction",
+        "additionalProperties": False,
+        "required": ["kind"],
+        "properties": {
+            "kind": {"type": "string", "enum": list(REACTIONS), "description": f"one of {', '.join(REACTIONS)}"},
+            "rate": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "description": "decay: the first-order rate lambda of A -> C [1/T]; a number > 0",
+            },
+            "k": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "description": "bimolecular: the rate constant k of A + B -> C at rate k C_A C_B [L/(M T)]; "
+                "a number > 0",
+            },
+            "B": {**b, "description": "bimolecular: B's initial condition, {uniform: C0} or {source, mass}"},
+        },
+    }

@@ -28,6 +28,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Field, StrictInt
 from pydantic_core import PydanticCustomError
 
+from .reactions import reaction_shape
 from .registry import (
     ADVECTION_SCHEMES,
     CONVENTION_NAMES,
@@ -487,7 +488,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
 # ------------------------------------------------------------------------------ scenes
 # One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
 # (core/reference.py), the candidate models and the accuracy they must reach.
-SCENE_MEASURES = ("rmse", "entropy", "dilution")
+SCENE_MEASURES = ("rmse", "entropy", "dilution", "product")
 # a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
 # the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
@@ -562,6 +563,17 @@ SCENE = (
         range_text=source_ranges(),
     ),
     Setting(
+        "reaction",
+        "scenes.<name>.reaction",
+        NO_DEFAULT,
+        "a reaction of the source's species A (core/reactions.py): {kind: decay, rate} (A -> C, first order) "
+        "or {kind: bimolecular, k, B} (A + B -> C at rate k C_A C_B; B {uniform: C0} or {source: <a source>, "
+        "mass}); absent: a conservative plume",
+        kind="shape",
+        shape=reaction_shape(SOURCE_SHAPE),
+        range_text="{kind: decay, rate > 0} or {kind: bimolecular, k > 0, B: {uniform: C0 > 0} or {source, mass > 0}}",
+    ),
+    Setting(
         "margin",
         "scenes.<name>.margin",
         6.0,
@@ -589,8 +601,9 @@ SCENE = (
         "measure",
         "scenes.<name>.target.measure",
         "rmse",
-        "the error judged at t_final: rmse = concentration RMSE at the common measurement points [1/L]; entropy "
-        "= |H_C - its exact value| [nats]; dilution = |E / E_exact - 1|",
+        "the error judged at t_final: rmse = concentration RMSE at the common measurement points (of A in a "
+        "reactive scene) [1/L]; entropy = |H_C - its exact value| [nats]; dilution = |E / E_exact - 1|; product "
+        "= |M_C / M_C,ref - 1|, the product's mass (reactive scenes only)",
         choices=SCENE_MEASURES,
     ),
     Setting(

@@ -526,6 +526,15 @@ class _Scene(Section):
     """A scene: its seed blocks fit its realisations."""
 
     @model_validator(mode="after")
+    def _measure_of_kind(self):
+        measure, reactive = self.target.measure, self.reaction is not None
+        if measure == "product" and not reactive:
+            raise refuse("target.measure", "rmse, entropy or dilution: a scene without a reaction makes no product")
+        if reactive and measure in ("entropy", "dilution"):
+            raise refuse("target.measure", "rmse (of C_A) or product: a reactive scene's reference has no entropy")
+        return self
+
+    @model_validator(mode="after")
     def _blocks(self):
         r, most = self.realisations, self.max_realisations
         if most is not None and (most < r or most % r):
@@ -558,7 +567,37 @@ class _ScenesPeclet(Section):
         return self
 
 
-_OWNED = {"Candidate": _Candidate}  # the models of structured values whose rules their owner states
+class _Reaction(OneOf):
+    """A scene's reaction: a decay takes its rate, A + B -> C its k and B."""
+
+    @model_validator(mode="after")
+    def _keys_of_kind(self):
+        given = self.model_fields_set
+        own = {"decay": ("rate",), "bimolecular": ("k", "B")}[self.kind]
+        for key in own:
+            if key not in given:
+                raise refuse(key, f"a required key of a {self.kind} reaction")
+        for key in ("rate", "k", "B"):
+            if key in given and key not in own:
+                raise refuse(key, f"not a key of a {self.kind} reaction (it takes {', '.join(own)})")
+        return self
+
+
+class _SpeciesB(OneOf):
+    """B's initial condition: a uniform background or a plume with its mass."""
+
+    @model_validator(mode="after")
+    def _exactly_one(self):
+        given = self.model_fields_set
+        if ("uniform" in given) == ("source" in given):
+            raise PydanticCustomError("one_of", "exactly one of {keys}", {"keys": "uniform, source"})
+        if "mass" in given and "uniform" in given:
+            raise refuse("mass", "with source only (a uniform B's mass is C0 times its extent)")
+        return self
+
+
+# the models of structured values whose rules their owner states
+_OWNED = {"Candidate": _Candidate, "Reaction": _Reaction, "SpeciesB": _SpeciesB}
 
 
 def keys_in(prefix: str, settings) -> tuple:

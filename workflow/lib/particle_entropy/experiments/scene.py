@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
+from ..core.reactions import Reaction, ReactionError
 from ..core.reference import Reference
 from ..core.registry import DEFAULT_ADVECTION
 from ..core.runconfig import RunConfig, check_plume_width
@@ -137,6 +138,7 @@ class Scene:
     paper_runs: frozenset = frozenset()  # candidates whose runs are the paper run's own (Scenes)
     paper_pattern: str = ""  # the paper run's table pattern, for those
     max_realisations: int = 0  # the most realisations of a particle rung, in blocks of ``realisations`` (0: 4 x)
+    reaction: Reaction | None = None  # A -> C or A + B -> C (core/reactions.py); None: conservative
 
     @property
     def blocks(self) -> int:
@@ -200,6 +202,8 @@ class Scene:
             "v": self.v,
             "window": self.points_span,  # the measurement points span the plume, at rest too
         }
+        if self.reaction is not None:  # only then: a conservative scene's runs keep their identity
+            out["reaction"] = self.reaction.record()
         if candidate.case.method == "fd":
             if candidate.courant is None:
                 out["dt0"] = candidate.fd_dt
@@ -218,6 +222,7 @@ class Scene:
     def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
         """The checked run of a candidate at resolution n."""
         settings = self.settings(candidate)
+        settings.pop("reaction", None)  # the transport's run; a reactive run adds its reaction (models/reactive_run.py)
         settings["source"] = self.source
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
@@ -243,7 +248,8 @@ class Scene:
         budget = math.inf if s.budget is None else s.budget
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
-        scene = replace(scene, budget=budget, max_realisations=most)
+        scene = replace(scene, budget=budget, max_realisations=most, reaction=_reaction(name, s.reaction))
+        _check_reactive(scene)
         _check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             for n in dict.fromkeys((c.n_lo, c.ladder()[-1])):
@@ -353,6 +359,34 @@ def _check_window(name: str, fd_length: float, source: Source, D: float, t_final
             f"(the paper's [-6, 6] at t = 1000, whose zero ends absorb 2 erfc(3) = 4.4e-5 of the mass by then): "
             "a narrower window loses the plume through its ends",
         )
+
+
+def _reaction(name: str, spec) -> Reaction | None:
+    """The reaction at scenes.<name>.reaction (Reaction.from_spec), else SettingError naming its key path."""
+    if spec is None:
+        return None
+    try:
+        return Reaction.from_spec(spec.model_dump(exclude_unset=True, warnings=False))
+    except ReactionError as e:
+        raise SettingError(_key(name, f"reaction.{e.param}"), e.value, e.allowed) from None
+
+
+# what a candidate of a reactive scene may be: the models that carry a reaction (models/reactive_run.py)
+REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
+
+
+def _check_reactive(scene: Scene) -> None:
+    """SettingError naming a candidate that cannot carry the scene's reaction: an MTPT scheme other than
+    the symmetric transfer (the authors' loop moves one species)."""
+    if scene.reaction is None:
+        return
+    for i, c in enumerate(scene.candidates):
+        if c.case.method == "mtpt" and c.case.scheme not in REACTIVE_SCHEMES:
+            raise SettingError(
+                scene.key(f"candidates[{i}].scheme"),
+                c.case.scheme,
+                f"{', '.join(REACTIVE_SCHEMES)} in a reactive scene: the transfer moves every species by one matrix",
+            )
 
 
 def _source(name: str, spec) -> Source:

@@ -1,0 +1,116 @@
+"""A reactive scene's reference (config ``scenes.<name>.reaction``): what every candidate's runs are
+judged against at t_final, with its own error stated.
+
+- A decay is exact: the conservative plume (core/reference.py) times exp(-lambda t), and the
+  product's mass 1 - exp(-lambda t); its error is zero.
+- A + B -> C is solved once on a fine grid in the frame moving with v, where the problem is pure
+  reaction-diffusion with no numerical dispersion from advection (numerics/reaction_diffusion.py:
+  Strang splitting of the closed-form kinetics around Crank-Nicolson), on three grids refined by 2
+  in space and time; each quantity is Richardson-extrapolated and its error estimated from the
+  three. Where A and B start uniform and equal, this is also the well-mixed C0 / (1 + k C0 t).
+
+The reference is keyed by a digest of the physics it depends on (``digest``), as runs are, so two
+scenes of the same physics share one file (REFERENCE_PATTERN).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+
+import numpy as np
+
+from ..core.reactions import Reaction
+
+REFERENCE_PATTERN = "results/scenes/references/{digest}.json"
+SERIES = 40  # the product's mass is recorded at this many equal times in (0, t_final] (the scene figure)
+
+
+def points(scene) -> np.ndarray:
+    """The scene's measurement points at t_final, common to every candidate (RunConfig.points) [L]."""
+    return scene.run_config(scene.candidates[0], scene.candidates[0].n_lo).points(scene.t_final)
+
+
+def physics(scene) -> dict:
+    """What the reference depends on: the source, D, v, t_final, the reaction and the points."""
+    return {
+        "source": scene.source.record(),
+        "D": scene.D,
+        "v": scene.v,
+        "t_final": scene.t_final,
+        "reaction": scene.reaction.record(),
+        "points": [float(p).hex() for p in points(scene)],
+    }
+
+
+def digest(scene) -> str:
+    """The reference's key: a digest of its physics (12 hex digits)."""
+    text = json.dumps(physics(scene), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def compute(scene) -> dict:
+    """The reference of a reactive scene at t_final: the product's mass and A's and C's concentrations at
+    the measurement points, each with its error estimate and observed order, and the product's mass
+    over time (SERIES times) -> a JSON-ready mapping."""
+    reaction: Reaction = scene.reaction
+    pts = points(scene)
+    t = scene.t_final
+    times = t * np.arange(1, SERIES + 1) / SERIES
+    if reaction.kind == "decay":
+        left = math.exp(-reaction.kinetics.rate * t)
+        plume = scene.source.density(pts, scene.D, scene.v, t)
+        zero = [0.0] * pts.size
+        return {
+            "method": "closed form: the conservative plume times exp(-lambda t)",
+            "product_mass": 1.0 - left,
+            "product_error": 0.0,
+            "product_order": math.nan,
+            "points": pts.tolist(),
+            "a_points": (plume * left).tolist(),
+            "a_error": zero,
+            "c_points": (plume * (1.0 - left)).tolist(),
+            "c_error": zero,
+            "times": times.tolist(),
+            "product_series": (-np.expm1(-reaction.kinetics.rate * times)).tolist(),
+            "seconds": [0.0],
+        }
+    from ..numerics.reaction_diffusion import reference
+
+    b = reaction.b_uniform if reaction.b_source is None else (reaction.b_source, reaction.b_mass)
+    ref = reference(scene.source, b, scene.D, reaction.kinetics, t, pts, v=scene.v, times_per_run=SERIES)
+    fine = ref.fine
+    return {
+        "method": "Richardson extrapolation of Strang-split Crank-Nicolson on three grids, moving with v",
+        "product_mass": float(ref.product_mass.value),
+        "product_error": float(ref.product_mass.error),
+        "product_order": float(ref.product_mass.order),
+        "points": pts.tolist(),
+        "a_points": np.asarray(ref.a_points.value, dtype=float).tolist(),
+        "a_error": np.asarray(ref.a_points.error, dtype=float).tolist(),
+        "c_points": np.asarray(ref.c_points.value, dtype=float).tolist(),
+        "c_error": np.asarray(ref.c_points.error, dtype=float).tolist(),
+        "times": fine.times.tolist(),
+        "product_series": fine.masses[:, 2].tolist(),
+        "cells": int(fine.x.size),
+        "steps": int(fine.n_steps),
+        "seconds": list(ref.seconds),
+    }
+
+
+def write(scene, path: str) -> None:
+    """The reference of ``scene`` as JSON at ``path`` (NaN written as null)."""
+    out = compute(scene)
+    out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump({"digest": digest(scene), "physics": physics(scene), **out}, f, indent=1)
+
+
+def read(path: str) -> dict:
+    """A reference written by ``write``, its points and values as arrays."""
+    with open(path, encoding="utf-8") as f:
+        ref = json.load(f)
+    for key in ("points", "a_points", "a_error", "c_points", "c_error", "times", "product_series"):
+        ref[key] = np.asarray(ref[key], dtype=np.float64)
+    return ref
