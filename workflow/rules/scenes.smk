@@ -13,6 +13,7 @@ rule simulate_scene:
         f"results/benchmarks/simulate_scene/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
     wildcard_constraints:
         scene_id=r"[0-9a-f]{12}",
+        kind="runs",
     conda:
         "../../envs/particle-entropy.yaml"
     params:
@@ -20,6 +21,51 @@ rule simulate_scene:
         code=lambda w: SIM_CODE[w.method],
     script:
         "../scripts/simulate.py"
+
+
+# A reactive scene's runs (config scenes.<name>.reaction): the transport of simulate_scene with the
+# reaction after every step (models/reactive_run.py), judged against the scene's reference.
+rule simulate_reactive_scene:
+    input:
+        reference=lambda w: SCENES.reference_path(w.scene_id),
+    output:
+        SCENE_RUN_PATTERN,
+    log:
+        f"logs/scenes/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.log",
+    benchmark:
+        f"results/benchmarks/simulate_scene/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
+    wildcard_constraints:
+        scene_id=r"[0-9a-f]{12}",
+        kind="reactive",
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        settings=lambda w: SCENES.settings(w.scene_id),
+        code=script_code(SCRIPTS / "simulate_reactive.py"),
+    script:
+        "../scripts/simulate_reactive.py"
+
+
+# A reactive scene's reference (experiments/reactive.py), once per physics: the closed form of a
+# decay, or A + B -> C on three fine grids in the frame moving with v, Richardson-extrapolated.
+rule scene_reference:
+    output:
+        REFERENCE_PATTERN,
+    log:
+        "logs/scenes/references/{digest}.log",
+    benchmark:
+        "results/benchmarks/scene_reference/{digest}.tsv"
+    wildcard_constraints:
+        digest=r"[0-9a-f]{12}",
+    conda:
+        "../../envs/particle-entropy.yaml"
+    params:
+        name=lambda w: SCENES.with_reference(w.digest),
+        spec=lambda w: SCENES.spec(SCENES.with_reference(w.digest)),
+        case_defaults=config.get("case_defaults", {}),
+        code=script_code(SCRIPTS / "scene_reference.py"),
+    script:
+        "../scripts/scene_reference.py"
 
 
 checkpoint scene_round:
@@ -46,7 +92,7 @@ checkpoint scene_round:
 
 rule scene_table:
     input:
-        unpack(scene_final_inputs),
+        unpack(scene_table_inputs),
     output:
         "results/scenes/{name}.parquet",
     log:

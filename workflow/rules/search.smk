@@ -57,3 +57,12 @@ optimum_round_inputs = search_inputs(optimum_kind, "optimum_round")
 optimum_final_inputs = search_inputs(optimum_kind, "optimum_round", final=True)
 scene_round_inputs = search_inputs(scene_kind, "scene_round")
 scene_final_inputs = search_inputs(scene_kind, "scene_round", final=True)
+
+
+def scene_table_inputs(wildcards):
+    """A scene's table reads its finished plan and runs, and a reactive scene its reference too."""
+    out = scene_final_inputs(wildcards)
+    scene = SCENES[wildcards.name]
+    if scene.reaction is not None:
+        return {**out, "reference": SCENES.reference_path(scene.identity(scene.candidates[0]))}
+    return out

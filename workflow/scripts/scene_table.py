@@ -15,5 +15,10 @@ inp, par = snakemake.input, snakemake.params
 scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
 plan = read_parquet(inp.plan)
 table = result(scene, judged(scene, read_runs(plan, list(inp.runs))))
+if scene.reaction is not None:  # the product over time, each rung's and the reference's (panel b)
+    from particle_entropy.analysis.scene_search import with_reference
+    from particle_entropy.experiments.reactive import read
+
+    table = with_reference(scene, table, plan, list(inp.runs), read(inp.reference))
 write_parquet(table, snakemake.output[0])
 print(table.to_string(), file=sys.stderr)

@@ -94,6 +94,8 @@ def error(scene: Scene, row: pd.Series | dict) -> float:
         return math.sqrt(row["SSE_points"] / MEASUREMENT_POINTS)
     if scene.measure == "entropy":
         return abs(row["H_C"] - row["H_C_analytic"])
+    if scene.measure == "product":  # a reactive scene's product mass against its reference
+        return row["product_error"]
     return abs(row["E"] / row["E_analytic"] - 1.0)
 
 
@@ -396,6 +398,31 @@ def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index(drop=True)
 
 
+def product_series(plan: pd.DataFrame, paths: list[str], times: np.ndarray) -> dict[tuple[int, int], list]:
+    """A reactive scene's product mass at ``times`` for every visited (candidate, n): each run's mass_C
+    linearly interpolated in time, then averaged over its seeds (the scene figure's panel b)."""
+    runs: dict[tuple[int, int], list] = {}
+    for r, path in zip(plan.itertuples(), paths):
+        table = read_parquet(path, columns=["seed", "time", "mass_C"])
+        for _, g in table.groupby("seed", sort=True):
+            runs.setdefault((int(r.candidate), int(r.n)), []).append(np.interp(times, g["time"], g["mass_C"]))
+    return {key: np.mean(series, axis=0).tolist() for key, series in runs.items()}
+
+
+def with_reference(scene: Scene, table: pd.DataFrame, plan: pd.DataFrame, paths: list[str], ref: dict) -> pd.DataFrame:
+    """A reactive scene's table with the product's mass over time: each row's (``product_series``) and
+    the reference's (``reference_series``, its error estimate ``reference_error``) at ``series_times``."""
+    times = np.asarray(ref["times"], dtype=np.float64)
+    series = product_series(plan, paths, times)
+    out = table.copy()
+    out["series_times"] = [times.tolist()] * len(out)
+    out["product_series"] = [series.get((int(c), int(n)), []) for c, n in zip(out["candidate"], out["n"])]
+    out["reference_series"] = [np.asarray(ref["product_series"], dtype=float).tolist()] * len(out)
+    out["reference_product"] = float(ref["product_mass"])
+    out["reference_error"] = float(ref["product_error"])
+    return out
+
+
 def run_path(scene: Scene, candidate: Candidate, n: int, first: int, last: int) -> str:
     """The table of a candidate's runs at resolution n, seeds first..last (SCENE_RUN_PATTERN; the
     paper run's own table where the scene shares its runs: Scene.paper_runs)."""
@@ -404,8 +431,9 @@ def run_path(scene: Scene, candidate: Candidate, n: int, first: int, last: int) 
     case = replace(candidate.case, n=int(n))
     if scene.candidates.index(candidate) in scene.paper_runs:  # the paper run's own table
         return scene.paper_pattern.format(kind="runs", first=first, last=last, **case.wildcards())
+    kind = "runs" if scene.reaction is None else "reactive"  # rules simulate_scene, simulate_reactive_scene
     return SCENE_RUN_PATTERN.format(
-        scene_id=scene.identity(candidate), kind="runs", first=first, last=last, **case.wildcards()
+        scene_id=scene.identity(candidate), kind=kind, first=first, last=last, **case.wildcards()
     )
 
 
@@ -434,7 +462,17 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     measured core-seconds (the sum of its steps' wall time: search.measured_core_s)."""
     keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_total"]
     keep += ["dV", "work"]
-    columns = ["candidate", "n", "seed", *keep, "mass_min", "negative_step", "negative_t", "negative_dt"]
+    columns = [
+        "candidate",
+        "n",
+        "seed",
+        *keep,
+        "product_error",
+        "mass_min",
+        "negative_step",
+        "negative_t",
+        "negative_dt",
+    ]
     rows = []
     if plan.empty:  # every candidate over the budget: nothing ran
         return pd.DataFrame(rows, columns=[*columns, "steps", "core_s"])
@@ -451,6 +489,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                     "n": int(r.n),
                     "seed": int(seed),
                     **{k: float(last[k]) for k in keep},
+                    "product_error": float(last["product_error"]) if "product_error" in g else math.nan,
                     "mass_min": smallest,
                     "negative_step": step,
                     "negative_t": t,

@@ -455,13 +455,32 @@ class Scenes(Mapping):
         """The config of scene ``name`` as written (a Peclet scene: its base with its v)."""
         return self._specs[name]
 
-    def settings(self, identity: str) -> dict:
-        """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
+    def _owner(self, identity: str) -> tuple[Scene, Candidate]:
         for scene in self.values():
             for candidate in scene.candidates:
                 if scene.identity(candidate) == identity:
-                    return scene.settings(candidate)
+                    return scene, candidate
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+
+    def settings(self, identity: str) -> dict:
+        """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
+        scene, candidate = self._owner(identity)
+        return scene.settings(candidate)
+
+    def reference_path(self, identity: str) -> str:
+        """The reference file that the reactive runs keyed by ``identity`` are judged against."""
+        from .reactive import REFERENCE_PATTERN, digest
+
+        return REFERENCE_PATTERN.format(digest=digest(self._owner(identity)[0]))
+
+    def with_reference(self, key: str) -> str:
+        """The name of a reactive scene whose reference is keyed ``key`` (reactive.digest)."""
+        from .reactive import digest
+
+        for name, scene in self.items():
+            if scene.reaction is not None and digest(scene) == key:
+                return name
+        raise KeyError(f"no reactive scene has a reference keyed {key!r}")
 
 
 def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
@@ -470,6 +489,8 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     the same measurement points. Their tables are the paper's (``pattern``): the paper scene
     recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
     shared = set()
+    if scene.reaction is not None:  # a reactive scene's runs carry its reaction: none is the paper's
+        return replace(scene, paper_pattern=pattern)
     for ci, cand in enumerate(scene.candidates):
         mine = scene.run_config(cand, cand.n_lo)
         try:

@@ -2,8 +2,10 @@
 
 (a) the error at t_final against the counted cost for every candidate (each visited resolution a
 point with its 95 % interval), the target as a line (the budget, if any, dotted), the recommended
-candidate and resolution starred; (b) COMIC at the common measurement points against resolution for every candidate, the
-COMIC-best ringed. Unscored runs (negative concentrations) are drawn hollow and named below.
+candidate and resolution starred; (b) COMIC at the common measurement points against resolution for
+every candidate, the COMIC-best ringed; for a reactive scene instead the product's mass against
+time: the reference, the recommended model and each candidate's finest visited rung (mean over
+seeds). Unscored runs (negative concentrations) are drawn hollow and named below.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ MEASURE_LABEL = {
     "rmse": "concentration RMSE at the points [1/L]",
     "entropy": r"$|H_C - H_C^{exact}|$ [nats]",
     "dilution": r"$|E / E^{exact} - 1|$",
+    "product": r"$|M_C / M_C^{ref} - 1|$, the product's mass",
 }
 
 
@@ -25,6 +28,7 @@ def scene(table: pd.DataFrame):
     fig, (ax, bx) = new_figure(2, width=5.4, height=4.2)
     name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
     labels = list(dict.fromkeys(table["label"]))
+    reactive = "product_series" in table
     for i, label in enumerate(labels):
         rows = table[table["label"] == label].sort_values("n")
         colour, marker = AUTO_COLOURS[i % len(AUTO_COLOURS)], AUTO_MARKERS[i % len(AUTO_MARKERS)]
@@ -52,6 +56,18 @@ def scene(table: pd.DataFrame):
                 mfc="white",
                 mec=colour,
             )
+        if reactive:
+            top = rows[rows["product_series"].map(len) > 0].tail(1)
+            for _, r in top.iterrows():
+                bx.plot(
+                    r["series_times"],
+                    r["product_series"],
+                    color=colour,
+                    lw=1.0,
+                    ls=":",
+                    label=f"{label}, n = {r['n']:,}",
+                )
+            continue
         bx.plot(
             rows.loc[scored, "n"],
             rows.loc[scored, "COMIC_points"],
@@ -78,7 +94,9 @@ def scene(table: pd.DataFrame):
             label=f"cheapest meeting it: {r['label']}, n = {r['n']:,}",
         )
     comic = table[table["comic_best"]]
-    if len(comic):
+    if reactive:
+        _product_panel(bx, table, best)
+    elif len(comic):
         r = comic.iloc[0]
         bx.plot(
             [r["n"]],
@@ -94,14 +112,15 @@ def scene(table: pd.DataFrame):
         ax, "a", f"scene {name}: error against cost", MEASURE_LABEL[measure], "counted cost of one run [s]", logx=True
     )
     ax.set_yscale("log")
-    style_axes(
-        bx,
-        "b",
-        "COMIC at the common measurement points",
-        "COMIC (Eq. 43) at the points",
-        "resolution n (particles; FD intervals)",
-        logx=True,
-    )
+    if not reactive:
+        style_axes(
+            bx,
+            "b",
+            "COMIC at the common measurement points",
+            "COMIC (Eq. 43) at the points",
+            "resolution n (particles; FD intervals)",
+            logx=True,
+        )
     ax.legend(fontsize=7, loc="best")
     bx.legend(fontsize=7, loc="best")
     notes = sorted({f"{lab}: {why}" for lab, why in zip(table["label"], table["unscored"]) if why})
@@ -120,3 +139,29 @@ def scene(table: pd.DataFrame):
         bottom = 0.045 * (1 + text.count("\n"))  # room for the notes; rect is (left, bottom, width, height)
         fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))
     return fig
+
+
+def _product_panel(bx, table: pd.DataFrame, best: pd.DataFrame) -> None:
+    """Panel b of a reactive scene: the product's mass against time, the reference (its Richardson
+    error estimate in the legend) and the recommended model's mean over its seeds."""
+    first = table.iloc[0]
+    bx.plot(
+        first["series_times"],
+        first["reference_series"],
+        color=BLACK,
+        lw=2.2,
+        label=f"reference ({first['reference_product']:.6g} +- {first['reference_error']:.2g} at t_final)",
+    )
+    if len(best) and len(best.iloc[0]["product_series"]):
+        r = best.iloc[0]
+        bx.plot(
+            r["series_times"],
+            r["product_series"],
+            color=BLACK,
+            lw=1.2,
+            ls="--",
+            marker="*",
+            markevery=8,
+            label=f"recommended: {r['label']}, n = {r['n']:,}",
+        )
+    style_axes(bx, "b", "the product's mass over time", r"product mass $M_C$", "time [T]")

@@ -80,12 +80,18 @@ def _judge(cfg: RunConfig, ref: dict, x, c_a, mass_c: float) -> dict:
     err = M.sse(model, ref["a_points"])
     product = ref["product_mass"]
     return {
+        **_NAN,
         "SSE_points": err,
+        "COMIC_points": M.comic(err, model.size, cfg.fd_dx if cfg.method == "fd" else cfg.dV),
         "product_error": abs(mass_c / product - 1.0) if product > 0 else math.nan,
     }
 
 
-_NAN = {"SSE_points": math.nan, "product_error": math.nan}
+# a reactive run's columns beside the conservative run's: its errors at t_final (last row only) and
+# no entropy (a reactive scene's reference has none: its measure is rmse of C_A or product)
+_NAN = dict.fromkeys(
+    ("SSE_points", "COMIC_points", "product_error", "H_C", "H_C_analytic", "E", "E_analytic"), math.nan
+)
 
 
 def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:

@@ -1,0 +1,13 @@
+"""A reactive scene's reference at t_final, once per physics digest (experiments/reactive.py)."""
+
+import sys
+
+sys.stderr = open(snakemake.log[0], "w", buffering=1)
+
+from particle_entropy.experiments.reactive import write
+from particle_entropy.experiments.scene import Scene
+
+par = snakemake.params
+scene = Scene.from_config(par.name, par.spec, par.case_defaults)
+write(scene, snakemake.output[0])
+print(open(snakemake.output[0]).read()[:2000], file=sys.stderr)
