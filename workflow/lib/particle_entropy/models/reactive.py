@@ -106,10 +106,10 @@ class Bimolecular:
 
     def on_masses(self, ma, mb, dV: float, dt: float):
         """(m_A, m_B, mass moved into C) after dt of the exact local kinetics at c = m / dV
-        (core.reactions.bimolecular_step); C gains the mean of what A and B lost, which differ by
-        round-off only."""
-        a, b = bimolecular_step(ma / dV, mb / dV, self.k, dt)
-        na, nb = a * dV, b * dV
+        (core.reactions.bimolecular_step), solved for the masses, dm_A/dt = -(k / dV) m_A m_B, so
+        that no mass goes through a division and back (neither loss below is ever negative); C
+        gains the mean of what A and B lost, which differ by round-off only."""
+        na, nb = bimolecular_step(ma, mb, self.k / dV, dt)
         return na, nb, 0.5 * ((ma - na) + (mb - nb))
 
     def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng):
@@ -315,18 +315,20 @@ def time_steps(t_end: float, dt0: float, growth: float = 0.0, dt_max: float = ma
 
 
 def run_mtpt(x, masses, reaction, dV, D, eta, dts, rng, kernel=CollisionKernel(), domain=None, window=None):
-    """MTPT steps of sizes ``dts`` from (x, masses) -> (times, mean c_A, mean c_B, final x, masses),
-    the means over ``window`` (lo, hi), default ``domain``, as the particles' mass in it over its
-    length (masses in the window / its length)."""
-    lo, hi = window if window is not None else domain if domain is not None else (x.min(), x.max())
+    """MTPT steps of sizes ``dts`` from (x, masses) -> (times, mean c_A, mean c_B, final x, masses):
+    the mass of the particles inside ``window`` (lo, hi) over its length, or without a window all
+    the mass over the particles' volume N dV."""
     t, times, ca, cb = 0.0, [], [], []
     for dt in dts:
         t += dt
         x, masses, _ = mtpt_step(x, masses, reaction, dV, D, eta, dt, rng, kernel, domain, t=t)
-        inside = (x >= lo) & (x <= hi)
+        if window is None:
+            inside, volume = slice(None), x.size * dV
+        else:
+            inside, volume = (x >= window[0]) & (x <= window[1]), window[1] - window[0]
         times.append(t)
-        ca.append(masses[A, inside].sum() / (hi - lo))
-        cb.append(masses[B, inside].sum() / (hi - lo))
+        ca.append(masses[A, inside].sum() / volume)
+        cb.append(masses[B, inside].sum() / volume)
     return np.array(times), np.array(ca), np.array(cb), x, masses
 
 
