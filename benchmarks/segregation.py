@@ -14,9 +14,10 @@ A and B start well mixed with the noise of finite particle numbers, equal totals
   C0, is PT's); the means are taken over the interior, a wall's reach (3 sqrt(8 D t_end)) in from
   each end.
 
-Steps: dt0 while 0.02 t < dt0, then dt = growth t (geometric). Output per run: the mean c_A(t);
-the slope of log <c_A> against log t over the late window, with a 95 % bootstrap interval over seeds
-(scipy.stats.bootstrap, resampling whole runs), and the early ratio <c_A> / (C0 / (1 + k C0 t)).
+Steps: dt0 while growth t < dt0, then dt = growth t (geometric; growth 0.01 by default). Output: the
+mean c_A(t) over seeds; the slope of log <c_A> against log t over the late window, with a 95 %
+bootstrap interval over seeds (scipy.stats.bootstrap, resampling whole runs), and the early ratio
+<c_A> / (C0 / (1 + k C0 t)).
 The segregation theory's late law, for white-noise initial A - B of strength 2 m_p C0, is
 c_A ~ sqrt(m_p C0 / pi) (8 pi D t)^(-1/4) (E|U| / 2 of the diffused difference U = A - B), so the
 crossover from t^-1 is near t* = (sqrt(pi / (m_p C0)) (8 pi D)^(1/4) / k)^(4/3).
@@ -77,7 +78,7 @@ def main(argv=None) -> None:
     p.add_argument("--c0", type=float, default=1.0)
     p.add_argument("--eta", type=float, default=0.5, help="MTPT's share of D by mass transfer")
     p.add_argument("--dt0", type=float, default=0.01)
-    p.add_argument("--growth", type=float, default=0.02, help="dt = growth t once above dt0")
+    p.add_argument("--growth", type=float, default=0.01, help="dt = growth t once above dt0")
     p.add_argument("--t-end", type=float, default=1e4)
     p.add_argument("--late", type=float, nargs=2, default=None, help="late window (default 10 t* .. t_end)")
     a = p.parse_args(argv)
