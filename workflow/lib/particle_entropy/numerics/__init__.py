@@ -1,9 +1,10 @@
 """Kernels and sums that the models call: kernel widths, weights and cut-offs (`kernels`: Eqs. 17,
 20, 23, 26), exact windowed and fast Gauss transforms without an N x N matrix (`gauss`), the
-symmetric mass transfer (`mass_transfer`: Eqs. 16-21), the authors' sequential pairwise loop
-(`sequential`), the vectorising exp they share (`fastexp`), the shear flow's pair kernels
-(`shear_kernels`) and the reactive scenes' reference (`reaction_diffusion`: A, B and C by Strang
-splitting on a fine grid, Richardson over three grids). The compiled loops of the transforms, the
-transfer and the FD solve are in `gauss_kernels`, `transfer_kernels` and `thomas`, reached through
-`compiled.kernels()`: numba's JIT, or the same loops compiled ahead of time for a simulation job.
-Imports only from `core`."""
+symmetric mass transfer (`mass_transfer`: Eqs. 16-21; several species by one P: `species_transfer`),
+the authors' sequential pairwise loop (`sequential`), the vectorising exp they share (`fastexp`), the
+shear flow's pair kernels (`shear_kernels`), the particle-killing reaction loop of random-walk
+tracking (`reaction_kernels`) and the reactive scenes' reference (`reaction_diffusion`: A, B and C
+by Strang splitting on a fine grid, Richardson over three grids). The compiled loops of the
+transforms, the transfer and the FD solve are in `gauss_kernels`, `transfer_kernels` and `thomas`,
+reached through `compiled.kernels()`: numba's JIT, or the same loops compiled ahead of time for a
+simulation job. Imports only from `core`."""
