@@ -96,6 +96,16 @@ class Decay:
         """lambda: the fastest local rate of the kinetics [1/T]."""
         return float(self.rate)
 
+    def on_masses(self, ma, mb, dV: float, dt: float):
+        """(m_A, m_B, mass moved into C) after dt on each particle or node: m_A exp(-lambda dt)."""
+        new = ma * decay_factor(self.rate, dt)
+        return new, mb, ma - new
+
+    @staticmethod
+    def conserved(a: float, b: float, c: float) -> dict[str, float]:
+        """The totals a decay keeps, from the totals of A, B and C: A + C and B."""
+        return {"A + C": a + c, "B": b}
+
 
 @dataclass(frozen=True)
 class Bimolecular:
@@ -117,6 +127,18 @@ class Bimolecular:
     def fastest_rate(self, a, b) -> float:
         """k max(A, B): the fastest local rate of the kinetics from (a, b) [1/T]."""
         return float(self.k * max(np.max(a, initial=0.0), np.max(b, initial=0.0)))
+
+    def on_masses(self, ma, mb, dV: float, dt: float):
+        """(m_A, m_B, mass moved into C) after dt of the exact local kinetics at c = m / dV, solved for
+        the masses, dm_A/dt = -(k / dV) m_A m_B, so that no mass goes through a division and back;
+        C gains the mean of what A and B lost, which differ by round-off only."""
+        na, nb = bimolecular_step(ma, mb, self.k / dV, dt)
+        return na, nb, 0.5 * ((ma - na) + (mb - nb))
+
+    @staticmethod
+    def conserved(a: float, b: float, c: float) -> dict[str, float]:
+        """The totals A + B -> C keeps, from the totals of A, B and C: A + C and B + C."""
+        return {"A + C": a + c, "B + C": b + c}
 
 
 # The reaction kinds, each once.

@@ -375,12 +375,36 @@ def _reaction(name: str, spec) -> Reaction | None:
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 
 
+def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
+    """SettingError naming a PT candidate's resolutions where Benson & Meerschaert's pair probability
+    k m_p dt v(0) (m_p = 1 / N, v(0) = 1 / sqrt(8 pi D dt)) exceeds 1 at its largest step: it holds
+    from N >= k sqrt(dt / (8 pi D)) on (models/reactive.max_pair_probability)."""
+    from ..core.timegrid import time_steps
+    from ..models.reactive import max_pair_probability
+
+    k = scene.reaction.kinetics.k
+    for n in (c.n_lo, *c.rungs):
+        cfg = scene.run_config(c, n)
+        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, "exact").max())
+        if max_pair_probability(k, 1.0 / n, scene.D, dt) > 1.0:
+            least = math.ceil(k * math.sqrt(dt / (8.0 * math.pi * scene.D)))
+            key = "ladder" if c.rungs else "n_range"
+            raise SettingError(
+                scene.key(f"candidates[{i}].{key}"),
+                list(c.rungs) if c.rungs else [c.n_lo, c.n_hi],
+                f"particle numbers >= {least:,}: PT's pair probability k dt v(0) / N (Benson & Meerschaert "
+                f"2008) exceeds 1 below that at its largest step dt = {dt:.4g}",
+            )
+
+
 def _check_reactive(scene: Scene) -> None:
     """SettingError naming a candidate that cannot carry the scene's reaction: an MTPT scheme other than
     the symmetric transfer (the authors' loop moves one species)."""
     if scene.reaction is None:
         return
     for i, c in enumerate(scene.candidates):
+        if c.case.method == "pt" and scene.reaction.kind == "bimolecular":
+            _check_pair_probability(scene, i, c)
         if c.case.method == "mtpt" and c.case.scheme not in REACTIVE_SCHEMES:
             raise SettingError(
                 scene.key(f"candidates[{i}].scheme"),

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.reactions import bimolecular_step, decay_factor
+from ..core.reactions import REACTIONS, Bimolecular, Decay, decay_factor  # noqa: F401  (the kinetics, re-exported)
 from ..numerics.kernels import beta_sph, collision_sigma
 from .conservation import MassError
 
@@ -68,62 +68,14 @@ def check_species_mass(
 # -------------------------------------------------------------------------------- reactions
 
 
-@dataclass(frozen=True)
-class Decay:
-    """First-order decay A -> C, dc_A/dt = -lambda c_A, at ``rate`` lambda [1/T]."""
-
-    rate: float
-
-    def __post_init__(self):
-        if not (self.rate >= 0.0 and math.isfinite(self.rate)):
-            raise ValueError(f"Decay rate must be finite and >= 0, got {self.rate!r}")
-
-    def on_masses(self, ma, mb, dV: float, dt: float):
-        """(m_A, m_B, mass moved into C) after dt on each particle: m_A exp(-lambda dt)."""
-        new = ma * decay_factor(self.rate, dt)
-        return new, mb, ma - new
-
-    def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng):
-        """(A kept, B kept, new C positions): each A survives dt with probability exp(-lambda dt)."""
-        keep = rng.random(xa.size) < decay_factor(self.rate, dt)
+def particle_reaction(reaction, xa, xb, m_p: float, D: float, dt: float, length: float, rng):
+    """(A kept, B kept, new C positions) of one PT step's reaction on particles of mass m_p: a decay
+    keeps each A with probability exp(-lambda dt) (its C where it was); A + B -> C is Benson &
+    Meerschaert's pair rule on the periodic domain [0, length) (``pair_reactions``)."""
+    if reaction.KIND == "decay":
+        keep = rng.random(xa.size) < decay_factor(reaction.rate, dt)
         return keep, np.ones(xb.size, dtype=bool), xa[~keep]
-
-    @staticmethod
-    def conserved(a: float, b: float, c: float) -> dict[str, float]:
-        """The totals decay keeps, from the totals of A, B and C: A + C and B."""
-        return {"A + C": a + c, "B": b}
-
-
-@dataclass(frozen=True)
-class Bimolecular:
-    """Irreversible A + B -> C, dc_A/dt = dc_B/dt = -k c_A c_B, at rate ``k`` [L/(M T)] in 1-D."""
-
-    k: float
-
-    def __post_init__(self):
-        if not (self.k >= 0.0 and math.isfinite(self.k)):
-            raise ValueError(f"Bimolecular k must be finite and >= 0, got {self.k!r}")
-
-    def on_masses(self, ma, mb, dV: float, dt: float):
-        """(m_A, m_B, mass moved into C) after dt of the exact local kinetics at c = m / dV
-        (core.reactions.bimolecular_step), solved for the masses, dm_A/dt = -(k / dV) m_A m_B, so
-        that no mass goes through a division and back (neither loss below is ever negative); C
-        gains the mean of what A and B lost, which differ by round-off only."""
-        na, nb = bimolecular_step(ma, mb, self.k / dV, dt)
-        return na, nb, 0.5 * ((ma - na) + (mb - nb))
-
-    def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng):
-        """(A kept, B kept, new C positions) of Benson & Meerschaert's pair rule on the periodic
-        domain [0, length): see ``pair_reactions``."""
-        return pair_reactions(xa, xb, self.k, m_p, D, dt, length, rng)
-
-    @staticmethod
-    def conserved(a: float, b: float, c: float) -> dict[str, float]:
-        """The totals A + B -> C keeps, from the totals of A, B and C: A + C and B + C."""
-        return {"A + C": a + c, "B + C": b + c}
-
-
-REACTIONS = {"decay": Decay, "bimolecular": Bimolecular}
+    return pair_reactions(xa, xb, reaction.k, m_p, D, dt, length, rng)
 
 
 # ---------------------------------------------------------------------------------- kernels
@@ -293,7 +245,7 @@ def pt_step(xa, xb, xc, reaction, m_p: float, D: float, dt: float, length: float
     xa = np.mod(xa + s * rng.standard_normal(xa.size), length)
     xb = np.mod(xb + s * rng.standard_normal(xb.size), length)
     xc = np.mod(xc + s * rng.standard_normal(xc.size), length)
-    keep_a, keep_b, new_c = reaction.on_particles(xa, xb, m_p, D, dt, length, rng)
+    keep_a, keep_b, new_c = particle_reaction(reaction, xa, xb, m_p, D, dt, length, rng)
     xa, xb, xc = xa[keep_a], xb[keep_b], np.concatenate([xc, new_c])
     after = reaction.conserved(float(xa.size), float(xb.size), float(xc.size))
     check_species_mass(before, after, m_p, t, "reactive pt")

@@ -8,12 +8,13 @@ run does it (``cfg``, a RunConfig), with the scene's reaction after every step, 
 - MTPT: the random walk with (1 - eta) D, then every species exchanged with eta D by one transfer
   matrix (Eq. 19; collision or SPH kernel), then every particle reacted over dt at its
   concentrations m / dV (Benson & Bolster 2016; Schmidt, Pankavich & Benson 2017).
-- PT: each particle carries A's mass; a decay scales every mass by exp(-lambda dt) (exact, so C_A
-  is the kernel reconstruction times the mass left). A + B -> C on particles needs separate A and
-  B particles and a probabilistic pair reaction (Benson & Meerschaert 2008): models/reactive.py.
+- PT: A and B on particles of their own, of equal mass, walking with D; a decay turns each A into C
+  with probability 1 - exp(-lambda dt), A + B -> C takes each pair with Benson & Meerschaert's
+  (2008) probability k m_p dt v(s) (models/reactive.py), on the periodic domain Omega in the frame
+  moving with v; C_A is the survivors' kernel reconstruction (models/pt.py) times their mass.
 
-Every step's reaction balances to round-off (A + C and B + C keep their totals: check_reaction); no
-mass goes negative, since the kinetics are exact. A row records the masses of A, B and the product
+Every step's reaction balances to round-off (A + C and B + C keep their totals, no mass is negative:
+models/reactive.check_species_mass). A row records the masses of A, B and the product
 made so far; the last row also the errors against the reference: SSE of C_A at the scene's points
 (SSE_points) and the product mass's relative error (product_error).
 """
@@ -32,29 +33,22 @@ from ..core.reactions import Reaction
 from ..core.records import Recorder
 from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
-from .conservation import MassError
-
-REACTION_ULPS = 64.0  # a reaction step's imbalance beyond this many ulps of its sums is no round-off
 
 
-def check_reaction(before: float, after: float, made: float, t: float) -> None:
-    """MassError unless a species' total fell by exactly the product ``made`` in a step, to round-off."""
-    size = abs(before) + abs(after) + abs(made)
-    tol = REACTION_ULPS * np.finfo(np.float64).eps * max(size, np.finfo(np.float64).tiny)
-    if not abs(before - after - made) <= tol:
-        raise MassError(f"a reaction step at t = {t:.6g} lost {before - after - made:.3g} (round-off {tol:.3g})")
+def react(reaction: Reaction, a: np.ndarray, b: np.ndarray, volume, dt: float, t: float, made: float):
+    """The masses a, b on nodes of ``volume`` dx after dt of the kinetics at their concentrations
+    m / volume (on_masses), with ``made`` the product so far -> (a, b, product made in the step);
+    MassError unless A + C and B + C (a decay: A + C and B) keep their totals to round-off and no mass
+    is negative (models/reactive.check_species_mass)."""
+    from .reactive import check_species_mass
 
-
-def react(reaction: Reaction, a: np.ndarray, b: np.ndarray, volume, dt: float, t: float):
-    """The masses a, b on nodes or particles of ``volume`` (dx or dV) after dt of the kinetics at their
-    concentrations m / volume -> (a, b, product made per node or particle), balanced (check_reaction)."""
-    a_new, b_new, made = reaction.kinetics.react(a / volume, b / volume, dt)
-    a_new, b_new, made = a_new * volume, b_new * volume, made * volume
-    total = float(made.sum())
-    check_reaction(float(a.sum()), float(a_new.sum()), total, t)
-    if reaction.kinetics.CONSUMES_B:
-        check_reaction(float(b.sum()), float(b_new.sum()), total, t)
-    return a_new, b_new, made
+    kinetics = reaction.kinetics
+    before = kinetics.conserved(float(a.sum()), float(b.sum()), made)
+    a_new, b_new, step = kinetics.on_masses(a, b, volume, dt)
+    gained = float(step.sum())
+    after = kinetics.conserved(float(a_new.sum()), float(b_new.sum()), made + gained)
+    check_species_mass(before, after, float(min(a_new.min(), b_new.min())), t, "reactive fd")
+    return a_new, b_new, gained
 
 
 def _row(rec: Recorder, k: int, t: float, dt: float, a, b, made: float, volume: float, extra: dict) -> None:
@@ -110,70 +104,64 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
             solvers[dt] = fd.solver(cfg, dt, dx)
         a[1:-1] = solvers[dt].solve(a[1:-1] / dx) * dx
         b[1:-1] = solvers[dt].solve(b[1:-1] / dx) * dx
-        a, b, step_made = react(reaction, a, b, dx, dt, t)
-        made += float(step_made.sum())
+        a, b, gained = react(reaction, a, b, dx, dt, t, made)
+        made += gained
         last = k == len(dts)
         _row(rec, k, t, dt, a, b, made, dx, _judge(cfg, ref, x, a / dx, made) if last else _NAN)
 
 
 def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
-    from ..core.registry import SCHEME_RECORDS
-    from ..numerics.mass_transfer import mass_transfer
     from . import mtpt
+    from .reactive import A, B, C, CollisionKernel, SPHKernel, mtpt_step
 
-    if SCHEME_RECORDS[cfg.scheme].sequential:
-        raise ValueError(f"scheme {cfg.scheme!r}: a reactive run transfers every species by one matrix (symmetric)")
     rng = cfg.rng()
     x, a, _ = mtpt.initial_state(cfg, rng)  # sorted positions, A's masses
     dV = cfg.dV
-    b = reaction.b_masses(x, dV)
-    made = 0.0
-    _row(rec, 0, 0.0, 0.0, a, b, made, dV, {"substeps": 1})
-    d_walk = (1.0 - cfg.eta) * cfg.D
+    masses = np.vstack([a, reaction.b_masses(x, dV), np.zeros_like(a)])
+    _row(rec, 0, 0.0, 0.0, masses[A], masses[B], 0.0, dV, {**_NAN, "substeps": 1})
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        if cfg.v != 0.0:
+        if cfg.v != 0.0:  # carried by the flow: a uniform shift leaves the order and the exchange alone
             x = x + cfg.v * dt
-        if d_walk > 0:
-            x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
-            order = np.argsort(x, kind="stable")
-            x, a, b = x[order], a[order], b[order]
-        sigma, beta = mtpt.kernel_for_step(cfg, dt, t)
-        substeps = 1
-        if sigma > 0.0 and beta > 0.0:
-            moved = []
-            for m in (a, b):
-                res = mass_transfer(x, m, sigma, beta, cfg.truncation, cfg.transfer_method, cfg.transfer_tolerance)
-                moved.append(res.mass)
-                substeps = max(substeps, res.substeps)
-            a, b = moved
-        a, b, step_made = react(reaction, a, b, dV, dt, t)
-        made += float(step_made.sum())
-        extra = _judge(cfg, ref, x, a / dV, made) if k == len(dts) else _NAN
-        _row(rec, k, t, dt, a, b, made, dV, {"substeps": substeps, **extra})
+        h, _ = mtpt.kernel_for_step(cfg, dt, t)
+        kernel = SPHKernel(h) if cfg.kernel == "sph" else CollisionKernel()
+        x, masses, substeps = mtpt_step(x, masses, reaction.kinetics, dV, cfg.D, cfg.eta, dt, rng, kernel, t=t)
+        made = float(masses[C].sum())
+        extra = _judge(cfg, ref, x, masses[A] / dV, made) if k == len(dts) else _NAN
+        _row(rec, k, t, dt, masses[A], masses[B], made, dV, {"substeps": substeps, **extra})
 
 
 def _run_pt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
+    """PT: A's particles from the source, each of mass m_p = 1 / N; B's of the same mass from its
+    initial condition (C0 Omega / m_p uniform ones, or b_mass / m_p from its plume); both walk with D
+    and react by particle_reaction on the periodic domain of width Omega around the source, in the
+    frame moving with v (a uniform B is then uniform everywhere, as the reference's)."""
     from . import pt
+    from .reactive import pt_step
 
-    if reaction.kind != "decay":
-        raise ValueError("PT carries a decay here; A + B -> C on particles is models/reactive.py's pair reaction")
     rng = cfg.rng()
-    x = np.sort(pt.initial_positions(cfg, rng))
-    left = 1.0  # the mass A keeps: every particle's share times exp(-lambda t)
-    empty = np.zeros(1)
-    _row(rec, 0, 0.0, 0.0, np.array([left]), empty, 0.0, cfg.dV, _NAN)
+    m_p, length = 1.0 / cfg.n, cfg.omega
+    lo = cfg.source.centre - length / 2.0
+    xa = np.mod(pt.initial_positions(cfg, rng) - lo, length)  # positions in [0, Omega), moving frame
+    if reaction.kind == "decay":
+        xb = np.empty(0)
+    elif reaction.b_source is None:
+        xb = rng.uniform(0.0, length, round(reaction.b_uniform * length / m_p))
+    else:
+        xb = np.mod(reaction.b_source.positions(round(reaction.b_mass / m_p), rng) - lo, length)
+    xc = np.empty(0)
+    one = np.ones(1)
+    _row(rec, 0, 0.0, 0.0, xa.size * m_p * one, xb.size * m_p * one, 0.0, cfg.dV, _NAN)
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        x = np.sort(pt.walk(x, cfg.D, dt, rng, cfg.v))
-        a, _, step_made = react(reaction, np.array([left]), empty, 1.0, dt, t)
-        left = float(a[0])
-        made = 1.0 - left
+        xa, xb, xc = pt_step(xa, xb, xc, reaction.kinetics, m_p, cfg.D, dt, length, rng, t=t)
+        made = xc.size * m_p
         extra = _NAN
-        if k == len(dts):
-            grid, c, _, _ = pt.reconstruct(cfg, x, t)
-            extra = _judge(cfg, ref, grid, left * c, made)
-        _row(rec, k, t, dt, np.array([left]), empty, made, cfg.dV, extra)
+        if k == len(dts):  # A's density, in the lab frame: the survivors' reconstruction times their mass
+            x = np.sort(xa + lo + cfg.v * t)
+            grid, c, _, _ = pt.reconstruct(cfg, x, t) if x.size else (np.zeros(1), np.zeros(1), 0, 0)
+            extra = _judge(cfg, ref, grid, xa.size * m_p * c, made)
+        _row(rec, k, t, dt, xa.size * m_p * one, xb.size * m_p * one, made, cfg.dV, extra)
 
 
 def run_arrow(cfg: RunConfig, reaction: Reaction, ref: dict, progress: Callable[[str], None] | None = None) -> pa.Table:
