@@ -1,0 +1,161 @@
+"""Reactive scenes (config scenes.<name>.reaction): the keys refused by their path, the reference held
+to closed forms, each model's reactive run held to its conservative twin or to the reference, and
+the search judging a reactive run's table."""
+
+import math
+
+import numpy as np
+import pytest
+
+from particle_entropy.core.case import SettingError
+from particle_entropy.experiments import reactive
+from particle_entropy.experiments.scene import Scene
+from particle_entropy.models.reactive_run import run_arrow
+
+FD = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.5, "n_range": [64, 1024]}
+MTPT = {"method": "mtpt", "kernel": "collision", "eta": 1, "n_range": [100, 1000]}
+PT = {"method": "pt", "kernel": "adaptive", "n_range": [300, 3000]}
+DECAY = {"kind": "decay", "rate": 0.02}
+MIXED = {"kind": "bimolecular", "k": 2.0, "B": {"source": {"kind": "box", "a": -1.0, "b": 1.0}, "mass": 1.0}}
+
+
+def spec(**over):
+    out = {
+        "D": 1e-3,
+        "v": 0.01,
+        "t_final": 20.0,
+        "source": {"kind": "box", "a": -1.0, "b": 1.0},
+        "reaction": DECAY,
+        "target": {"measure": "product", "value": 0.01},
+        "candidates": [FD, MTPT, PT],
+    }
+    out.update(over)
+    return out
+
+
+def _refused(spec_):
+    with pytest.raises(SettingError) as err:
+        Scene.from_config("r", spec_)
+    return err.value
+
+
+@pytest.mark.parametrize(
+    "reaction, key",
+    [
+        ({"kind": "decay"}, "reaction.rate"),
+        ({"kind": "decay", "rate": 0.0}, "reaction.rate"),
+        ({"kind": "decay", "rate": 1.0, "k": 2.0}, "reaction.k"),
+        ({"kind": "bimolecular", "k": 1.0}, "reaction.B"),
+        ({"kind": "bimolecular", "k": 1.0, "B": {"uniform": 1.0, "source": {"kind": "point"}}}, "reaction.B"),
+        ({"kind": "bimolecular", "k": 1.0, "B": {"uniform": 1.0, "mass": 2.0}}, "reaction.B.mass"),
+        (
+            {"kind": "bimolecular", "k": 1.0, "B": {"source": {"kind": "box", "a": 1.0, "b": 0.0}}},
+            "reaction.B.source.b",
+        ),
+        ({"kind": "bimolecular", "k": math.inf, "B": {"uniform": 1.0}}, "reaction.k"),
+        ({"kind": "fission", "rate": 1.0}, "reaction.kind"),
+    ],
+)
+def test_a_bad_reaction_is_refused_by_its_key_path(reaction, key):
+    assert _refused(spec(reaction=reaction)).name == f"scenes.r.{key}"
+
+
+def test_a_measure_the_reaction_cannot_judge_is_refused():
+    assert _refused(spec(target={"measure": "entropy", "value": 0.1})).name == "scenes.r.target.measure"
+    no_reaction = {k: v for k, v in spec().items() if k != "reaction"}
+    assert _refused(no_reaction).name == "scenes.r.target.measure"  # product without a reaction
+
+
+def test_a_pt_rung_whose_pair_probability_exceeds_one_is_refused_with_the_least_n():
+    err = _refused(spec(reaction=MIXED, candidates=[{**PT, "n_range": [2, 3000]}]))
+    assert err.name == "scenes.r.candidates[0].n_range" and "particle numbers >= " in err.allowed
+    least = int(err.allowed.split(">= ")[1].split(":")[0].replace(",", ""))
+    Scene.from_config("r", spec(reaction=MIXED, candidates=[{**PT, "n_range": [least, 3000]}]))
+
+
+def test_the_reaction_is_part_of_a_run_s_identity_and_a_conservative_scene_s_is_unchanged():
+    reactive_scene = Scene.from_config("r", spec())
+    plain_spec = {k: v for k, v in spec(target={"measure": "rmse", "value": 0.1}).items() if k != "reaction"}
+    plain = Scene.from_config("p", plain_spec)
+    assert plain.reaction is None and "reaction" not in plain.settings(plain.candidates[0])
+    other = Scene.from_config("r", spec(reaction={"kind": "decay", "rate": 0.03}))
+    c = reactive_scene.candidates[0]
+    assert reactive_scene.identity(c) != other.identity(other.candidates[0]) != plain.identity(plain.candidates[0])
+    assert reactive_scene.settings(c)["reaction"] == {"kind": "decay", "rate": 0.02}
+
+
+def _ref(scene):
+    out = reactive.compute(scene)
+    return {k: np.asarray(v) if isinstance(v, list) else v for k, v in out.items()}
+
+
+def test_decay_runs_are_the_conservative_runs_times_exp_to_round_off():
+    """FD (every scheme's transport is linear) and MTPT at eta = 1 (no walk): A's masses are the
+    conservative run's times exp(-lambda t), and the product 1 - exp(-lambda t), to round-off."""
+    from particle_entropy.models.simulate import run_arrow as conservative
+
+    scene = Scene.from_config("r", spec())
+    ref = _ref(scene)
+    left = math.exp(-0.02 * 20.0)
+    for ci, n in ((0, 256), (1, 300)):
+        cfg = scene.run_config(scene.candidates[ci], n)
+        rx = run_arrow(cfg, scene.reaction, ref).to_pandas()
+        plain, state = conservative(cfg, want_state=True)
+        mass = state.column("mass").to_numpy() if "mass" in state.column_names else state.column("c").to_numpy()
+        total = float(mass.sum()) * (cfg.fd_dx if cfg.method == "fd" else 1.0)
+        last = rx.iloc[-1]
+        assert last["mass_A"] == pytest.approx(total * left, rel=1e-12)
+        assert last["mass_C"] == pytest.approx(1.0 - left, rel=1e-9)
+        assert last["product_error"] < 1e-9
+
+
+def test_pt_decay_keeps_exp_of_its_particles_within_its_binomial_noise():
+    scene = Scene.from_config("r", spec())
+    ref = _ref(scene)
+    cfg = scene.run_config(scene.candidates[2], 3000)
+    kept = [
+        run_arrow(cfg.__class__(**{**cfg.__dict__, "seed": s}), scene.reaction, ref).to_pandas().iloc[-1]["mass_A"]
+        for s in range(4)
+    ]
+    p = math.exp(-0.4)
+    sd = math.sqrt(p * (1 - p) / 3000 / 4)
+    assert abs(np.mean(kept) - p) < 4 * sd
+
+
+def test_the_reference_is_the_decay_s_closed_form_and_the_well_mixed_law_inside_equal_boxes():
+    decay = _ref(Scene.from_config("r", spec()))
+    assert decay["product_mass"] == pytest.approx(1.0 - math.exp(-0.4), rel=1e-15) and decay["product_error"] == 0.0
+    mixed_scene = Scene.from_config("r", spec(reaction=MIXED, D=1e-4, v=0.0, target={"measure": "rmse", "value": 0.01}))
+    mixed = _ref(mixed_scene)
+    c0, k, t = 0.5, 2.0, 20.0
+    inside = np.abs(mixed["points"]) < 1.0 - 6.0 * math.sqrt(2e-4 * t)  # far from the boxes' edges
+    assert inside.sum() >= 3
+    law = c0 / (1.0 + k * c0 * t)
+    np.testing.assert_allclose(mixed["a_points"][inside], law, rtol=1e-6)
+    assert np.all(mixed["a_error"][inside] < 1e-6)
+
+
+def test_every_reactive_run_balances_its_species_and_the_search_reads_its_error(tmp_path):
+    """A + C and B + C keep their totals in FD, MTPT and PT runs; read_runs takes product_error."""
+    import pandas as pd
+
+    from particle_entropy.analysis.scene_search import error, read_runs
+    from particle_entropy.core.io import write_parquet
+
+    scene = Scene.from_config("r", spec(reaction=MIXED))
+    ref = _ref(scene)
+    paths, plan = [], []
+    for ci, n in ((0, 128), (1, 200), (2, 400)):
+        table = run_arrow(scene.run_config(scene.candidates[ci], n), scene.reaction, ref)
+        frame = table.to_pandas()
+        b0 = frame["mass_B"].iloc[0]
+        np.testing.assert_allclose(frame["mass_A"] + frame["mass_C"], 1.0, rtol=0, atol=1e-4)  # FD: the ends
+        np.testing.assert_allclose(frame["mass_B"] + frame["mass_C"], b0, rtol=0, atol=1e-4)
+        assert frame["mass_min"].min() >= 0.0
+        path = tmp_path / f"{ci}.parquet"
+        write_parquet(table, path)
+        paths.append(str(path))
+        plan.append({"candidate": ci, "n": n, "first": 0, "last": 0})
+    runs = read_runs(pd.DataFrame(plan), paths)
+    assert np.all(np.isfinite(runs["product_error"]))
+    assert [error(scene, r) for _, r in runs.iterrows()] == list(runs["product_error"])
