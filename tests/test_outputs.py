@@ -114,8 +114,11 @@ def test_sigint_inside_a_commit_waits_until_the_table_and_its_checksum_are_in_pl
             signal.raise_signal(signal.SIGINT)
 
     monkeypatch.setattr(io.os, "replace", replace_and_interrupt)
+    # Python's own Ctrl-C: a shell that starts pytest in the background hands it SIGINT ignored
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     with pytest.raises(KeyboardInterrupt):
         write_parquet(NEW, out)
+    signal.signal(signal.SIGINT, previous)
     assert pd.read_parquet(out).equals(NEW) and _consistent(out) and checksum_path(out).exists()
     assert not list(tmp_path.glob(".*.tmp"))
 
@@ -168,6 +171,11 @@ def test_only_this_tables_stale_temporaries_are_removed(tmp_path):
     assert not any(f.exists() for f in stale) and all(f.exists() for f in others)
 
 
+def _default_signals() -> None:
+    for s in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(s, signal.SIG_DFL)
+
+
 def _simulate(*args):
     return [sys.executable, "-m", "particle_entropy", "simulate", "--method", "mtpt", *args]
 
@@ -177,7 +185,9 @@ def test_sigint_and_sigterm_end_the_cli_with_one_line_and_no_temporary(tmp_path,
     """Case 3: SIGINT printed a traceback (exit -2); SIGTERM ended silently (exit -15)."""
     out, state = tmp_path / "o.parquet", tmp_path / "s.parquet"
     args = _simulate("--n", "10000", "--t-final", "1000", "--out", str(out), "--state-out", str(state))
-    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True)
+    # the child starts with the default dispositions whatever this process inherited (a shell that
+    # starts a job in the background ignores SIGINT in it, and an ignored signal stays ignored)
+    proc = subprocess.Popen(args, stderr=subprocess.PIPE, text=True, preexec_fn=_default_signals)
     first = proc.stderr.readline()  # the first progress line: the run has started
     proc.send_signal(sig)
     rest = proc.stderr.read()
