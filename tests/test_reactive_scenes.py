@@ -3,6 +3,7 @@ to closed forms, each model's reactive run held to its conservative twin or to t
 the search judging a reactive run's table."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -113,10 +114,7 @@ def test_pt_decay_keeps_exp_of_its_particles_within_its_binomial_noise():
     scene = Scene.from_config("r", spec())
     ref = _ref(scene)
     cfg = scene.run_config(scene.candidates[2], 3000)
-    kept = [
-        run_arrow(cfg.__class__(**{**cfg.__dict__, "seed": s}), scene.reaction, ref).to_pandas().iloc[-1]["mass_A"]
-        for s in range(4)
-    ]
+    kept = [run_arrow(replace(cfg, seed=s), scene.reaction, ref).to_pandas().iloc[-1]["mass_A"] for s in range(4)]
     p = math.exp(-0.4)
     sd = math.sqrt(p * (1 - p) / 3000 / 4)
     assert abs(np.mean(kept) - p) < 4 * sd
@@ -175,9 +173,7 @@ def test_mtpt_product_of_meeting_plumes_converges_to_the_reference_as_n_grows():
     signed = {}
     for n in (100, 3200):
         cfg = scene.run_config(scene.candidates[0], n)
-        runs = [
-            run_arrow(cfg.__class__(**{**cfg.__dict__, "seed": s}), scene.reaction, ref).to_pandas() for s in range(8)
-        ]
+        runs = [run_arrow(replace(cfg, seed=s), scene.reaction, ref).to_pandas() for s in range(8)]
         signed[n] = np.array([r["mass_C"].iloc[-1] for r in runs]) / ref["product_mass"] - 1.0
     high = signed[3200]
     assert abs(high.mean()) < 3.0 * high.std(ddof=1) / math.sqrt(high.size), signed
