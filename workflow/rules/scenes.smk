@@ -60,9 +60,7 @@ rule scene_reference:
     conda:
         "../../envs/particle-entropy.yaml"
     params:
-        name=lambda w: SCENES.with_reference(w.digest),
-        spec=lambda w: SCENES.spec(SCENES.with_reference(w.digest)),
-        case_defaults=config.get("case_defaults", {}),
+        physics=lambda w: SCENES.reference_physics(w.digest),
         code=script_code(SCRIPTS / "scene_reference.py"),
     script:
         "../scripts/scene_reference.py"

@@ -5,9 +5,6 @@ import sys
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
 from particle_entropy.experiments.reactive import write
-from particle_entropy.experiments.scene import Scene
 
-par = snakemake.params
-scene = Scene.from_config(par.name, par.spec, par.case_defaults)
-write(scene, snakemake.output[0])
+write(dict(snakemake.params.physics), snakemake.output[0])
 print(open(snakemake.output[0]).read()[:2000], file=sys.stderr)

@@ -172,11 +172,6 @@ class Reaction:
     def kind(self) -> str:
         return self.kinetics.KIND
 
-    @property
-    def well_mixed(self) -> bool:
-        """Whether the reference is closed-form: a decay (the conservative plume times exp(-lambda t))."""
-        return self.kind == "decay"
-
     def record(self) -> dict:
         """The reaction as a run's settings carry it and its identity digests it."""
         if self.kind == "decay":

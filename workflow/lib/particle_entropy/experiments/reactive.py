@@ -50,17 +50,21 @@ def digest(scene) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
-def compute(scene) -> dict:
-    """The reference of a reactive scene at t_final: the product's mass and A's and C's concentrations at
-    the measurement points, each with its error estimate and observed order, and the product's mass
-    over time (SERIES times) -> a JSON-ready mapping."""
-    reaction: Reaction = scene.reaction
-    pts = points(scene)
-    t = scene.t_final
+def compute(physics: dict) -> dict:
+    """The reference of a reactive scene at t_final from its ``physics`` (what ``digest`` covers, so
+    that nothing else, a target or a candidate, can change it): the product's mass and A's and C's
+    concentrations at the measurement points, each with its error estimate and observed order, and
+    the product's mass over time (SERIES times) -> a JSON-ready mapping."""
+    from ..core.sources import Source
+
+    reaction = Reaction.of(physics["reaction"])
+    source = Source.of(**physics["source"])
+    D, v, t = physics["D"], physics["v"], physics["t_final"]
+    pts = np.array([float.fromhex(p) for p in physics["points"]])
     times = t * np.arange(1, SERIES + 1) / SERIES
     if reaction.kind == "decay":
         left = math.exp(-reaction.kinetics.rate * t)
-        plume = scene.source.density(pts, scene.D, scene.v, t)
+        plume = source.density(pts, D, v, t)
         zero = [0.0] * pts.size
         return {
             "method": "closed form: the conservative plume times exp(-lambda t)",
@@ -79,7 +83,7 @@ def compute(scene) -> dict:
     from ..numerics.reaction_diffusion import reference
 
     b = reaction.b_uniform if reaction.b_source is None else (reaction.b_source, reaction.b_mass)
-    ref = reference(scene.source, b, scene.D, reaction.kinetics, t, pts, v=scene.v, times_per_run=SERIES)
+    ref = reference(source, b, D, reaction.kinetics, t, pts, v=v, times_per_run=SERIES)
     fine = ref.fine
     return {
         "method": "Richardson extrapolation of Strang-split Crank-Nicolson on three grids, moving with v",
@@ -99,12 +103,14 @@ def compute(scene) -> dict:
     }
 
 
-def write(scene, path: str) -> None:
-    """The reference of ``scene`` as JSON at ``path`` (NaN written as null)."""
-    out = compute(scene)
+def write(physics: dict, path: str) -> None:
+    """The reference of ``physics`` (a scene's: ``physics(scene)``) as JSON at ``path``, NaN as null."""
+    out = compute(physics)
     out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+    text = json.dumps(physics, sort_keys=True, separators=(",", ":"))
+    key = hashlib.sha256(text.encode()).hexdigest()[:12]
     with open(path, "w", encoding="utf-8") as f:
-        json.dump({"digest": digest(scene), "physics": physics(scene), **out}, f, indent=1)
+        json.dump({"digest": key, "physics": physics, **out}, f, indent=1)
 
 
 def read(path: str) -> dict:

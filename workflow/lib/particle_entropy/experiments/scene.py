@@ -234,11 +234,15 @@ class Scene:
         s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, functools.partial(_where, name))
         D, v, t_final, r = s.D, s.v, s.t_final, s.realisations
         source = _source(name, s.source)
-        span = 2.0 * (source.half_width + s.margin * math.sqrt(2.0 * D * t_final))
+        reaction = _reaction(name, s.reaction)
+        extent = _extent(source, reaction)  # the domains hold a second species' plume too
+        span = 2.0 * (extent + s.margin * math.sqrt(2.0 * D * t_final))
         omega = span if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         if s.fd_length is not None:  # from the margin it holds the plume by the margin's range
             _check_window(name, fd_length, source, D, t_final)
+        if reaction is not None and reaction.b_source is not None:
+            _check_species_b(name, reaction, source, min(omega, fd_length), D, t_final)
         cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(s.candidates))
         _distinct(name, cands)
         if v == 0:  # nothing to advect: FD's scheme and Courant number are no part of the runs (the step is
@@ -248,7 +252,7 @@ class Scene:
         budget = math.inf if s.budget is None else s.budget
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
-        scene = replace(scene, budget=budget, max_realisations=most, reaction=_reaction(name, s.reaction))
+        scene = replace(scene, budget=budget, max_realisations=most, reaction=reaction)
         _check_reactive(scene)
         _check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
@@ -375,6 +379,30 @@ def _reaction(name: str, spec) -> Reaction | None:
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 
 
+def _extent(source: Source, reaction: Reaction | None) -> float:
+    """The half width around A's centre that the domains must hold at t = 0: A's source, and B's
+    plume where A + B -> C has one (both domains are centred on A's source) [L]."""
+    if reaction is None or reaction.b_source is None:
+        return source.half_width
+    b = reaction.b_source
+    return max(source.half_width, abs(b.centre - source.centre) + b.half_width)
+
+
+def _check_species_b(name: str, reaction: Reaction, source: Source, width: float, D: float, t_final: float) -> None:
+    """SettingError naming scenes.<name>.reaction.B.source unless B's plume and REACH sqrt(4 D t_final)
+    beyond it lie within the narrower of the domains (omega, fd_length) around A's centre: outside
+    them MTPT would put B's mass on the edge particle, FD on the edge node, PT would wrap it."""
+    b = reaction.b_source
+    need = 2.0 * (abs(b.centre - source.centre) + b.half_width + REACH * math.sqrt(4.0 * D * t_final))
+    if width < need * (1.0 - 1e-12):
+        raise SettingError(
+            _key(name, "reaction.B.source"),
+            b.record(),
+            f"a plume within the scene's domains: omega and fd_length ({width:.6g} wide around A's centre) must "
+            f"reach {need:.6g}, B's extent and 3 sqrt(4 D t_final) beyond it; widen them, or leave them to margin",
+        )
+
+
 def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
     """SettingError naming a PT candidate's resolutions where Benson & Meerschaert's pair probability
     k m_p dt v(0) (m_p = 1 / N, v(0) = 1 / sqrt(8 pi D dt)) exceeds 1 at its largest step: it holds
@@ -385,7 +413,7 @@ def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
     k = scene.reaction.kinetics.k
     for n in (c.n_lo, *c.rungs):
         cfg = scene.run_config(c, n)
-        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, "exact").max())
+        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # reactive_run's grid
         if max_pair_probability(k, 1.0 / n, scene.D, dt) > 1.0:
             least = math.ceil(k * math.sqrt(dt / (8.0 * math.pi * scene.D)))
             key = "ladder" if c.rungs else "n_range"
@@ -497,13 +525,14 @@ class Scenes(Mapping):
 
         return REFERENCE_PATTERN.format(digest=digest(self._owner(identity)[0]))
 
-    def with_reference(self, key: str) -> str:
-        """The name of a reactive scene whose reference is keyed ``key`` (reactive.digest)."""
-        from .reactive import digest
+    def reference_physics(self, key: str) -> dict:
+        """The physics of the reference keyed ``key`` (reactive.digest): all that its file depends on,
+        the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
+        from .reactive import digest, physics
 
-        for name, scene in self.items():
+        for scene in self.values():
             if scene.reaction is not None and digest(scene) == key:
-                return name
+                return physics(scene)
         raise KeyError(f"no reactive scene has a reference keyed {key!r}")
 
 

@@ -93,8 +93,12 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
 
     x, dx = fd.grid(cfg)
     a = fd.initial_concentration(cfg) * dx  # node masses
+    # B's ends: a plume's are held at zero, as A's (models/fd.py); a uniform background's at C0, so
+    # that B neither drains through them nor enters B-free with the flow: its departure from C0 is
+    # carried with zero ends (every scheme, the TVD limiter included, is unchanged by a constant)
+    background = reaction.b_uniform * dx if reaction.b_source is None else 0.0
     b = reaction.b_masses(x, dx)
-    b[0] = b[-1] = 0.0  # the end nodes are held at zero (models/fd.py)
+    b[0] = b[-1] = background
     made = 0.0
     _row(rec, 0, 0.0, 0.0, a, b, made, dx, _NAN)
     solvers: dict = {}
@@ -103,7 +107,7 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
         if dt not in solvers:
             solvers[dt] = fd.solver(cfg, dt, dx)
         a[1:-1] = solvers[dt].solve(a[1:-1] / dx) * dx
-        b[1:-1] = solvers[dt].solve(b[1:-1] / dx) * dx
+        b[1:-1] = solvers[dt].solve((b[1:-1] - background) / dx) * dx + background
         a, b, gained = react(reaction, a, b, dx, dt, t, made)
         made += gained
         last = k == len(dts)

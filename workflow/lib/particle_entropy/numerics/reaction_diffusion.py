@@ -269,7 +269,7 @@ def reference(
     (steps n_steps, 2 n_steps, 4 n_steps) over ``bounds`` (default ``window``), each quantity
     extrapolated by ``richardson``; A from mass_a of source_a, B from ``b`` as in initial_fields,
     points in the lab frame (the grid moves with v), concentrations interpolated by ``at_points``. The
-    default n_steps makes r <= 1/4 and dt <= 1/8 of the fastest reaction time on the coarsest grid;
+    default n_steps makes r <= 1/4 and dt <= 2 of the fastest reaction times on the coarsest grid (COARSE_KINETIC);
     ``times_per_run`` > 0 records the masses at that many equal times in (0, t_final] on every grid
     (the fine one's in ``fine.masses``)."""
     sources = [source_a] + ([b[0]] if isinstance(b, tuple) else [])
