@@ -64,5 +64,5 @@ def scene_table_inputs(wildcards):
     out = scene_final_inputs(wildcards)
     scene = SCENES[wildcards.name]
     if scene.reaction is not None:
-        return {**out, "reference": SCENES.reference_path(scene.identity(scene.candidates[0]))}
+        return {**out, "reference": reactive_reference_path(scene)}
     return out

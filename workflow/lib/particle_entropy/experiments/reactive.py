@@ -44,10 +44,20 @@ def physics(scene) -> dict:
     }
 
 
-def digest(scene) -> str:
-    """The reference's key: a digest of its physics (12 hex digits)."""
-    text = json.dumps(physics(scene), sort_keys=True, separators=(",", ":"))
+def key(physics: dict) -> str:
+    """A reference's key: a digest of its physics (12 hex digits)."""
+    text = json.dumps(physics, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def digest(scene) -> str:
+    """The key of a reactive scene's reference (``key`` of its ``physics``)."""
+    return key(physics(scene))
+
+
+def path(scene) -> str:
+    """The file of a reactive scene's reference (REFERENCE_PATTERN)."""
+    return REFERENCE_PATTERN.format(digest=digest(scene))
 
 
 def compute(physics: dict) -> dict:
@@ -103,14 +113,12 @@ def compute(physics: dict) -> dict:
     }
 
 
-def write(physics: dict, path: str) -> None:
-    """The reference of ``physics`` (a scene's: ``physics(scene)``) as JSON at ``path``, NaN as null."""
+def write(physics: dict, out_path: str) -> None:
+    """The reference of ``physics`` (a scene's: ``physics(scene)``) as JSON at ``out_path``, NaN as null."""
     out = compute(physics)
     out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
-    text = json.dumps(physics, sort_keys=True, separators=(",", ":"))
-    key = hashlib.sha256(text.encode()).hexdigest()[:12]
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump({"digest": key, "physics": physics, **out}, f, indent=1)
+    with open(out_path, "w", encoding="utf-8") as f:
+        json.dump({"digest": key(physics), "physics": physics, **out}, f, indent=1)
 
 
 def read(path: str) -> dict:

@@ -521,18 +521,18 @@ class Scenes(Mapping):
 
     def reference_path(self, identity: str) -> str:
         """The reference file that the reactive runs keyed by ``identity`` are judged against."""
-        from .reactive import REFERENCE_PATTERN, digest
+        from .reactive import path
 
-        return REFERENCE_PATTERN.format(digest=digest(self._owner(identity)[0]))
+        return path(self._owner(identity)[0])
 
     def reference_physics(self, key: str) -> dict:
         """The physics of the reference keyed ``key`` (reactive.digest): all that its file depends on,
         the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
-        from .reactive import digest, physics
+        from . import reactive
 
         for scene in self.values():
-            if scene.reaction is not None and digest(scene) == key:
-                return physics(scene)
+            if scene.reaction is not None and reactive.key(physics := reactive.physics(scene)) == key:
+                return physics
         raise KeyError(f"no reactive scene has a reference keyed {key!r}")
 
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.reactions import REACTIONS, Bimolecular, Decay, decay_factor  # noqa: F401  (the kinetics, re-exported)
+from ..core.reactions import Bimolecular, Decay, decay_factor  # noqa: F401  (the kinetics, re-exported)
 from ..numerics.kernels import beta_sph, collision_sigma
 from .conservation import MassError
 
