@@ -65,6 +65,9 @@ def test_a_measure_the_reaction_cannot_judge_is_refused():
     assert _refused(spec(target={"measure": "entropy", "value": 0.1})).name == "scenes.r.target.measure"
     no_reaction = {k: v for k, v in spec().items() if k != "reaction"}
     assert _refused(no_reaction).name == "scenes.r.target.measure"  # product without a reaction
+    no_reaction["target"] = {"measure": "product_rmse", "value": 0.1}
+    err = _refused(no_reaction)
+    assert err.name == "scenes.r.target.measure" and "makes no product" in err.allowed
 
 
 def test_a_pt_rung_whose_pair_probability_exceeds_one_is_refused_with_the_least_n():
@@ -108,6 +111,9 @@ def test_decay_runs_are_the_conservative_runs_times_exp_to_round_off():
         assert last["mass_A"] == pytest.approx(total * left, rel=1e-12)
         assert last["mass_C"] == pytest.approx(1.0 - left, rel=1e-9)
         assert last["product_error"] < 1e-9
+        # C is carried on every node or particle: C = (A + C) (1 - f) and A = (A + C) f everywhere, f =
+        # exp(-lambda t), and so are the references, so C's SSE at the points is A's times ((1 - f) / f)^2
+        assert last["SSE_points_C"] == pytest.approx(last["SSE_points"] * ((1.0 - left) / left) ** 2, rel=1e-6)
 
 
 def test_pt_decay_keeps_exp_of_its_particles_within_its_binomial_noise():
@@ -157,8 +163,11 @@ def test_every_reactive_run_balances_its_species_and_the_search_reads_its_error(
         last = frame.iloc[-1]
         assert last["product_error"] == pytest.approx(abs(last["mass_C"] / ref["product_mass"] - 1.0), rel=1e-12)
     runs = read_runs(pd.DataFrame(plan), paths)
-    assert np.all(np.isfinite(runs["product_error"]))
+    assert np.all(np.isfinite(runs["product_error"])) and np.all(np.isfinite(runs["SSE_points_C"]))
     assert [error(scene, r) for _, r in runs.iterrows()] == list(runs["product_error"])
+    by_c = Scene.from_config("r", spec(reaction=MIXED, target={"measure": "product_rmse", "value": 0.01}))
+    rmse_c = np.sqrt(runs["SSE_points_C"].to_numpy() / ref["points"].size)
+    assert [error(by_c, r) for _, r in runs.iterrows()] == pytest.approx(rmse_c, rel=1e-15)
 
 
 def test_mtpt_product_of_meeting_plumes_converges_to_the_reference_as_n_grows():
@@ -211,3 +220,5 @@ def test_pt_decay_in_a_flow_is_measured_in_the_lab_frame():
     last = run_arrow(scene.run_config(scene.candidates[2], 3000), scene.reaction, ref).to_pandas().iloc[-1]
     rmse = math.sqrt(last["SSE_points"] / ref["points"].size)
     assert rmse < 0.05 * ref["a_points"].max()
+    rmse_c = math.sqrt(last["SSE_points_C"] / ref["points"].size)  # C's particles, where A's decayed
+    assert rmse_c < 0.05 * ref["c_points"].max()

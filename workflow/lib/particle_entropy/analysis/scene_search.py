@@ -96,6 +96,8 @@ def error(scene: Scene, row: pd.Series | dict) -> float:
         return abs(row["H_C"] - row["H_C_analytic"])
     if scene.measure == "product":  # a reactive scene's product mass against its reference
         return row["product_error"]
+    if scene.measure == "product_rmse":  # and its product's concentration at the points
+        return math.sqrt(row["SSE_points_C"] / MEASUREMENT_POINTS)
     return abs(row["E"] / row["E_analytic"] - 1.0)
 
 
@@ -468,6 +470,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
         "seed",
         *keep,
         "product_error",
+        "SSE_points_C",
         "mass_min",
         "negative_step",
         "negative_t",
@@ -489,7 +492,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                     "n": int(r.n),
                     "seed": int(seed),
                     **{k: float(last[k]) for k in keep},
-                    "product_error": float(last["product_error"]) if "product_error" in g else math.nan,
+                    **{k: float(last[k]) if k in g else math.nan for k in ("product_error", "SSE_points_C")},
                     "mass_min": smallest,
                     "negative_step": step,
                     "negative_t": t,

@@ -488,7 +488,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
 # ------------------------------------------------------------------------------ scenes
 # One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
 # (core/reference.py), the candidate models and the accuracy they must reach.
-SCENE_MEASURES = ("rmse", "entropy", "dilution", "product")
+SCENE_MEASURES = ("rmse", "entropy", "dilution", "product", "product_rmse")
 # a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
 # the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
@@ -603,7 +603,8 @@ SCENE = (
         "rmse",
         "the error judged at t_final: rmse = concentration RMSE at the common measurement points (of A in a "
         "reactive scene) [1/L]; entropy = |H_C - its exact value| [nats]; dilution = |E / E_exact - 1|; product "
-        "= |M_C / M_C,ref - 1|, the product's mass (reactive scenes only)",
+        "= |M_C / M_C,ref - 1|, the product's mass, and product_rmse = the RMSE of the product's concentration C_C at "
+        "the points [1/L] (reactive scenes only)",
         choices=SCENE_MEASURES,
     ),
     Setting(

@@ -528,10 +528,12 @@ class _Scene(Section):
     @model_validator(mode="after")
     def _measure_of_kind(self):
         measure, reactive = self.target.measure, self.reaction is not None
-        if measure == "product" and not reactive:
+        if measure in ("product", "product_rmse") and not reactive:
             raise refuse("target.measure", "rmse, entropy or dilution: a scene without a reaction makes no product")
         if reactive and measure in ("entropy", "dilution"):
-            raise refuse("target.measure", "rmse (of C_A) or product: a reactive scene's reference has no entropy")
+            raise refuse(
+                "target.measure", "rmse (of C_A), product or product_rmse: a reactive scene's reference has no entropy"
+            )
         return self
 
     @model_validator(mode="after")

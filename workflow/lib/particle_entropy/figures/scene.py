@@ -20,6 +20,7 @@ MEASURE_LABEL = {
     "entropy": r"$|H_C - H_C^{exact}|$ [nats]",
     "dilution": r"$|E / E^{exact} - 1|$",
     "product": r"$|M_C / M_C^{ref} - 1|$, the product's mass",
+    "product_rmse": "product's concentration RMSE at the points [1/L]",
 }
 
 

@@ -1,22 +1,22 @@
 """Run one candidate of a reactive scene (experiments/reactive.py): its transport, as the conservative
 run does it (``cfg``, a RunConfig), with the scene's reaction after every step, to a per-step table.
 
-- FD: every species carried by the case's own transport step on the fixed grid (models/fd.py), then
-  every node reacted over dt by the closed-form kinetics (core/reactions.py): sequential
+- FD: every species (A, B, C) carried by the case's own transport step on the fixed grid (models/fd.py),
+  then every node reacted over dt by the closed-form kinetics (core/reactions.py): sequential
   non-iterative operator splitting, transport then reaction (Lie's order; Valocchi & Malmstead 1992;
-  as RT3D reacts MT3D's nodes, Clement 1997).
+  as RT3D reacts MT3D's nodes, Clement 1997): the loop of models/fd_reactive.steps.
 - MTPT: the random walk with (1 - eta) D, then every species exchanged with eta D by one transfer
   matrix (Eq. 19; collision or SPH kernel), then every particle reacted over dt at its
   concentrations m / dV (Benson & Bolster 2016; Schmidt, Pankavich & Benson 2017).
 - PT: A and B on particles of their own, of equal mass, walking with D; a decay turns each A into C
   with probability 1 - exp(-lambda dt), A + B -> C takes each pair with Benson & Meerschaert's
   (2008) probability k m_p dt v(s) (models/reactive.py), on the periodic domain Omega in the frame
-  moving with v; C_A is the survivors' kernel reconstruction (models/pt.py) times their mass.
+  moving with v; C_A and C_C are each species' kernel reconstruction (models/pt.py) times its mass.
 
 Every step's reaction balances to round-off (A + C and B + C keep their totals, no mass is negative:
 models/reactive.check_species_mass). A row records the masses of A, B and the product
-made so far; the last row also the errors against the reference: SSE of C_A at the scene's points
-(SSE_points) and the product mass's relative error (product_error).
+made so far; the last row also the errors against the reference: the SSE of C_A and of C_C at the
+scene's points (SSE_points, SSE_points_C) and the product mass's relative error (product_error).
 """
 
 from __future__ import annotations
@@ -35,22 +35,6 @@ from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
 
 
-def react(reaction: Reaction, a: np.ndarray, b: np.ndarray, volume, dt: float, t: float, made: float):
-    """The masses a, b on nodes of ``volume`` dx after dt of the kinetics at their concentrations
-    m / volume (on_masses), with ``made`` the product so far -> (a, b, product made in the step);
-    MassError unless A + C and B + C (a decay: A + C and B) keep their totals to round-off and no mass
-    is negative (models/reactive.check_species_mass)."""
-    from .reactive import check_species_mass
-
-    kinetics = reaction.kinetics
-    before = kinetics.conserved(float(a.sum()), float(b.sum()), made)
-    a_new, b_new, step = kinetics.on_masses(a, b, volume, dt)
-    gained = float(step.sum())
-    after = kinetics.conserved(float(a_new.sum()), float(b_new.sum()), made + gained)
-    check_species_mass(before, after, float(min(a_new.min(), b_new.min())), t, "reactive fd")
-    return a_new, b_new, gained
-
-
 def _row(rec: Recorder, k: int, t: float, dt: float, a, b, made: float, volume: float, extra: dict) -> None:
     mass_a = float(a.sum())
     rec.add(
@@ -67,15 +51,18 @@ def _row(rec: Recorder, k: int, t: float, dt: float, a, b, made: float, volume: 
     )
 
 
-def _judge(cfg: RunConfig, ref: dict, x, c_a, mass_c: float) -> dict:
-    """The errors of a run's last state against the reference: SSE of C_A at the scene's points (the
-    model's concentration linearly interpolated there, measures.at_points) and |M_C / M_C,ref - 1|."""
+def _judge(cfg: RunConfig, ref: dict, x, c_a, mass_c: float, x_c=None, c_c=None) -> dict:
+    """The errors of a run's last state against the reference: the SSE of C_A and of C_C at the scene's
+    points (the model's concentrations linearly interpolated there, measures.at_points; C_C on ``x_c``,
+    by default A's ``x``) and |M_C / M_C,ref - 1|."""
     model = M.at_points(ref["points"], x, c_a)
     err = M.sse(model, ref["a_points"])
     product = ref["product_mass"]
+    x_c = x if x_c is None else x_c
     return {
         **_NAN,
         "SSE_points": err,
+        "SSE_points_C": M.sse(M.at_points(ref["points"], x_c, c_c), ref["c_points"]),
         "COMIC_points": M.comic(err, model.size, cfg.fd_dx if cfg.method == "fd" else cfg.dV),
         "product_error": abs(mass_c / product - 1.0) if product > 0 else math.nan,
     }
@@ -84,12 +71,15 @@ def _judge(cfg: RunConfig, ref: dict, x, c_a, mass_c: float) -> dict:
 # a reactive run's columns beside the conservative run's: its errors at t_final (last row only) and
 # no entropy (a reactive scene's reference has none: its measure is rmse of C_A or product)
 _NAN = dict.fromkeys(
-    ("SSE_points", "COMIC_points", "product_error", "H_C", "H_C_analytic", "E", "E_analytic"), math.nan
+    ("SSE_points", "SSE_points_C", "COMIC_points", "product_error", "H_C", "H_C_analytic", "E", "E_analytic"),
+    math.nan,
 )
 
 
 def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
+    """FD: A, B and C carried by the case's transport step and every node reacted (fd_reactive.steps)."""
     from . import fd
+    from .fd_reactive import steps
 
     x, dx = fd.grid(cfg)
     a = fd.initial_concentration(cfg) * dx  # node masses
@@ -99,19 +89,18 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
     background = reaction.b_uniform * dx if reaction.b_source is None else 0.0
     b = reaction.b_masses(x, dx)
     b[0] = b[-1] = background
-    made = 0.0
-    _row(rec, 0, 0.0, 0.0, a, b, made, dx, _NAN)
+    masses = np.vstack([a, b, np.zeros_like(a)])
+    _row(rec, 0, 0.0, 0.0, a, b, 0.0, dx, _NAN)
     solvers: dict = {}
-    for k, dt in enumerate(dts, start=1):
-        t = ts[k]
+
+    def solver(dt: float):
         if dt not in solvers:
             solvers[dt] = fd.solver(cfg, dt, dx)
-        a[1:-1] = solvers[dt].solve(a[1:-1] / dx) * dx
-        b[1:-1] = solvers[dt].solve((b[1:-1] - background) / dx) * dx + background
-        a, b, gained = react(reaction, a, b, dx, dt, t, made)
-        made += gained
-        last = k == len(dts)
-        _row(rec, k, t, dt, a, b, made, dx, _judge(cfg, ref, x, a / dx, made) if last else _NAN)
+        return solvers[dt]
+
+    for k, t, dt, (a, b, c), made in steps(solver, masses, reaction.kinetics, dx, dts, ts, background):
+        extra = _judge(cfg, ref, x, a / dx, made, c_c=c / dx) if k == len(dts) else _NAN
+        _row(rec, k, t, dt, a, b, made, dx, extra)
 
 
 def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
@@ -131,7 +120,7 @@ def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recor
         kernel = SPHKernel(h) if cfg.kernel == "sph" else CollisionKernel()
         x, masses, substeps = mtpt_step(x, masses, reaction.kinetics, dV, cfg.D, cfg.eta, dt, rng, kernel, t=t)
         made = float(masses[C].sum())
-        extra = _judge(cfg, ref, x, masses[A] / dV, made) if k == len(dts) else _NAN
+        extra = _judge(cfg, ref, x, masses[A] / dV, made, c_c=masses[C] / dV) if k == len(dts) else _NAN
         _row(rec, k, t, dt, masses[A], masses[B], made, dV, {"substeps": substeps, **extra})
 
 
@@ -161,11 +150,22 @@ def _run_pt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
         xa, xb, xc = pt_step(xa, xb, xc, reaction.kinetics, m_p, cfg.D, dt, length, rng, t=t)
         made = xc.size * m_p
         extra = _NAN
-        if k == len(dts):  # A's density, in the lab frame: the survivors' reconstruction times their mass
-            x = np.sort(xa + lo + cfg.v * t)
-            grid, c, _, _ = pt.reconstruct(cfg, x, t) if x.size else (np.zeros(1), np.zeros(1), 0, 0)
-            extra = _judge(cfg, ref, grid, xa.size * m_p * c, made)
+        if k == len(dts):  # A's and C's densities in the lab frame: each species' reconstruction times its mass
+            (grid, c_a), (grid_c, c_c) = (_density(cfg, xs + lo + cfg.v * t, m_p, t) for xs in (xa, xc))
+            extra = _judge(cfg, ref, grid, c_a, made, grid_c, c_c)
         _row(rec, k, t, dt, xa.size * m_p * one, xb.size * m_p * one, made, cfg.dV, extra)
+
+
+def _density(cfg: RunConfig, x: np.ndarray, m_p: float, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """A PT species' concentration from its particles' lab positions ``x``, each of mass m_p: the
+    case's reconstruction (models/pt.reconstruct, a density of unit mass) times their mass; zero if
+    none is left."""
+    from . import pt
+
+    if not x.size:
+        return np.zeros(1), np.zeros(1)
+    grid, c, _, _ = pt.reconstruct(cfg, np.sort(x), t)
+    return grid, x.size * m_p * c
 
 
 def run_arrow(cfg: RunConfig, reaction: Reaction, ref: dict, progress: Callable[[str], None] | None = None) -> pa.Table:

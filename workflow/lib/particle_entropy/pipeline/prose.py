@@ -96,6 +96,8 @@ def target(measure: str, value: float) -> str:
     """A scene's target in words: RMSE <= 0.1, H_C within 0.01 nats, E within 1 %, product within 2 %."""
     if measure == "product":
         return f"product mass within {percent(value)}"
+    if measure == "product_rmse":
+        return f"RMSE of C_C <= {value:g}"
     if measure == "entropy":
         return f"H_C within {value:g} nats"
     if measure == "dilution":
