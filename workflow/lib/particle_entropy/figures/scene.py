@@ -26,7 +26,7 @@ MEASURE_LABEL = {
 
 def scene(table: pd.DataFrame):
     """The figure of one scene's table."""
-    fig, (ax, bx) = new_figure(2, width=5.4, height=4.2)
+    fig, (ax, bx) = new_figure(2, width=5.4, height=5.6)
     name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
     labels = list(dict.fromkeys(table["label"]))
     reactive = "product_series" in table
@@ -122,8 +122,8 @@ def scene(table: pd.DataFrame):
             "resolution n (particles; FD intervals)",
             logx=True,
         )
-    ax.legend(fontsize=7, loc="best")
-    bx.legend(fontsize=7, loc="best")
+    for axes in (ax, bx):  # below the axes, where no legend covers a point (the recommended star)
+        axes.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=1, frameon=False)
     notes = sorted({f"{lab}: {why}" for lab, why in zip(table["label"], table["unscored"]) if why})
     if not len(best):
         closest = table[table["unscored"] == ""].sort_values("error_upper95").head(1)
