@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from particle_entropy.core.case import SettingError
+from particle_entropy.core.timegrid import MAX_STEPS
 from particle_entropy.experiments.scene import Scene, scenes
 
 FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 1000]}
@@ -694,3 +695,24 @@ def test_a_scene_and_the_workflow_refuse_a_value_in_the_same_words(key, value):
         check_config({**config, "scenes": {**config["scenes"], "carried": bad}})
     assert alone.value.name.startswith(f"scenes.carried.{key}")
     assert str(alone.value) == str(workflow.value)
+
+
+def test_a_particle_candidate_takes_a_first_step_of_its_own():
+    """dt0 on a particle candidate: its runs step from it (growth 1: a fixed step), its label and run
+    identity say so, and a candidate without it keeps its identity; FD refuses it (fd_dt is FD's)."""
+    own = {**MTPT, "dt0": 0.5, "dt_growth": 1.0}
+    scene = Scene.from_config("s", spec(candidates=[{**MTPT, "dt_growth": 1.0}, own]))
+    plain, fixed = scene.candidates
+    cfg = scene.run_config(fixed, 100)
+    assert (cfg.dt0, cfg.dt_growth) == (0.5, 1.0) and scene.run_config(plain, 100).dt0 != 0.5
+    assert fixed.label.endswith("dt0=0.5 growth=1") and "dt0" not in plain.label
+    assert scene.settings(fixed)["dt0"] == 0.5 and "dt0" not in scene.settings(plain)
+    assert scene.identity(fixed) != scene.identity(plain) and scene.same_as(1) == 1
+    alone = Scene.from_config("s", spec(candidates=[{**MTPT, "dt_growth": 1.0}]))
+    assert alone.identity(alone.candidates[0]) == scene.identity(plain)
+    err = _refused(spec(candidates=[{**FD, "dt0": 0.5}]))
+    assert err.name == "scenes.s.candidates[0].dt0" and "particle candidates only" in err.allowed
+    err = _refused(spec(candidates=[FD, {**MTPT, "dt0": 1e-9, "dt_growth": 1.0}]))
+    assert err.name == "scenes.s.candidates[1].dt0" and err.value == 1e-9
+    least = float(err.allowed.split(">= ")[1].split(" ")[0])
+    assert least == pytest.approx(50.0 / MAX_STEPS, rel=1e-2)  # t_final / the most steps

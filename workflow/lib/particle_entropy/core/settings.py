@@ -540,6 +540,12 @@ CANDIDATE_SHAPE = {
                 "(instead of n_range)",
             },
             "time_grid": {"type": "string", "enum": ["exact"], "description": SCENE_TIME_GRID_TEXT},
+            "dt0": {
+                "type": "number",
+                "exclusiveMinimum": 0,
+                "description": "a particle candidate's first time step, instead of `time.dt0` (with dt_growth 1 a "
+                "fixed step) [T]; a number > 0",
+            },
         },
         "oneOf": [{"required": ["n_range"]}, {"required": ["ladder"]}],
     },

@@ -493,6 +493,7 @@ class _Search(Section):
 
 
 FD_ONLY = ("advection", "fd_dt", "courant")  # a scene candidate's keys that only FD takes
+PARTICLE_ONLY = ("dt0",)  # and those only particles take (FD's step: fd_dt or courant)
 
 
 class _Candidate(OneOf):
@@ -510,6 +511,8 @@ class _Candidate(OneOf):
             raise refuse("n_range", even)
         if not fd and (given := [k for k in FD_ONLY if k in self.model_fields_set]):
             raise refuse(given[0], "fd candidates only")
+        if fd and (given := [k for k in PARTICLE_ONLY if k in self.model_fields_set]):
+            raise refuse(given[0], "particle candidates only (FD's step: fd_dt, or courant in a flow)")
         if fd and ladder is not None and any(n % 2 for n in ladder):
             raise refuse("ladder", "for fd even numbers of intervals")
         limit = COURANT_LIMIT.get(self.advection or DEFAULT_ADVECTION, math.inf)

@@ -23,7 +23,7 @@ from ..core.runcost import StepWork, Tally
 from ..core.settings import MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
-from ..core.typed import FD_ONLY, shared, validate
+from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
 from ..core.typed import key_path as typed_key_path
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
@@ -76,6 +76,7 @@ class Candidate:
     fd_dt: float = PAPER["fd_dt"]
     rungs: tuple[int, ...] = ()  # a ladder written out (config `ladder`) instead of n_range's
     courant: float | None = None  # FD in a flow: the step's Courant number instead of fd_dt
+    dt0: float | None = None  # particles: their first step instead of time.dt0 (growth 1: a fixed step)
 
     @property
     def label(self) -> str:
@@ -92,6 +93,8 @@ class Candidate:
                 words.append(f"cut={_number(c.truncation)}")
             if c.scheme != "symmetric":
                 words.append(c.scheme)
+        if self.dt0 is not None:
+            words.append(f"dt0={_number(self.dt0)}")
         if c.dt_growth != PAPER["dt_growth"]:  # every dimension that tells two models apart
             words.append(f"growth={_number(c.dt_growth)}")
         if c.time_grid != PAPER["time_grid"]:
@@ -100,8 +103,8 @@ class Candidate:
 
     @property
     def model(self) -> tuple:
-        """What makes two candidates the same model: the case, FD's scheme and step."""
-        return (self.case, self.advection, self.fd_dt, self.courant)
+        """What makes two candidates the same model: the case, FD's scheme and step, particles' first step."""
+        return (self.case, self.advection, self.fd_dt, self.courant, self.dt0)
 
     def ladder(self) -> list[int]:
         """The resolutions the search may visit: n_lo, n_lo r, n_lo r^2, ... up to n_hi (r = LADDER_RATIO,
@@ -211,6 +214,8 @@ class Scene:
                 out["courant"] = candidate.courant
             if self.v != 0.0:
                 out["advection"] = candidate.advection
+        elif candidate.dt0 is not None:  # only when set, as courant
+            out["dt0"] = candidate.dt0
         return out
 
     def identity(self, candidate: Candidate) -> str:
@@ -326,6 +331,14 @@ def _candidate_error(scene: Scene, i: int, spec, e: SettingError) -> SettingErro
         return SettingError(scene.key(f"{where}.courant"), e.value, e.allowed)
     if e.name == "dt0" and cand.case.method == "fd" and "fd_dt" in spec:
         return SettingError(scene.key(f"{where}.fd_dt"), e.value, e.allowed)
+    if e.name == "dt0" and cand.dt0 is not None:  # a particle step of its own: too many steps to t_final
+        least = max_first_step(scene.t_final, cand.case.dt_growth)
+        return SettingError(
+            scene.key(f"{where}.dt0"),
+            cand.dt0,
+            f"a number >= {least:.3g} [T]: a first step that reaches t_final = {scene.t_final:g} in at most "
+            f"{MAX_STEPS:,} steps",
+        )
     if e.name == "dt0":  # a step the scene does not set: the time it must reach is the key
         g = cand.case.dt_growth
         try:
@@ -453,7 +466,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     """Candidate i of scene ``name`` from its parsed model (its keys' rules held there, core/typed.py):
     its case built with case_defaults (not their time_grid: a scene's runs end at t_final, where they
     are judged), else SettingError naming the candidate's key or case_defaults'."""
-    dims = spec.model_dump(exclude_unset=True, exclude={*FD_ONLY, "n_range", "ladder"})
+    dims = spec.model_dump(exclude_unset=True, exclude={*FD_ONLY, *PARTICLE_ONLY, "n_range", "ladder"})
     case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
     try:
         case = Case.from_spec(dims, None, case_defaults)
@@ -463,7 +476,7 @@ def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
     lo, hi = (rungs[0], rungs[-1]) if rungs else spec.n_range
     advection = spec.advection or DEFAULT_ADVECTION
     fd_dt = PAPER["fd_dt"] if spec.fd_dt is None else spec.fd_dt
-    return Candidate(case, lo, hi, advection, fd_dt, rungs, spec.courant)
+    return Candidate(case, lo, hi, advection, fd_dt, rungs, spec.courant, spec.dt0)
 
 
 class Scenes(Mapping):
