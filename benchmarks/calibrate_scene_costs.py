@@ -31,6 +31,13 @@ from particle_entropy.pipeline.configcheck import load_yaml
 RUNGS = 4  # rungs timed per candidate
 
 
+def rungs(scene, cand, max_s: float) -> list[int]:
+    """Up to RUNGS rungs of a candidate's ladder, spread from its low end to the highest rung whose
+    counted cost under the current model is at most ``max_s`` [s]."""
+    ladder = [n for n in cand.ladder() if scene.run_cost(cand, n) <= max_s]
+    return sorted({ladder[round(k * (len(ladder) - 1) / (RUNGS - 1))] for k in range(RUNGS)}) if ladder else []
+
+
 def timed_points(config: dict, names: list[str], max_s: float) -> dict[str, list[tuple[float, float, float, str]]]:
     """Per method, (steps, work, measured s, what) of the runs timed."""
     out: dict[str, list] = defaultdict(list)
@@ -39,9 +46,7 @@ def timed_points(config: dict, names: list[str], max_s: float) -> dict[str, list
     for name in names or list(table_of):
         scene = table_of[name]
         for cand in scene.candidates:
-            ladder = [n for n in cand.ladder() if scene.run_cost(cand, n) <= max_s]
-            pick = sorted({ladder[round(k * (len(ladder) - 1) / (RUNGS - 1))] for k in range(RUNGS)}) if ladder else []
-            for n in pick:
+            for n in rungs(scene, cand, max_s):
                 cfg = scene.run_config(cand, n, seed=int(config.get("base_seed", 0)))
                 key = (cfg.method, cfg.kernel, n, cfg.t_final, cfg.dt0, cfg.v != 0.0, cand.advection)
                 if key in seen:

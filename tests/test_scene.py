@@ -716,3 +716,57 @@ def test_a_particle_candidate_takes_a_first_step_of_its_own():
     assert err.name == "scenes.s.candidates[1].dt0" and err.value == 1e-9
     least = float(err.allowed.split(">= ")[1].split(" ")[0])
     assert least == pytest.approx(50.0 / MAX_STEPS, rel=1e-2)  # t_final / the most steps
+
+
+def _transport_s(scene: Scene, cand, n: int) -> tuple[float, float]:
+    """A run's counted step part and work part under the scene's `cost` alone, by StepWork's formula
+    written out: seconds a step x steps, seconds a unit x steps x units (particles, FD's n + 1 nodes)."""
+    from particle_entropy.core.runcost import run_steps
+
+    cfg = scene.run_config(cand, n)
+    per_step, per_unit = dict(scene.cost)[cfg.method]
+    steps = run_steps(cfg).size
+    units = n + 1 if cfg.method == "fd" else n
+    return per_step * steps, per_unit * (steps * units)
+
+
+def test_a_conservative_scene_s_counted_cost_is_its_transport_s_to_the_bit():
+    """No reaction, no factor: every rung of the shipped conservative scenes costs what `cost` counts
+    for its steps and work (settings.REACTIVE_COST prices reactive runs only)."""
+    from conftest import ROOT
+
+    from particle_entropy.pipeline.configcheck import load_yaml
+
+    table = scenes(dict(load_yaml(ROOT / "config.yaml")))
+    for name in ("carried", "spill", "narrow"):
+        scene = table[name]
+        assert scene.reaction is None
+        for cand in scene.candidates:
+            for n in cand.ladder()[:3]:
+                step_s, work_s = _transport_s(scene, cand, n)
+                assert scene.run_cost(cand, n) == step_s + work_s
+
+
+def test_a_reactive_rung_costs_its_transport_times_the_reaction_s_factors():
+    """A reactive scene's run costs its transport's step part and work part, each times its method's
+    factor of settings.REACTIVE_COST (benchmarks/reactive_cost.py): FD (no factor) the same as its
+    transport; MTPT and PT more at their top rung, where the work dominates (a small rung's steps
+    may cost less: the reactive run draws no entropy or exact density a step)."""
+    from particle_entropy.core.settings import REACTIVE_COST
+
+    mixed = {"kind": "bimolecular", "k": 2.0, "B": {"source": {"kind": "box", "a": -1.0, "b": 1.0}, "mass": 1.0}}
+    cands = [FD, MTPT, {**PT, "n_range": [300, 3000]}]
+    box = {"kind": "box", "a": -1.0, "b": 1.0}
+    reactive = Scene.from_config("r", spec(source=box, reaction=mixed, target={"value": 0.02}, candidates=cands))
+    for cand in reactive.candidates:
+        method = cand.case.method
+        for n in (cand.n_lo, cand.ladder()[-1]):
+            step_s, work_s = _transport_s(reactive, cand, n)
+            on_step, on_work = REACTIVE_COST.get(method, (1.0, 1.0))
+            got = reactive.run_cost(cand, n)
+            assert got == pytest.approx(on_step * step_s + on_work * work_s, rel=1e-12)
+            if method == "fd":
+                assert method not in REACTIVE_COST and got == step_s + work_s
+            elif n == cand.ladder()[-1]:
+                assert got > step_s + work_s
+    assert set(REACTIVE_COST) == {"mtpt", "pt"} and all(on_work > 1.0 for _, on_work in REACTIVE_COST.values())

@@ -651,7 +651,8 @@ SCENE = (
         {"fd": [3.85e-5, 1.72e-8], "pt": [7.99e-5, 3.71e-8], "mtpt": [8.37e-5, 2.02e-7]},
         "the cost model of a run, by method: [seconds a time step, seconds a unit of work] (work = node- or "
         "particle-steps); counted, never timed, so the answer is the same on every machine (fitted by "
-        "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03)",
+        "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03); a reactive "
+        "scene's run: its steps' part and its work's part times its method's factor (settings.REACTIVE_COST)",
         "s",
         kind="shape",
         shape=dict[Literal[METHODS], array(number(ge=0), min_length=2, max_length=2)],
@@ -683,6 +684,17 @@ SCENE = (
         required=True,
     ),
 )
+
+# A reactive scene's run (models/reactive_run.py) against its transport's, which `cost` prices: per
+# method, the factors on the counted cost's step part and work part, [x seconds a step, x seconds a
+# unit of work] (Scene.cost_model). MTPT moves three species through the transfer matrix and reacts
+# every particle; PT pairs A with B (Benson & Meerschaert) but draws no per-step measures; FD is
+# absent (factor 1): its two species' solves and node reaction cost about what its conservative
+# run's measures do (reactive / conservative 0.93, range 0.77-1.13). Fitted by
+# benchmarks/reactive_cost.py (nnls, relative) to the 40 rungs of the shipped reactive scenes, each
+# run beside its conservative run, CPU seconds, AMD EPYC, 2 vCPU, 2026-12-04: `python
+# benchmarks/reactive_cost.py`. Factors, not seconds, so a scene's own `cost` carries over.
+REACTIVE_COST = {"mtpt": (0.873, 1.56), "pt": (0.465, 2.62)}
 
 
 SCENES_PECLET = (

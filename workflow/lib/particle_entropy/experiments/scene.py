@@ -20,7 +20,7 @@ from ..core.reference import Reference
 from ..core.registry import DEFAULT_ADVECTION
 from ..core.runconfig import RunConfig, check_plume_width
 from ..core.runcost import StepWork, Tally
-from ..core.settings import MAX_REALISATIONS, PAPER, SCENE, SCENE_REACH, defaults
+from ..core.settings import MAX_REALISATIONS, PAPER, REACTIVE_COST, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
 from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
@@ -150,8 +150,12 @@ class Scene:
 
     def cost_model(self, method: str) -> StepWork:
         """The scene's cost model of a method's runs (``cost``: seconds a step, seconds a unit of work;
-        core/runcost.StepWork, units as the run tables' `work` counts them)."""
+        core/runcost.StepWork, units as the run tables' `work` counts them); in a reactive scene each
+        times its method's factor of settings.REACTIVE_COST (what the reaction adds to the transport)."""
         per_step, per_work = dict(self.cost)[method]
+        if self.reaction is not None:
+            on_step, on_work = REACTIVE_COST.get(method, (1.0, 1.0))
+            per_step, per_work = per_step * on_step, per_work * on_work
         return StepWork(per_step, per_work)
 
     def cost_s(self, method: str, steps: float, work: float) -> float:
@@ -161,7 +165,8 @@ class Scene:
     def run_cost(self, candidate: Candidate, n: int) -> float:
         """The counted cost of one run of ``candidate`` at resolution n, known before it runs: its time
         steps and work (particles, or FD's n + 1 nodes, times steps; MTPT's substeps, if any, come on
-        top in the run's own count) times the scene's unit costs [s]."""
+        top in the run's own count) times the scene's unit costs (cost_model: a reactive scene's with
+        its reaction's factors) [s]."""
         cfg = self.run_config(candidate, n)
         return self.cost_model(cfg.method).seconds(cfg)
 

@@ -34,7 +34,7 @@ from ..analysis import resampling, scene_search
 from ..analysis.optimum import SEARCH_DEFAULTS
 from ..core.registry import MEASUREMENT_POINTS
 from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
-from ..core.settings import SCENE, SCENE_MIN_MARGIN, defaults
+from ..core.settings import REACTIVE_COST, SCENE, SCENE_MIN_MARGIN, defaults
 from ..core.timegrid import MAX_STEPS
 from ..experiments import scene
 from ..experiments.scene import SWEEP_PREFIX
@@ -110,11 +110,15 @@ def code_values() -> dict[str, str]:
     """The constants quoted in prose, each from the module that uses it."""
     d = defaults(SCENE)
     cost = ", ".join(f"{ABBREVIATED[m]} {a:.3g} s a step + {b:.3g} s a unit" for m, (a, b) in d["cost"].items())
+    factors = ", ".join(
+        f"{ABBREVIATED[m]} {a:.3g} on the steps, {b:.3g} on the work" for m, (a, b) in REACTIVE_COST.items()
+    )
     return {
         "scenes.physics": f"{power(d['D'])}, {d['v']:g}, {d['t_final']:g}",
         "scenes.margin": f"{d['margin']:g}",
         "scenes.realisations": str(d["realisations"]),
         "scenes.cost": cost,
+        "settings.REACTIVE_COST": factors,
         "scene.MAX_BLOCKS": str(scene.MAX_BLOCKS),
         "settings.SCENE_MIN_MARGIN": f"{SCENE_MIN_MARGIN:.3g}",
         "registry.MEASUREMENT_POINTS": str(MEASUREMENT_POINTS),
