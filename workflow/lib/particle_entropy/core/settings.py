@@ -688,13 +688,12 @@ SCENE = (
 # A reactive scene's run (models/reactive_run.py) against its transport's, which `cost` prices: per
 # method, the factors on the counted cost's step part and work part, [x seconds a step, x seconds a
 # unit of work] (Scene.cost_model). MTPT moves three species through the transfer matrix and reacts
-# every particle; PT pairs A with B (Benson & Meerschaert) but draws no per-step measures; FD is
-# absent (factor 1): its two species' solves and node reaction cost about what its conservative
-# run's measures do (reactive / conservative 0.93, range 0.77-1.13). Fitted by
+# every particle; PT pairs A with B (Benson & Meerschaert) but draws no per-step measures; FD
+# solves A, B and C and reacts every node (reactive / conservative 1.17, range 0.95-1.46). Fitted by
 # benchmarks/reactive_cost.py (nnls, relative) to the 40 rungs of the shipped reactive scenes, each
-# run beside its conservative run, CPU seconds, AMD EPYC, 2 vCPU, 2026-12-04: `python
+# run beside its conservative run, CPU seconds, AMD EPYC, 2 vCPU, 2026-12-04, at 9049350: `python
 # benchmarks/reactive_cost.py`. Factors, not seconds, so a scene's own `cost` carries over.
-REACTIVE_COST = {"mtpt": (0.873, 1.56), "pt": (0.465, 2.62)}
+REACTIVE_COST = {"fd": (1.08, 1.45), "mtpt": (0.902, 1.58), "pt": (0.474, 2.64)}
 
 
 SCENES_PECLET = (
