@@ -22,6 +22,7 @@ step-work model of core/runcost.py: Scene.cost_model); the measured core-seconds
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -124,13 +125,19 @@ def unscored(scene: Scene, row) -> str:
     return ""
 
 
+@functools.cache
+def _t_quantile(quantile: float, dof: int):
+    """scipy's t.ppf(quantile, dof), kept: a search asks for the same few hundreds of times."""
+    from scipy.stats import t
+
+    return t.ppf(quantile, dof)
+
+
 def _t_margin(errors: np.ndarray, quantile: float) -> float:
     """Student t's ``quantile`` times the mean's standard error; 0 for a single value."""
     if errors.size == 1:
         return 0.0
-    from scipy.stats import t
-
-    return float(t.ppf(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
+    return float(_t_quantile(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
 
 
 def upper_bound(errors: np.ndarray) -> float:
