@@ -22,6 +22,7 @@ step-work model of core/runcost.py: Scene.cost_model); the measured core-seconds
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -126,13 +127,19 @@ def unscored(scene: Scene, row) -> str:
     return ""
 
 
+@functools.cache
+def _t_quantile(quantile: float, dof: int):
+    """scipy's t.ppf(quantile, dof), kept: a search asks for the same few hundreds of times."""
+    from scipy.stats import t
+
+    return t.ppf(quantile, dof)
+
+
 def _t_margin(errors: np.ndarray, quantile: float) -> float:
     """Student t's ``quantile`` times the mean's standard error; 0 for a single value."""
     if errors.size == 1:
         return 0.0
-    from scipy.stats import t
-
-    return float(t.ppf(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
+    return float(_t_quantile(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
 
 
 def upper_bound(errors: np.ndarray) -> float:
@@ -163,9 +170,13 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
     rows = []
     if runs.empty:
         return pd.DataFrame(rows, columns=JUDGED_COLUMNS)
-    for (ci, n), g in runs.groupby(["candidate", "n"], sort=True):
+    # the records of every run at once, each group's picked by position: the same dicts as each
+    # group's own to_dict("records"), without pandas' per-column cost once per group
+    every = runs.to_dict("records")
+    groups = runs.groupby(["candidate", "n"], sort=True)
+    for (ci, n), g in groups:
         cand = scene.candidates[ci]
-        records = g.to_dict("records")
+        records = [every[i] for i in groups.indices[(ci, n)]]
         reason = next((why for why in (unscored(scene, r) for r in records) if why), "")
         errs = np.array([error(scene, r) for r in records])
         k = errs.size
