@@ -40,8 +40,8 @@ def _g(x: np.ndarray) -> np.ndarray:
     """(1 - exp(-x)) / x for x >= 0, with g(0) = 1, without cancellation (expm1, and its series near 0)."""
     x = np.asarray(x, dtype=np.float64)
     small = x < _SERIES
-    safe = np.where(small, 1.0, x)
-    return np.where(small, 1.0 - x / 2.0 + x * x / 6.0, -np.expm1(-safe) / safe)
+    safe, tiny = np.where(small, 1.0, x), np.where(small, x, 0.0)  # each branch on its own x: no overflow
+    return np.where(small, 1.0 - tiny / 2.0 + tiny * tiny / 6.0, -np.expm1(-safe) / safe)
 
 
 def _ordered(a, b, k: float, dt):
