@@ -72,9 +72,9 @@ def steps(
     made = 0.0
     for k, dt in enumerate(dts, start=1):
         transport = solver(dt)
-        a[1:-1] = transport.solve(a[1:-1] / dx) * dx
-        b[1:-1] = transport.solve((b[1:-1] - background) / dx) * dx + background
-        c[1:-1] = transport.solve(c[1:-1] / dx) * dx
+        a[:] = transport_step(transport, a / dx) * dx
+        b[:] = transport_step(transport, (b - background) / dx) * dx + background
+        c[:] = transport_step(transport, c / dx) * dx
         a[:], b[:], step = react(kinetics, a, b, dx, dt, ts[k], made)
         c += step
         made += float(step.sum())
