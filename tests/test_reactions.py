@@ -75,3 +75,30 @@ def test_reaction_kinds_account_for_every_mass():
     assert REACTIONS == {"decay": Decay, "bimolecular": Bimolecular}
     with pytest.raises(ValueError):
         Decay(-1.0)
+
+
+@pytest.mark.parametrize("x", [1e-10, 1e-200, 1e-300])
+def test_small_moved_masses_keep_their_digits(x):
+    # issue 50: a product of 1e-300 must not vanish as m - m exp(-x), nor as m_B - m_B'.
+    # Independent values: the series of each exact amount to second order, the next term far below 1e-12
+    from particle_entropy.core.reactions import Bimolecular, Decay
+
+    m = np.array([0.25, 1.0, 3.0])
+    _, _, moved = Decay(x).on_masses(m, m, 1.0, 1.0)
+    np.testing.assert_allclose(moved, m * x * (1.0 - x / 2.0), rtol=1e-12)
+    mb = np.array([0.5, 0.5, 2.0])
+    na, nb, made = Bimolecular(x).on_masses(m, mb, 0.1, 2.0)
+    kappa = x * 2.0 / 0.1  # k dt / dV; the series of the exact r to second order in it
+    np.testing.assert_allclose(made, m * mb * kappa * (1.0 - (m + mb) * kappa / 2.0), rtol=1e-12)
+    assert np.all(na <= m) and np.all(nb <= mb)
+
+
+def test_a_round_off_negative_residue_takes_no_part_in_the_reaction():
+    # an FD scheme carrying B as its departure from a background leaves -1e-18 where B is used up:
+    # it must react as 0 (no negative product, A untouched there) and be carried through unchanged
+    from particle_entropy.core.reactions import Bimolecular
+
+    a, b = np.array([1.0, 1.0]), np.array([-1.7e-18, 0.5])
+    na, nb, made = Bimolecular(100.0).on_masses(a, b, 1.0, 0.1)
+    assert na[0] == 1.0 and nb[0] == -1.7e-18 and made[0] == 0.0
+    assert made[1] > 0.0 and na[1] + made[1] == pytest.approx(1.0, rel=1e-15)

@@ -222,3 +222,42 @@ def test_pt_decay_in_a_flow_is_measured_in_the_lab_frame():
     assert rmse < 0.05 * ref["a_points"].max()
     rmse_c = math.sqrt(last["SSE_points_C"] / ref["points"].size)  # C's particles, where A's decayed
     assert rmse_c < 0.05 * ref["c_points"].max()
+
+
+def _extreme(reaction, **over):
+    """A narrow pulse of A into the issue 50 extremes: FD at fd_dt 0.005 and MTPT, t_final 20."""
+    cands = [{**FD, "n_range": [64, 128]}, {**MTPT, "n_range": [200, 400]}]
+    gauss = {"kind": "gaussian", "x0": 0.0, "sd": 0.01}
+    return Scene.from_config("x", spec(D=1e-4, v=0.0, source=gauss, reaction=reaction, candidates=cands, **over))
+
+
+def test_a_product_of_1e_300_is_made_and_judged_by_fd_and_mtpt():
+    # issue 50: at k = 1e-300 both recorded 0 (error 1 at every rung). A unit mass in B = 0.5 makes
+    # k C0 t = 1e-299 to first order, its next term k^2 far below round-off
+    scene = _extreme({"kind": "bimolecular", "k": 1e-300, "B": {"uniform": 0.5}})
+    ref = reactive.compute(reactive.physics(scene))
+    for cand in scene.candidates:
+        last = run_arrow(scene.run_config(cand, cand.n_lo), scene.reaction, ref).to_pandas().iloc[-1]
+        assert last["mass_C"] == pytest.approx(1e-299, rel=1e-9), cand.label
+        assert last["product_error"] < 1e-6, cand.label
+
+
+def test_fd_s_round_off_below_a_used_up_background_fails_no_run():
+    # issue 50: B carried as its departure from C0 leaves -1.7e-18 where the pulse used B up, and the
+    # run aborted with "made a negative mass: -6.01e-21"; now it runs and balances its species
+    upwind = {"method": "fd", "kernel": "implicit", "advection": "upwind", "fd_dt": 0.005, "n_range": [64, 128]}
+    scene = _extreme({"kind": "bimolecular", "k": 100.0, "B": {"uniform": 0.5}})
+    scene = replace(scene, candidates=(replace(scene.candidates[0], fd_dt=upwind["fd_dt"]),))
+    pts = reactive.points(scene)
+    stub = {"points": pts, "a_points": 0 * pts, "c_points": 0 * pts, "product_mass": 1.0}  # judged elsewhere
+    table = run_arrow(scene.run_config(scene.candidates[0], 64), scene.reaction, stub).to_pandas()
+    assert table["mass_min"].min() < 0.0  # the residue is there, and within round-off of B's total
+    assert table["mass_min"].min() > -1e-12 * table["mass_B"].iloc[0]
+    made, a_left = table["mass_C"].iloc[-1], table["mass_A"].iloc[-1]
+    assert 0.1 < made < 1.0 and made + a_left == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("b", [{"uniform": 1e-300}, {"source": {"kind": "box", "a": -1.0, "b": 1.0}, "mass": 1e-250}])
+def test_a_b_whose_masses_reach_subnormal_doubles_is_refused(b):
+    err = _refused(spec(reaction={"kind": "bimolecular", "k": 1.0, "B": b}))
+    assert err.name.startswith("scenes.r.reaction.B.") and "1e-200" in err.allowed
