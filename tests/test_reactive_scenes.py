@@ -261,3 +261,23 @@ def test_fd_s_round_off_below_a_used_up_background_fails_no_run():
 def test_a_b_whose_masses_reach_subnormal_doubles_is_refused(b):
     err = _refused(spec(reaction={"kind": "bimolecular", "k": 1.0, "B": b}))
     assert err.name.startswith("scenes.r.reaction.B.") and "1e-200" in err.allowed
+
+
+def test_b_plus_c_lost_through_fd_s_ends_unscores_a_rung_whose_a_plus_c_is_held():
+    # issue 50: the lost-mass rule read A plus the product made, so a rung that let B and C out of its
+    # window was scored. B's box downstream of A's: upwind's numerical dispersion carries B + C out
+    # first (n = 256: A + C loses 6e-4, B + C 6 %)
+    from particle_entropy.analysis.scene_search import negative_steps, unscored
+
+    b_ahead = {"kind": "bimolecular", "k": 10.0, "B": {"source": {"kind": "box", "a": 0.5, "b": 1.0}, "mass": 1.0}}
+    upwind = {"method": "fd", "kernel": "implicit", "advection": "upwind", "courant": 0.5, "n_range": [64, 4096]}
+    sp = spec(D=1e-4, v=0.1, t_final=50.0, source={"kind": "box", "a": -0.5, "b": 0.0}, reaction=b_ahead)
+    scene = Scene.from_config("r", {**sp, "candidates": [upwind]})
+    pts = reactive.points(scene)
+    stub = {"points": pts, "a_points": 0 * pts, "c_points": 0 * pts, "product_mass": 1.0}
+    table = run_arrow(scene.run_config(scene.candidates[0], 256), scene.reaction, stub).to_pandas()
+    last = table.iloc[-1]
+    assert 1.0 - last["mass_total"] < 1e-3 < last["mass_lost_BC"]
+    step, *_ = negative_steps(table)
+    row = {**last.to_dict(), "candidate": 0, "negative_step": step}
+    assert unscored(scene, row).startswith("B + C lost through the window's ends")

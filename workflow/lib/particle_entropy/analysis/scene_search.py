@@ -64,7 +64,8 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "meets": "the rung is scored and `error_upper95` <= `target`",
     "unscored": "why the rung cannot be judged (a concentration below -1e-12 of the total at any step: its "
     "first such step, the minimum and, for FD in a flow, the grid Peclet and Courant numbers; more than 1e-3 of "
-    "the mass lost through the FD window's ends, or gained; not run: over budget), else empty",
+    "the mass lost through the FD window's ends, or gained, in a reactive run of A + C or of B + C; not run: over "
+    "budget), else empty",
     "steps": "time steps of a run",
     "work": "particle-steps (FD node-steps) of a run, MTPT substeps counted",
     "cost_s": "the counted cost of one run: `steps` and `work` times the scene's `cost` (a rung not run: "
@@ -118,13 +119,23 @@ def unscored(scene: Scene, row) -> str:
             peclet, courant = abs(scene.v) * dx / scene.D, abs(scene.v) * row["negative_dt"] / dx
             why += f"; grid Peclet {peclet:.3g}{' > 2' if peclet > 2 else ''}, Courant {courant:.3g}"
         return why
-    lost = 1.0 - row["mass_total"]
-    if not abs(lost) <= MASS_LOSS_MAX:
-        what = "lost through the window's ends" if lost > 0 else "gained"
-        return f"mass {what}: {abs(lost):.3g} of 1 (at most {MASS_LOSS_MAX:g})"
+    for name, lost in conserved_losses(row).items():
+        if not abs(lost) <= MASS_LOSS_MAX:
+            what = "lost through the window's ends" if lost > 0 else "gained"
+            return f"{name} {what}: {abs(lost):.3g} of it (at most {MASS_LOSS_MAX:g})"
     if not np.isfinite(row["SSE_points"]):
         return "SSE not finite"
     return ""
+
+
+def conserved_losses(row) -> dict[str, float]:
+    """The fraction of each conserved total a run lost by t_final (negative: gained): its mass (A + C
+    held, in a reactive run), and a reactive run's B + C (mass_lost_BC; NaN in a conservative run)."""
+    reactive = "mass_lost_BC" in row and np.isfinite(row["mass_lost_BC"])
+    out = {"A + C" if reactive else "mass": 1.0 - row["mass_total"]}
+    if reactive:
+        out["B + C"] = row["mass_lost_BC"]
+    return out
 
 
 @functools.cache
@@ -469,6 +480,9 @@ def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
     return int(first["step"]), float(first["time"]), float(first["dt"]), smallest
 
 
+REACTIVE_ONLY = ("product_error", "SSE_points_C", "mass_lost_BC")  # a reactive run's columns (models/reactive_run)
+
+
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """One row per run of a plan (``paths`` in its order): the last step's measures, the smallest
     mass over every step and its first negative step (negative_steps), the run's work and its
@@ -480,8 +494,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
         "n",
         "seed",
         *keep,
-        "product_error",
-        "SSE_points_C",
+        *REACTIVE_ONLY,
         "mass_min",
         "negative_step",
         "negative_t",
@@ -503,7 +516,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                     "n": int(r.n),
                     "seed": int(seed),
                     **{k: float(last[k]) for k in keep},
-                    **{k: float(last[k]) if k in g else math.nan for k in ("product_error", "SSE_points_C")},
+                    **{k: float(last[k]) if k in g else math.nan for k in REACTIVE_ONLY},
                     "mass_min": smallest,
                     "negative_step": step,
                     "negative_t": t,

@@ -250,7 +250,7 @@ class Scene:
         omega = span if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         if s.fd_length is not None:  # from the margin it holds the plume by the margin's range
-            _check_window(name, fd_length, source, D, t_final)
+            _check_window(name, fd_length, extent, D, t_final)
         if reaction is not None and reaction.b_source is not None:
             _check_species_b(name, reaction, source, min(omega, fd_length), D, t_final)
         cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(s.candidates))
@@ -366,20 +366,21 @@ def _candidate_error(scene: Scene, i: int, spec, e: SettingError) -> SettingErro
     return SettingError(scene.key(e.name), e.value, e.allowed)
 
 
-def _check_window(name: str, fd_length: float, source: Source, D: float, t_final: float) -> None:
+def _check_window(name: str, fd_length: float, extent: float, D: float, t_final: float) -> None:
     """SettingError naming scenes.<name>.fd_length unless the window reaches REACH sqrt(4 D t_final)
-    beyond the source's extent on either side, as the paper's [-6, 6] at t = 1000: its zero ends then
-    absorb at most 2 erfc(3) = 4.4e-5 of the mass by t_final (an upper bound: a flow only lowers it);
-    a window of +- 1 sqrt(2 D t_final) lost a third."""
-    need = 2.0 * (source.half_width + REACH * math.sqrt(4.0 * D * t_final))
+    beyond the sources' extent (``extent``: the half width around A's centre holding A's source and
+    B's plume, _extent) on either side, as the paper's [-6, 6] at t = 1000: its zero ends then absorb
+    at most 2 erfc(3) = 4.4e-5 of each species' mass by t_final (an upper bound: a flow only lowers
+    it); a window of +- 1 sqrt(2 D t_final) lost a third."""
+    need = 2.0 * (extent + REACH * math.sqrt(4.0 * D * t_final))
     if fd_length < need * (1.0 - 1e-12):  # the paper's own 12 is the bound at its D, t_final
-        extent = f"the source's extent {2.0 * source.half_width:.6g} + " if source.half_width else ""
+        extent_text = f"the sources' extent {2.0 * extent:.6g} + " if extent else ""
         raise SettingError(
             _key(name, "fd_length"),
             fd_length,
-            f"a window >= {extent}2 x {REACH:g} sqrt(4 D t_final) = {need:.6g} for D = {D:g}, t_final = {t_final:g} "
-            f"(the paper's [-6, 6] at t = 1000, whose zero ends absorb 2 erfc(3) = 4.4e-5 of the mass by then): "
-            "a narrower window loses the plume through its ends",
+            f"a window >= {extent_text}2 x {REACH:g} sqrt(4 D t_final) = {need:.6g} for D = {D:g}, t_final = "
+            f"{t_final:g} (the paper's [-6, 6] at t = 1000, whose zero ends absorb 2 erfc(3) = 4.4e-5 of the mass "
+            "by then): a narrower window loses the plume through its ends",
         )
 
 

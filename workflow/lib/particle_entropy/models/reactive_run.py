@@ -15,8 +15,10 @@ run does it (``cfg``, a RunConfig), with the scene's reaction after every step, 
 
 Every step's reaction balances to round-off (A + C and B + C keep their totals, no mass is negative:
 models/reactive.check_species_mass). A row records the masses of A, B and the product
-made so far; the last row also the errors against the reference: the SSE of C_A and of C_C at the
-scene's points (SSE_points, SSE_points_C) and the product mass's relative error (product_error).
+made so far, A + C still held (mass_total) and the fraction of B + C lost (mass_lost_BC: FD's
+window ends let both totals out, particles none); the last row also the errors against the
+reference: the SSE of C_A and of C_C at the scene's points (SSE_points, SSE_points_C) and the
+product mass's relative error (product_error).
 """
 
 from __future__ import annotations
@@ -35,8 +37,8 @@ from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
 
 
-def _row(rec: Recorder, k: int, t: float, dt: float, a, b, made: float, volume: float, extra: dict) -> None:
-    mass_a = float(a.sum())
+def _row(rec: Recorder, k: int, t: float, dt: float, a, b, c, made: float, volume: float, lost_bc: float, extra: dict):
+    mass_a, mass_c = float(a.sum()), float(c.sum())
     rec.add(
         step=k,
         time=t,
@@ -44,7 +46,8 @@ def _row(rec: Recorder, k: int, t: float, dt: float, a, b, made: float, volume: 
         mass_A=mass_a,
         mass_B=float(b.sum()),
         mass_C=made,
-        mass_total=mass_a + made,  # A's own: 1 but for what left an FD window's ends
+        mass_total=mass_a + mass_c,  # A + C still held: 1 but for what left an FD window's ends
+        mass_lost_BC=lost_bc,
         mass_min=float(min(a.min(), b.min())),
         dV=volume,
         **extra,
@@ -90,7 +93,14 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
     b = reaction.b_masses(x, dx)
     b[0] = b[-1] = background
     masses = np.vstack([a, b, np.zeros_like(a)])
-    _row(rec, 0, 0.0, 0.0, a, b, 0.0, dx, _NAN)
+    # B + C lost through the window's ends, as a fraction of B's mass (a uniform B's departure from
+    # C0, which only the reaction makes, in units of A's unit mass)
+    b_total, scale = float((b - background).sum()), reaction.b_mass if reaction.b_source is not None else 1.0
+
+    def lost_bc(b, c) -> float:
+        return 0.0 if reaction.kind == "decay" else (b_total - float((b - background).sum() + c.sum())) / scale
+
+    _row(rec, 0, 0.0, 0.0, a, b, masses[2], 0.0, dx, 0.0, _NAN)
     solvers: dict = {}
 
     def solver(dt: float):
@@ -100,7 +110,7 @@ def _run_fd(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
 
     for k, t, dt, (a, b, c), made in steps(solver, masses, reaction.kinetics, dx, dts, ts, background):
         extra = _judge(cfg, ref, x, a / dx, made, c_c=c / dx) if k == len(dts) else _NAN
-        _row(rec, k, t, dt, a, b, made, dx, extra)
+        _row(rec, k, t, dt, a, b, c, made, dx, lost_bc(b, c), extra)
 
 
 def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
@@ -111,7 +121,7 @@ def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recor
     x, a, _ = mtpt.initial_state(cfg, rng)  # sorted positions, A's masses
     dV = cfg.dV
     masses = np.vstack([a, reaction.b_masses(x, dV), np.zeros_like(a)])
-    _row(rec, 0, 0.0, 0.0, masses[A], masses[B], 0.0, dV, {**_NAN, "substeps": 1})
+    _row(rec, 0, 0.0, 0.0, masses[A], masses[B], masses[C], 0.0, dV, 0.0, {**_NAN, "substeps": 1})
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
         if cfg.v != 0.0:  # carried by the flow: a uniform shift leaves the order and the exchange alone
@@ -121,7 +131,7 @@ def _run_mtpt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recor
         x, masses, substeps = mtpt_step(x, masses, reaction.kinetics, dV, cfg.D, cfg.eta, dt, rng, kernel, t=t)
         made = float(masses[C].sum())
         extra = _judge(cfg, ref, x, masses[A] / dV, made, c_c=masses[C] / dV) if k == len(dts) else _NAN
-        _row(rec, k, t, dt, masses[A], masses[B], made, dV, {"substeps": substeps, **extra})
+        _row(rec, k, t, dt, masses[A], masses[B], masses[C], made, dV, 0.0, {"substeps": substeps, **extra})
 
 
 def _run_pt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorder) -> None:
@@ -144,7 +154,7 @@ def _run_pt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
         xb = np.mod(reaction.b_source.positions(round(reaction.b_mass / m_p), rng) - lo, length)
     xc = np.empty(0)
     one = np.ones(1)
-    _row(rec, 0, 0.0, 0.0, xa.size * m_p * one, xb.size * m_p * one, 0.0, cfg.dV, _NAN)
+    _row(rec, 0, 0.0, 0.0, xa.size * m_p * one, xb.size * m_p * one, 0.0 * one, 0.0, cfg.dV, 0.0, _NAN)
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
         xa, xb, xc = pt_step(xa, xb, xc, reaction.kinetics, m_p, cfg.D, dt, length, rng, t=t)
@@ -153,7 +163,7 @@ def _run_pt(cfg: RunConfig, reaction: Reaction, ref: dict, dts, ts, rec: Recorde
         if k == len(dts):  # A's and C's densities in the lab frame: each species' reconstruction times its mass
             (grid, c_a), (grid_c, c_c) = (_density(cfg, xs + lo + cfg.v * t, m_p, t) for xs in (xa, xc))
             extra = _judge(cfg, ref, grid, c_a, made, grid_c, c_c)
-        _row(rec, k, t, dt, xa.size * m_p * one, xb.size * m_p * one, made, cfg.dV, extra)
+        _row(rec, k, t, dt, xa.size * m_p * one, xb.size * m_p * one, made * one, made, cfg.dV, 0.0, extra)
 
 
 def _density(cfg: RunConfig, x: np.ndarray, m_p: float, t: float) -> tuple[np.ndarray, np.ndarray]:
