@@ -281,3 +281,20 @@ def test_b_plus_c_lost_through_fd_s_ends_unscores_a_rung_whose_a_plus_c_is_held(
     step, *_ = negative_steps(table)
     row = {**last.to_dict(), "candidate": 0, "negative_step": step}
     assert unscored(scene, row).startswith("B + C lost through the window's ends")
+
+
+def test_the_models_steps_do_not_grow_with_k_and_pt_is_refused_where_its_pair_rule_cannot_hold():
+    # issue 50: the exact kinetics need no step at the reaction's time scale. Over k C0 t from 1e-6 to
+    # 1e9 FD's and MTPT's runs keep their steps (their counted cost); PT, whose pair probability grows
+    # with k, is refused by key path naming the least N, and k past K_MAX by its own
+    costs = []
+    for kct in (1e-6, 1.0, 1e9):
+        scene = _extreme({"kind": "bimolecular", "k": kct / (0.5 * 20.0), "B": {"uniform": 0.5}})
+        costs.append([scene.run_cost(c, c.n_lo) for c in scene.candidates])
+    assert costs[0] == costs[1] == costs[2]
+    pt = spec(D=1e-4, reaction={"kind": "bimolecular", "k": 1e8, "B": {"uniform": 0.5}}, candidates=[PT])
+    assert _refused(pt).name == "scenes.r.candidates[0].n_range"
+    assert (
+        _refused(spec(reaction={"kind": "bimolecular", "k": 1e300, "B": {"uniform": 0.5}})).name
+        == "scenes.r.reaction.k"
+    )

@@ -55,7 +55,19 @@ def search_inputs(search_of, checkpoint, final=False):
 
 optimum_round_inputs = search_inputs(optimum_kind, "optimum_round")
 optimum_final_inputs = search_inputs(optimum_kind, "optimum_round", final=True)
-scene_round_inputs = search_inputs(scene_kind, "scene_round")
+_scene_round_inputs = search_inputs(scene_kind, "scene_round")
+
+
+def scene_round_inputs(wildcards):
+    """A scene's round reads its last plan and runs, and a reactive scene's its reference too (a target
+    the reference cannot judge stops the search before any run: experiments/defined.py)."""
+    out = _scene_round_inputs(wildcards)
+    scene = SCENES[wildcards.name]
+    if scene.reaction is not None:
+        return {**out, "reference": reactive_reference_path(scene)}
+    return out
+
+
 scene_final_inputs = search_inputs(scene_kind, "scene_round", final=True)
 
 

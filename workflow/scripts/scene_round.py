@@ -14,7 +14,12 @@ exit_on_table_errors()  # a table that fails its page checksums: one line naming
 inp, par, out = snakemake.input, snakemake.params, snakemake.output
 scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
 plan = read_parquet(inp.plan) if "plan" in inp.keys() else None
-plan = SceneSearch(scene).round(
+reference = None
+if "reference" in inp.keys():  # a reactive scene's: a target it cannot judge stops the search at once
+    from particle_entropy.experiments.reactive import read
+
+    reference = read(inp.reference)
+plan = SceneSearch(scene, reference).round(
     plan, list(inp.runs) if plan is not None else [], int(par.base_seed)
 )  # the search engine's round
 write_parquet(plan, out[0])

@@ -14,11 +14,17 @@ exit_on_table_errors()  # a table that fails its page checksums: one line naming
 inp, par = snakemake.input, snakemake.params
 scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
 plan = read_parquet(inp.plan)
-table = result(scene, judged(scene, read_runs(plan, list(inp.runs))))
-if scene.reaction is not None:  # the product over time, each rung's and the reference's (panel b)
-    from particle_entropy.analysis.scene_search import with_reference
+reference, why = None, ""
+if scene.reaction is not None:  # judged against its reference, which may leave the target undefined
+    from particle_entropy.experiments.defined import undefined
     from particle_entropy.experiments.reactive import read
 
-    table = with_reference(scene, table, plan, list(inp.runs), read(inp.reference))
+    reference = read(inp.reference)
+    why = undefined(scene.measure, scene.value, reference)
+table = result(scene, judged(scene, read_runs(plan, list(inp.runs))), why)
+if reference is not None:  # the product over time, each rung's and the reference's (panel b)
+    from particle_entropy.analysis.scene_search import with_reference
+
+    table = with_reference(scene, table, plan, list(inp.runs), reference)
 write_parquet(table, snakemake.output[0])
 print(table.to_string(), file=sys.stderr)

@@ -30,6 +30,7 @@ import pandas as pd
 
 from ..core.io import read_parquet
 from ..core.registry import MEASUREMENT_POINTS
+from ..experiments import defined
 from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
 from .search import AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
@@ -74,7 +75,9 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "COMIC_points": "mean COMIC (Eq. 43) at the common measurement points (NaN if unscored)",
     "scene": "the scene's name",
     "stopped": "why the candidate's search stopped: met (at the low end, or every rung below it fails), not met "
-    "(within n_range, or the budget: every rung within it run), over budget, or an at-rest twin",
+    "(within n_range, or the budget: every rung within it run), over budget, an at-rest twin, or target undefined "
+    "(the reference makes no product, a field of zeros meets the target, or its own error reaches it: nothing runs "
+    "and nothing is recommended)",
     "n_below": "the highest failing rung visited below `n` (NaN if none); every rung below a candidate's answer "
     "is run, so at its first passing row this is the rung just below",
     "recommended": "the cheapest candidate's smallest rung that meets the target (at most one row)",
@@ -123,8 +126,8 @@ def unscored(scene: Scene, row) -> str:
         if not abs(lost) <= MASS_LOSS_MAX:
             what = "lost through the window's ends" if lost > 0 else "gained"
             return f"{name} {what}: {abs(lost):.3g} of it (at most {MASS_LOSS_MAX:g})"
-    if not np.isfinite(row["SSE_points"]):
-        return "SSE not finite"
+    if not np.isfinite(error(scene, row)):
+        return f"its {scene.measure} error is not finite"
     return ""
 
 
@@ -292,12 +295,17 @@ def _next_rungs(scene: Scene, candidate: Candidate, visited: pd.DataFrame) -> tu
     return [], "not met within n_range"
 
 
-def next_plan(scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None, base_seed: int) -> pd.DataFrame:
+def next_plan(
+    scene: Scene, plan: pd.DataFrame | None, runs: pd.DataFrame | None, base_seed: int, undefined: str = ""
+) -> pd.DataFrame:
     """The plan after ``plan`` (None: round 0) given the runs it made: every earlier row, and a row
     per run table each candidate still searching makes next (a rung's seed block: seeds); ``done``
-    on every row when no candidate searches on."""
+    on every row when no candidate searches on, at once when the target is ``undefined`` (why, from
+    experiments/defined.py: no run can answer it)."""
     k = next_round(plan)
     rows = [] if plan is None else plan.drop(columns="done").to_dict("records")
+    if undefined:
+        return new_plan(rows, PLAN_COLUMNS, done=True)
     table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=JUDGED_COLUMNS)
     added = False
     for ci, cand in enumerate(scene.candidates):
@@ -316,8 +324,10 @@ class SceneSearch(AdaptiveSearch):
     """A scene's search as a kind of the search engine (search.AdaptiveSearch): its rule for the
     next points is next_plan (each candidate's _next_rungs)."""
 
-    def __init__(self, scene: Scene):
+    def __init__(self, scene: Scene, reference: dict | None = None):
         self.scene = scene
+        # why the target cannot be judged against a reactive scene's solved reference ('' if it can)
+        self.undefined = "" if reference is None else defined.undefined(scene.measure, scene.value, reference)
 
     @property
     def title(self) -> str:
@@ -328,10 +338,10 @@ class SceneSearch(AdaptiveSearch):
         return max_rounds(self.scene)
 
     def first_plan(self, base_seed: int) -> pd.DataFrame:
-        return next_plan(self.scene, None, None, base_seed)
+        return next_plan(self.scene, None, None, base_seed, self.undefined)
 
     def next_plan(self, plan: pd.DataFrame, runs: pd.DataFrame, base_seed: int) -> pd.DataFrame:
-        return next_plan(self.scene, plan, runs, base_seed)
+        return next_plan(self.scene, plan, runs, base_seed, self.undefined)
 
     def read_runs(self, plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
         return read_runs(plan, paths)
@@ -345,8 +355,10 @@ class SceneSearch(AdaptiveSearch):
         return self.scene.run_cost(self.scene.candidates[int(ci)], int(n))
 
 
-def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
-    """Each candidate's reason to have stopped."""
+def stop_reasons(scene: Scene, table: pd.DataFrame, undefined: str = "") -> dict[int, str]:
+    """Each candidate's reason to have stopped (every one's: the target is ``undefined``, and why)."""
+    if undefined:
+        return dict.fromkeys(range(len(scene.candidates)), f"target undefined: {undefined}")
     return {
         ci: _next_rungs(scene, cand, table[table["candidate"] == ci])[1]
         if scene.same_as(ci) == ci
@@ -355,10 +367,10 @@ def stop_reasons(scene: Scene, table: pd.DataFrame) -> dict[int, str]:
     }
 
 
-def _unvisited(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
+def _unvisited(scene: Scene, table: pd.DataFrame, undefined: str = "") -> pd.DataFrame:
     """The rows of candidates the search never ran: an at-rest twin's are its first's (Scene.same_as),
-    a candidate whose first rung is over the budget has one row saying so (realisations 0, its
-    counted cost, no error)."""
+    a candidate whose first rung is over the budget, or of a scene whose target is ``undefined``, has
+    one row saying so (realisations 0, its counted cost, no error)."""
     visited, rows = set(table["candidate"]), []
     for ci, cand in enumerate(scene.candidates):
         if ci in visited:
@@ -376,27 +388,28 @@ def _unvisited(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
             n=n,
             realisations=0,
             meets=False,
-            unscored="not run: over budget",
+            unscored=f"not run: target undefined: {undefined}" if undefined else "not run: over budget",
             cost_s=scene.run_cost(cand, n),
         )
         rows.append(row)
     return pd.DataFrame(rows, columns=JUDGED_COLUMNS)
 
 
-def result(scene: Scene, table: pd.DataFrame) -> pd.DataFrame:
+def result(scene: Scene, table: pd.DataFrame, undefined: str = "") -> pd.DataFrame:
     """The scene's table: every visited (candidate, n) with its error, interval, counted cost, measured
     core-seconds and COMIC at the common points; ``recommended`` on the cheapest row that meets the
     target (at most one row), ``n_below`` the highest failing rung visited below each row (at a
     candidate's answer the rung just below: every rung below it is run), ``comic_best`` on the lowest
-    COMIC_points of the scene's own rows; ``stopped`` says why each candidate stopped."""
-    extra = _unvisited(scene, table)
+    COMIC_points of the scene's own rows; ``stopped`` says why each candidate stopped (a target
+    ``undefined`` against the reference: every one, with the reason, and nothing recommended)."""
+    extra = _unvisited(scene, table, undefined)
     parts = [t for t in (table, extra) if len(t)]
     out = pd.concat(parts, ignore_index=True) if parts else table.copy()
     out = out.sort_values(["candidate", "n"], kind="stable").reset_index(drop=True)
     out = out.astype({"candidate": int, "n": int, "realisations": int, "meets": bool})
     own = np.array([scene.same_as(c) == c for c in out["candidate"]], dtype=bool)  # twins' rows are copies
     out["scene"] = scene.name
-    reasons = stop_reasons(scene, table)
+    reasons = stop_reasons(scene, table, undefined)
     out["stopped"] = [reasons[c] for c in out["candidate"]]
     out["n_below"] = [
         out[(out["candidate"] == c) & (out["n"] < n) & ~out["meets"]]["n"].max()

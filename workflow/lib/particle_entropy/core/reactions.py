@@ -157,6 +157,10 @@ B_UNIFORM_MAX = 1e6  # a uniform B above this many units of mass per length is a
 # finest grids (cells of 1e-5, times k dt) reach the subnormal doubles, which the tridiagonal solvers
 # flush to zero; at B = 1e-305 the reference's product was 10 % off, at 1e-300 1e-6, at 1e-200 exact
 B_MIN = 1e-200
+# the largest rate constant: the kinetics divide it by a particle's or node's dV (down to 1e-100 in
+# any scene a grid can hold) and multiply by dt, and k / dV past 1e308 is inf, whose step is NaN; at
+# k C0 t far below this bound a reaction is already instantaneous on every grid
+K_MAX = 1e200
 
 
 class ReactionError(ValueError):
@@ -276,8 +280,9 @@ def reaction_shape(source_shape: dict) -> dict:
             "k": {
                 "type": "number",
                 "exclusiveMinimum": 0,
+                "maximum": K_MAX,
                 "description": "bimolecular: the rate constant k of A + B -> C at rate k C_A C_B [L/(M T)]; "
-                "a number > 0",
+                f"a number in (0, {K_MAX:g}]",
             },
             "B": {**b, "description": "bimolecular: B's initial condition, {uniform: C0} or {source, mass}"},
         },

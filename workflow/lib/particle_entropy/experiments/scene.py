@@ -25,6 +25,7 @@ from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
 from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
 from ..core.typed import key_path as typed_key_path
+from . import defined
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -271,6 +272,7 @@ class Scene:
                     scene.run_config(c, n)
                 except SettingError as e:
                     raise _candidate_error(scene, i, s.candidates[i].model_fields_set, e) from None
+        defined.check(scene, defined.closed_form(scene))  # a target its closed-form reference can judge
         return scene
 
 
