@@ -768,3 +768,31 @@ def test_a_reactive_rung_costs_its_transport_times_the_reaction_s_factors():
             if n == cand.ladder()[-1]:
                 assert got > step_s + work_s
     assert set(REACTIVE_COST) == {"fd", "mtpt", "pt"} and all(w > 1.0 for _, w in REACTIVE_COST.values())
+
+
+def test_half_step_halves_every_candidate_s_step_at_every_time():
+    """issue 50: an answer is checked at half its step. A particle's dt_n = dt0 g^n is dt0 + (g - 1) t at
+    time t, so halving dt0 and g - 1 halves it all the way; FD halves fd_dt or its Courant number."""
+    from particle_entropy.core.timegrid import time_steps
+
+    spec = {
+        **S_SMALL,
+        "v": 0.01,
+        "candidates": [
+            {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.5, "n_range": [64, 256]},
+            {"method": "fd", "kernel": "implicit", "fd_dt": 0.5, "n_range": [64, 256]},
+            {"method": "mtpt", "kernel": "collision", "eta": 1, "n_range": [100, 400]},
+            {"method": "pt", "kernel": "adaptive", "dt_growth": 1.0, "dt0": 0.2, "n_range": [100, 400]},
+        ],
+    }
+    scene = Scene.from_config("s", spec)
+    for cand in scene.candidates:
+        half = scene.half_step(cand)
+        assert scene.identity(half) != scene.identity(cand) and half.label != cand.label
+        full, fine = (scene.run_config(c, 64 if c.case.method == "fd" else 100) for c in (cand, half))
+        steps = [time_steps(c.t_final, c.dt0, c.dt_growth, "exact") for c in (full, fine)]
+        ends = [np.cumsum(d) for d in steps]
+        # the step in force at times away from the last (cut) step: half, to a step's growth
+        t = np.linspace(0.1, 0.8, 8) * full.t_final
+        ratio = [np.interp(t, e, d) for e, d in zip(ends, steps)]
+        np.testing.assert_allclose(ratio[1] / ratio[0], 0.5, rtol=0.06)

@@ -237,6 +237,18 @@ class Scene:
         settings["source"] = self.source
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
+    def half_step(self, candidate: Candidate) -> Candidate:
+        """The candidate at half its time step at every time: FD's fd_dt or Courant number halved; a
+        particle's dt_n = dt0 g^n is dt0 + (g - 1) t at time t, so dt0 and g - 1 halved (a fixed step
+        halved). Its runs are of their own identity: the check that an answer holds at a finer step."""
+        if candidate.case.method == "fd":
+            if candidate.courant is not None:
+                return replace(candidate, courant=candidate.courant / 2.0)
+            return replace(candidate, fd_dt=candidate.fd_dt / 2.0)
+        dt0 = self.run_config(candidate, candidate.n_lo).dt0  # its own, or the time section's
+        growth = 1.0 + (candidate.case.dt_growth - 1.0) / 2.0
+        return replace(candidate, dt0=dt0 / 2.0, case=replace(candidate.case, dt_growth=growth))
+
     @classmethod
     def from_config(cls, name: str, spec, case_defaults: Mapping | None = None) -> Scene:
         """The scene at config key scenes.<name>: ``spec`` as written (parsed here by the scene's model,
