@@ -298,3 +298,18 @@ def test_the_models_steps_do_not_grow_with_k_and_pt_is_refused_where_its_pair_ru
         _refused(spec(reaction={"kind": "bimolecular", "k": 1e300, "B": {"uniform": 0.5}})).name
         == "scenes.r.reaction.k"
     )
+
+
+@pytest.mark.parametrize("lam_t", [1e-300, 1e-200, 1e-10, 1e-3])
+def test_a_decay_s_product_down_to_1e_300_is_exact_at_every_point(lam_t):
+    # issue 50: 1 - exp(-lambda t) cancelled to 0 at lambda t = 1e-300 (every error NaN) and was off
+    # by ~1e-6 at 1e-10; -expm1 keeps its digits, and C at the points is the plume times it
+    scene = Scene.from_config("r", spec(reaction={"kind": "decay", "rate": lam_t / 20.0}))
+    ref = _ref(scene)
+    exact = sum((-1) ** (n + 1) * lam_t**n / math.factorial(n) for n in range(1, 8))  # 1 - exp(-x)'s series
+    assert ref["product_mass"] == pytest.approx(exact, rel=1e-15)
+    assert ref["product_series"][-1] == pytest.approx(exact, rel=1e-14)
+    plume = scene.source.density(ref["points"], scene.D, scene.v, scene.t_final)
+    assert np.all(plume > 0.0)
+    np.testing.assert_allclose(ref["c_points"], plume * exact, rtol=1e-14)
+    np.testing.assert_allclose(ref["a_points"] + ref["c_points"], plume, rtol=1e-15)
