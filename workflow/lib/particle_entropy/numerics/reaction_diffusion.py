@@ -362,13 +362,14 @@ def plan(
     bounds: tuple[float, float] | None = None,
     n_cells: int = COARSE_CELLS,
     n_steps: int | None = None,
-    max_work: float = MAX_WORK,
+    max_work: float | None = None,
 ) -> Plan:
     """The plan of ``reference`` with the same arguments, from the physics alone (no solve). Its
     window is ``bounds`` on n_cells, else ``aligned_grid``; its steps, unless given, make r <= COARSE_R
     and dt <= COARSE_KINETIC fastest reaction times on the coarsest grid, the kinetic rule capped so
-    that the work stays within max_work (the kinetics are exact within a step, so the kinetic rule
+    that the work stays within max_work (default MAX_WORK; the kinetics are exact within a step, so the kinetic rule
     bounds only the splitting error, which Richardson's estimate then states); r's rule is never cut."""
+    max_work = MAX_WORK if max_work is None else max_work
     sources = [source_a] + ([b[0]] if isinstance(b, tuple) else [])
     if bounds is not None:
         lo, hi = bounds
@@ -401,7 +402,7 @@ def reference(
     n_cells: int = COARSE_CELLS,
     n_steps: int | None = None,
     times_per_run: int = 0,
-    max_work: float = MAX_WORK,
+    max_work: float | None = None,
 ) -> ReactiveReference:
     """The reference of a reactive scene at t_final: ``solve`` on the ``plan``'s grids, n, 2 n and 4 n
     cells (s, 2 s and 4 s steps), each quantity extrapolated by ``richardson``; A from mass_a of
@@ -421,6 +422,7 @@ def reference(
         n_steps=n_steps,
         max_work=max_work,
     )
+    max_work = MAX_WORK if max_work is None else max_work
     if how.work > max_work:
         raise CostError(how, max_work)
     points = np.asarray(points, dtype=np.float64) - v * t_final
