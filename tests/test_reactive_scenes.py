@@ -381,3 +381,16 @@ def test_a_sweep_of_k_c0_t_from_1e_6_to_1e9_ends_or_is_refused_in_bounded_time(m
     assert time.perf_counter() - start < 1.0
     assert refused.value.name == "scenes.x.reaction.k" and refused.value.value == 1e8
     assert "at most 3e+06 cell-steps" in refused.value.allowed and "finest of three grids" in refused.value.allowed
+
+
+def test_the_reference_rule_s_code_hash_covers_the_solver():
+    # a stale reference is rebuilt: scene_reference's code param hashes what its script imports, the
+    # solver (imported lazily in compute) included
+    from pathlib import Path
+
+    from particle_entropy.pipeline.codeversion import closure, script_imports
+
+    script = Path(__file__).parents[1] / "workflow" / "scripts" / "scene_reference.py"
+    assert {"experiments.reactive", "numerics.reaction_diffusion"} <= set(closure(script_imports(script)))
+    rule = (Path(__file__).parents[1] / "workflow" / "rules" / "scenes.smk").read_text()
+    assert 'code=script_code(SCRIPTS / "scene_reference.py")' in rule

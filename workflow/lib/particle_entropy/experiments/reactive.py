@@ -7,7 +7,13 @@ judged against at t_final, with its own error stated.
   reaction-diffusion with no numerical dispersion from advection (numerics/reaction_diffusion.py:
   Strang splitting of the closed-form kinetics around Crank-Nicolson), on three grids refined by 2
   in space and time; each quantity is Richardson-extrapolated and its error estimated from the
-  three. Where A and B start uniform and equal, this is also the well-mixed C0 / (1 + k C0 t).
+  three, or, where the observed order is far from 2 (``*_asymptotic`` false), the finest grid's
+  value with a conservative error. Where A and B start uniform and equal, this is also the
+  well-mixed C0 / (1 + k C0 t). Its cost is known before it runs (``plan``), and scene
+  validation refuses a reference past numerics/reaction_diffusion's MAX_WORK.
+
+The rule scene_reference passes the code hash of its script's imports (pipeline/codeversion.py:
+this module and numerics/reaction_diffusion.py, lazy imports included), so an edit reruns it.
 
 The reference is keyed by a digest of the physics it depends on (``digest``), as runs are, so two
 scenes of the same physics share one file (REFERENCE_PATTERN).

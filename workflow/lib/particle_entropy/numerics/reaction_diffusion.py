@@ -13,7 +13,10 @@ while r = D dt / dx^2 <= 1 (the explicit half's diagonal 1 - r >= 0; the implici
 
 ``richardson`` extrapolates a quantity from three grids, dx and dt halved each level (Richardson
 1911; the observed order as in Roache 1998, Verification and Validation in Computational Science),
-and ``reference`` runs the three grids of a scene and extrapolates its product mass and its
+where the observed order is near the scheme's (ORDER_BAND), else states the finest grid's value with
+a conservative error. ``plan`` states a reference's grids, steps and cost from its physics before
+any solve (the box edges on cell faces, ``aligned_grid``; the kinetic steps capped at MAX_WORK), and
+``reference`` runs the three grids of a scene and extrapolates its product mass and its
 concentrations of A and C at given points."""
 
 from __future__ import annotations
