@@ -156,10 +156,19 @@ def _t_margin(errors: np.ndarray, quantile: float) -> float:
     return float(_t_quantile(quantile, errors.size - 1) * errors.std(ddof=1) / math.sqrt(errors.size))
 
 
-def upper_bound(errors: np.ndarray) -> float:
-    """The mean's one-sided 95 % upper bound (Student t); one value: itself."""
+def upper_bound(errors: np.ndarray, confidence: float = CONFIDENCE) -> float:
+    """The mean's one-sided ``confidence`` upper bound (Student t; 95 % unless told); one value: itself."""
     errors = np.asarray(errors, dtype=float)
-    return float(errors.mean() + _t_margin(errors, CONFIDENCE))
+    return float(errors.mean() + _t_margin(errors, confidence))
+
+
+def answer_confidence(candidate: Candidate) -> float:
+    """The one-sided confidence of each rung's bound, Bonferroni-corrected over the candidate's
+    ladder: 1 - (1 - CONFIDENCE) / (its rungs). The search takes the lowest of up to that many rungs
+    that passes, so each at 95 % would let a rung above the target through once in a few ladders
+    (benchmarks/answer_rate.py); at this level the answer, not each rung, holds with 95 %. A
+    constant of the candidate, so a rung's state still depends on its own runs only."""
+    return 1.0 - (1.0 - CONFIDENCE) / len(candidate.ladder())
 
 
 def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) -> tuple[int, int]:
@@ -195,7 +204,7 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
         errs = np.array([error(scene, r) for r in records])
         k = errs.size
         half = _t_margin(errs, 0.5 * (1.0 + CONFIDENCE))  # two-sided
-        up = upper_bound(errs)
+        up = upper_bound(errs, answer_confidence(cand))
         rows.append(
             {
                 "candidate": int(ci),
