@@ -1,13 +1,13 @@
 """How often a scene search's answer is wrong in expectation: the real search (scene_search's
 next_plan, judged, result) replayed on noisy ladders whose true mean error at every rung is known.
 
-A noisy ladder is one particle candidate's ladder with a true mean error m(n) = (n / n_0)^-slope
-(slope 1/2: Monte Carlo) that crosses the target at n* within the ladder (log2(n* / n_0) = k + u, k uniform on 1 ..
-rungs - 2, u on [0, width)), and per-run errors around m(n) with a coefficient of variation ``cv`` (lognormal, or
-normal folded at zero), fixed per (rung, seed). The answer is wrong when its rung's m(n) is above the
-target: it meets the target for the seeds it drew, not in expectation. ``false_answer_rate`` counts
-those over an ensemble and gives the rate with its Clopper-Pearson 95 % interval, and the runs and
-particle-runs the searches cost."""
+A noisy ladder is one particle candidate's ratio-2 ladder with a true mean error m(n) = (n / n_0)^-slope
+(slope 1/2: Monte Carlo) that crosses the target at n* within the ladder (log2(n* / n_0) = k + u, k
+uniform on 1 .. rungs - 2, u on [0, width)), and per-run errors around m(n) with a coefficient of
+variation ``cv`` (lognormal, or normal folded at zero), fixed per (rung, seed). The answer is wrong
+when its rung's m(n) is above the target: it meets the target for the seeds it drew, not in
+expectation. ``false_answer_rate`` counts those over an ensemble and gives the rate with its
+Clopper-Pearson 95 % interval, and the runs and particle-runs the searches cost."""
 
 from __future__ import annotations
 
@@ -53,18 +53,19 @@ def noisy_ladders(
     out = []
     for _ in range(count):
         u = rng.integers(1, len(ladder) - 1) + rng.uniform(0.0, width)
-        target = (2.0**u) ** -slope
         c = rng.uniform(*cv)
-        means = {n: (n / ladder[0]) ** -slope for n in ladder}
         z = rng.standard_normal((len(ladder), seeds))
-        if noise == "lognormal":  # mean m, sd c m
+        if noise == "lognormal":  # mean 1, sd c
             s = math.sqrt(math.log1p(c * c))
-            factor = np.exp(s * z - 0.5 * s * s)
-        elif noise == "normal":  # folded at zero, as an error is
+            factor, scale = np.exp(s * z - 0.5 * s * s), 1.0
+        elif noise == "normal":  # |1 + c z|, folded at zero as an error is: its mean E|1 + c Z|
             factor = np.abs(1.0 + c * z)
+            scale = c * math.sqrt(2.0 / math.pi) * math.exp(-0.5 / (c * c)) + math.erf(1.0 / (c * math.sqrt(2.0)))
         else:
             raise ValueError(f"noise {noise!r}: lognormal or normal")
-        out.append(NoisyLadder(target, means, {n: means[n] * factor[i] for i, n in enumerate(ladder)}))
+        means = {n: scale * (n / ladder[0]) ** -slope for n in ladder}  # the true mean error of each rung
+        target = scale * (2.0**u) ** -slope
+        out.append(NoisyLadder(target, means, {n: means[n] / scale * factor[i] for i, n in enumerate(ladder)}))
     return out
 
 
@@ -119,36 +120,51 @@ def binomial_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[f
     return float(ci.low), float(ci.high)
 
 
-def false_answer_rate(scene: Scene, ladders: list[NoisyLadder]) -> dict:
-    """The real search on each ladder (scene: one particle candidate, its target replaced by the
-    ladder's): answers, how many are above the target in expectation (``false``), their rate and
-    Clopper-Pearson 95 % interval, none met, the mean runs and particle-runs (sum of n) a search,
-    and the answers' mean rungs above the lowest rung that truly meets the target (``above_ideal``)."""
-    false = none = 0
-    runs_made = particle_runs = above = 0.0
-    for lad in ladders:
-        at = replace(scene, value=lad.target)
-        answer, table = search(at, lad.law)
-        runs_made += table["realisations"].sum()
-        particle_runs += (table["realisations"] * table["n"]).sum()
-        if answer is None:
-            none += 1
-            continue
-        false += int(lad.means[answer] > lad.target)
-        ladder = sorted(lad.means)
-        ideal = next(i for i, n in enumerate(ladder) if lad.means[n] <= lad.target)
-        above += ladder.index(answer) - ideal
-    total = len(ladders)
+def outcome(scene: Scene, ladder: NoisyLadder) -> dict:
+    """The real search on one ladder (``scene``: one particle candidate over the ladder's rungs, its
+    target replaced by the ladder's): its answer (None: not met), whether the answer is above the
+    target in expectation (``false``), its rungs above the lowest that truly meets it, the runs and
+    particle-runs (sum of n) the search made."""
+    answer, table = search(replace(scene, value=ladder.target), ladder.law)
+    rungs = sorted(ladder.means)
+    ideal = next(i for i, n in enumerate(rungs) if ladder.means[n] <= ladder.target)
+    return {
+        "answer": answer,
+        "false": answer is not None and ladder.means[answer] > ladder.target,
+        "above_ideal": math.nan if answer is None else rungs.index(answer) - ideal,
+        "runs": int(table["realisations"].sum()),
+        "particle_runs": int((table["realisations"] * table["n"]).sum()),
+    }
+
+
+def summary(outcomes: list[dict]) -> dict:
+    """An ensemble's outcomes in a few numbers: ladders, false answers, their rate and Clopper-Pearson
+    95 % interval, searches that met nothing, mean runs and particle-runs a search, and the answers'
+    mean rungs above the ideal one."""
+    total = len(outcomes)
+    false = sum(o["false"] for o in outcomes)
     lo, hi = binomial_interval(false, total)
-    answered = total - none
+    above = [o["above_ideal"] for o in outcomes if o["answer"] is not None]
     return {
         "ladders": total,
-        "false": false,
+        "false": int(false),
         "rate": false / total,
         "lo": lo,
         "hi": hi,
-        "not_met": none,
-        "runs": runs_made / total,
-        "particle_runs": particle_runs / total,
-        "above_ideal": above / answered if answered else math.nan,
+        "not_met": sum(o["answer"] is None for o in outcomes),
+        "runs": float(np.mean([o["runs"] for o in outcomes])),
+        "particle_runs": float(np.mean([o["particle_runs"] for o in outcomes])),
+        "above_ideal": float(np.mean(above)) if above else math.nan,
     }
+
+
+def false_answer_rate(scene: Scene, ladders: list[NoisyLadder]) -> dict:
+    """How often the search's answer is above the target in expectation over ``ladders`` (summary)."""
+    return summary([outcome(scene, lad) for lad in ladders])
+
+
+def ladder_scene(ladder: list[int], realisations: int = 8, max_realisations: int = 32) -> Scene:
+    """A scene of one PT candidate over ``ladder`` (measure rmse; its target set per noisy ladder)."""
+    candidate = {"method": "pt", "kernel": "adaptive", "ladder": list(ladder)}
+    spec = {"v": 0.01, "t_final": 50.0, "realisations": realisations, "max_realisations": max_realisations}
+    return Scene.from_config("answer_rate", {**spec, "target": {"value": 0.1}, "candidates": [candidate]})
