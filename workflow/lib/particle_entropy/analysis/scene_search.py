@@ -1,8 +1,9 @@
 """The cheapest model of a scene (experiments/scene.py) that reaches its accuracy, and the COMIC-best.
 
 For each candidate, the smallest rung of its affordable ladder (Candidate.ladder, within the budget)
-whose mean error meets the target with 95 % confidence: the one-sided upper bound mean + t_0.95
-s / sqrt(R) of R realisations (FD is deterministic: one run, its error). The answer is the brute
+whose mean error meets the target: the one-sided upper bound mean + t_q s / sqrt(R) of R
+realisations, q = 1 - 0.05 / rungs (answer_confidence: the answer, not each rung, holds with 95 %)
+(FD is deterministic: one run, its error). The answer is the brute
 force's, as if every rung had run: errors need not fall with n (noise; FD central's error can rise
 with it). A particle rung whose interval straddles the target (mean - t_0.95 se < target < mean +
 t_0.95 se) gets another block of ``realisations`` seeds until it falls on one side or reaches
@@ -61,7 +62,9 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
     "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
     "error_hi": "upper end of that interval",
-    "error_upper95": "the mean's one-sided 95 % upper bound: the rung meets the target when it is <= `target`",
+    "error_upper95": "the mean's one-sided upper bound at 1 - 0.05 / rungs of the candidate's ladder (Student t, "
+    "Bonferroni-corrected so that the answer, the lowest passing rung, holds with 95 %; FD: the error): the rung "
+    "meets the target when it is <= `target`",
     "meets": "the rung is scored and `error_upper95` <= `target`",
     "unscored": "why the rung cannot be judged (a concentration below -1e-12 of the total at any step: its "
     "first such step, the minimum and, for FD in a flow, the grid Peclet and Courant numbers; more than 1e-3 of "
