@@ -364,8 +364,9 @@ def test_a_run_that_never_goes_negative_has_no_negative_step():
 
 
 # The search's answer equals brute force: every affordable rung run, each settled by the same rule
-# (seed blocks while its 95 % interval straddles the target, up to max_realisations), the answer the
-# lowest rung whose upper bound meets the target. The brute force below judges with its own Student t.
+# (seed blocks while its interval straddles the target, up to max_realisations), the answer the
+# lowest rung whose upper bound meets the target, at one-sided 1 - 0.05 / rungs (Bonferroni over the
+# candidate's ladder). The brute force below judges with its own Student t.
 
 
 def _settled_bound(scene, cand, n, law, ci) -> tuple[float, int]:
@@ -379,7 +380,8 @@ def _settled_bound(scene, cand, n, law, ci) -> tuple[float, int]:
     while True:
         errors += [law(ci, n, seed) for seed in range(len(errors), len(errors) + r)]
         e = np.array(errors)
-        margin = 0.0 if fd else t.ppf(0.95, e.size - 1) * e.std(ddof=1) / math.sqrt(e.size)
+        level = 1.0 - 0.05 / len(cand.ladder())  # Bonferroni over the ladder: the answer holds with 95 %
+        margin = 0.0 if fd else t.ppf(level, e.size - 1) * e.std(ddof=1) / math.sqrt(e.size)
         straddles = e.mean() - margin < scene.value < e.mean() + margin
         if fd or not straddles or e.size >= scene.max_realisations:
             return e.mean() + margin, e.size
@@ -500,13 +502,16 @@ def test_a_straddling_rung_gets_seed_blocks_until_it_settles():
     blocks of 8 more (seeds 8-15, 16-23, ...) and passes once the bound falls below; a rung whose
     interval stays across the target stops at max_realisations and fails."""
     scene = _scene(value=1.0, candidates=(PT_LADDER,))
-    law = lambda ci, n, seed: (0.9 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
+    law = lambda ci, n, seed: (0.8 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
     plan, table, _ = _search(scene, law)
     blocks = plan[plan["n"] == 60][["first", "last"]].values.tolist()
     assert blocks[0] == [0, 7] and all(b == [8 * k, 8 * k + 7] for k, b in enumerate(blocks))
     row = table.set_index("n").loc[60]
     assert row["meets"] and 8 < row["realisations"] <= scene.max_realisations
-    assert row["realisations"] == 8 * len(blocks) and S.upper_bound(np.array([law(0, 60, s) for s in range(8)])) > 1
+    assert (
+        row["realisations"] == 8 * len(blocks)
+        and S.upper_bound(np.array([law(0, 60, s) for s in range(8)]), S.answer_confidence(scene.candidates[0])) > 1
+    )
     # a mean at the target: refined to max_realisations, then failing; the answer above it
     law = lambda ci, n, seed: (1.0 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
     answers, out, _ = _answers(scene, law)
@@ -600,3 +605,20 @@ def test_only_rungs_that_can_still_be_the_answer_are_refined():
     assert answers == {0: 60} == _brute_force(scene, law)  # 60 (filled) passes below 120 (refined)
     assert rows.loc[120, "realisations"] == scene.max_realisations  # settled (it passes at 32)
     assert rows.loc[480, "realisations"] < scene.max_realisations and not rows.loc[480, "meets"]
+
+
+def test_a_recommended_rung_is_above_the_target_in_expectation_at_most_5_percent_of_the_time():
+    """Issue 50, point 7: the search tests rung after rung and takes the lowest that passes, so each
+    rung's bound at 95 % gave a false answer (true mean error above the target) in about 10 % of noisy
+    ladders. On a fixed ensemble of 160 (analysis/answer_rate.py: true mean (n / 30)^-1/2 crossing the
+    target within a 9-rung ladder, lognormal per-run noise of cv 0.3-1.0) the real search, at the
+    Bonferroni level, is wrong in at most 5 % (7 of 160); at 95 % a rung it was 13 of 160 (8.1 %)."""
+    from particle_entropy.analysis import answer_rate as A
+
+    ladder = PT_LADDER["ladder"]
+    scene = A.ladder_scene(ladder, realisations=8, max_realisations=32)
+    assert S.answer_confidence(scene.candidates[0]) == pytest.approx(1 - 0.05 / 9)
+    ladders = A.noisy_ladders(ladder, 160, seed=7, seeds=32)
+    out = A.false_answer_rate(scene, ladders)
+    assert out["ladders"] == 160 and out["not_met"] < 24
+    assert out["rate"] <= 0.05, out
