@@ -1,12 +1,14 @@
 """How a reactive answer moves with the time step, per method, at fixed resolution (issue 50 point 8).
 
-    python benchmarks/reactive_step.py [--mtpt-seeds 16] [--pt-seeds 8] [--halvings 2] [--only fd mtpt pt]
+    python benchmarks/reactive_step.py [--mtpt-seeds 16] [--pt-seeds 8] [--only fd mtpt pt]
+    python benchmarks/reactive_step.py --only mtpt --halvings 0 2 0 --n 0 4624 0   # another N
 
 The scene is carried_reaction's physics (config.yaml; written out here so that the benchmark stays
 put if the config moves): a Gaussian A (x0 0, sd 0.02) carried by v 0.5 with D 1e-4 to t_final 50
 through a uniform B of 0.3, A + B -> C at k 2, target product_rmse 0.005. Each candidate runs at
 one resolution and at its step halved (Scene.half_step: FD's Courant number halved; a particle's
-dt0 and growth - 1 halved, which halves dt = dt0 + (g - 1) t at every time), and halved again:
+dt0 and growth - 1 halved, which halves dt = dt0 + (g - 1) t at every time), and halved again
+(--halvings per method, --n the resolutions):
 
 - FD, TVD advection, Courant 0.75, 0.375, 0.1875, at n = 2048 (deterministic: one run each);
 - MTPT, collision kernel, eta 1, at N = 2312: the default step, /2, /4 (--mtpt-seeds seeds each);
@@ -18,7 +20,7 @@ judged against the scene's reference, experiments/reactive.compute): the signed 
 mass_C / M_C,ref - 1 and the product's RMSE at the scene's points, sqrt(SSE_points_C / points).
 Printed: per step, the mean of each over seeds with its 95 % t interval; per halving, the paired
 mean change with its 95 % t interval and whether it exceeds the noise (the interval excludes 0).
-Single process. Takes about 8 minutes on one core (MTPT's 48 runs most of it).
+Single process. About a minute of CPU (MTPT's 48 runs most of it).
 """
 
 from __future__ import annotations
@@ -111,6 +113,7 @@ def main(argv=None) -> None:
     p.add_argument("--mtpt-seeds", type=int, default=16)
     p.add_argument("--pt-seeds", type=int, default=8)
     p.add_argument("--halvings", type=int, nargs=3, default=(2, 2, 1), metavar=("FD", "MTPT", "PT"))
+    p.add_argument("--n", type=int, nargs=3, default=None, metavar=("FD", "MTPT", "PT"), help="resolutions")
     p.add_argument("--only", nargs="*", choices=("fd", "mtpt", "pt"), default=("fd", "mtpt", "pt"))
     p.add_argument("--base-seed", type=int, default=0)
     args = p.parse_args(argv)
@@ -122,6 +125,7 @@ def main(argv=None) -> None:
         ref[key] = np.asarray(ref[key], dtype=np.float64)
     print(f"reference: M_C = {ref['product_mass']:.6g} ({time.process_time() - t0:.1f} s CPU)", flush=True)
     halvings = dict(zip(("fd", "mtpt", "pt"), args.halvings))
+    resolution = RESOLUTION if args.n is None else dict(zip(("fd", "mtpt", "pt"), args.n))
     n_seeds = {"fd": 1, "mtpt": args.mtpt_seeds, "pt": args.pt_seeds}
 
     head = f"{'method':6s} {'N':>5s} {'step':32s} {'steps':>6s} {'seeds':>5s}"
@@ -131,7 +135,7 @@ def main(argv=None) -> None:
         method = cand.case.method
         if method not in args.only:
             continue
-        n = RESOLUTION[method]
+        n = resolution[method]
         seeds = [args.base_seed + i for i in range(n_seeds[method])]
         levels, c = [], cand
         for _ in range(halvings[method] + 1):
@@ -148,15 +152,16 @@ def main(argv=None) -> None:
         results[method] = levels
 
     print("\nPaired change per halving (finer - coarser, same seeds; 95 % t interval; * : beyond the noise)")
-    print(f"{'method':6s} {'from -> to':45s} {'d product error [%]':>22s} {'d product_rmse [1e-3]':>24s}")
+    print(f"{'method':6s} {'N':>5s} {'from -> to':28s} {'d product error [%]':>22s} {'d product_rmse [1e-3]':>24s}")
     for method, levels in results.items():
-        for lo, hi in zip(levels, levels[1:]):
+        for k, (lo, hi) in enumerate(zip(levels, levels[1:])):
             cells = []
             for attr, scale in (("product", 100.0), ("rmse", 1e3)):
                 mean, half = interval(getattr(hi, attr) - getattr(lo, attr))
                 beyond = "" if math.isnan(half) else ("*" if abs(mean) > half else " ")
                 cells.append(fmt(mean, half, scale) + beyond)
-            print(f"{method:6s} {lo.label + ' -> ' + hi.label.split(' growth')[0]:45s} {cells[0]:>22s} {cells[1]:>24s}")
+            step = f"step/{2**k} -> step/{2 ** (k + 1)}"
+            print(f"{method:6s} {resolution[method]:5d} {step:28s} {cells[0]:>22s} {cells[1]:>24s}")
 
 
 if __name__ == "__main__":
