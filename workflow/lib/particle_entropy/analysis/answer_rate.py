@@ -72,15 +72,16 @@ def noisy_ladders(
 def runs(plan: pd.DataFrame, law) -> pd.DataFrame:
     """The runs a plan would make, as read_runs gives them, each with RMSE law(n, seed) (a scene
     of measure rmse: SSE_points = MEASUREMENT_POINTS rmse^2), no negative step, no mass lost."""
-    cols = [plan[c].to_numpy(dtype=np.int64) for c in ("candidate", "n", "first", "last")]
-    rows = [(c, n, s) for c, n, a, b in zip(*cols) for s in range(a, b + 1)]
-    ci, n, seed = (np.array(c, dtype=np.int64) for c in zip(*rows)) if rows else (np.zeros(0, np.int64),) * 3
+    cols = [plan[c].to_numpy(dtype=np.int64) for c in ("candidate", "n", "half_step", "first", "last")]
+    rows = [(c, n, h, s) for c, n, h, a, b in zip(*cols) for s in range(a, b + 1)]
+    ci, n, half, seed = (np.array(c, dtype=np.int64) for c in zip(*rows)) if rows else (np.zeros(0, np.int64),) * 4
     e = np.array([law(a, b) for a, b in zip(n, seed)], dtype=float)
     size = e.size
     return pd.DataFrame(
         {
             "candidate": ci,
             "n": n,
+            "half_step": half.astype(bool),  # an answer's check at half its step: the law knows no step
             "seed": seed,
             "SSE_points": MEASUREMENT_POINTS * e * e,
             "COMIC_points": np.log(e),
@@ -108,6 +109,7 @@ def search(scene: Scene, law, max_plans: int | None = None) -> tuple[int | None,
         if k > cap:
             raise RuntimeError(f"no finished plan after {cap} rounds")
     table = scene_search.judged(scene, runs(plan, law))
+    table = table[~table["half_step"]]
     met = table[table["meets"]]
     return (int(met["n"].min()) if len(met) else None), table
 

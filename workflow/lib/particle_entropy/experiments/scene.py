@@ -561,10 +561,11 @@ class Scenes(Mapping):
         return self._specs[name]
 
     def _owner(self, identity: str) -> tuple[Scene, Candidate]:
-        for scene in self.values():
+        for scene in self.values():  # each candidate, and each at half its step (an answer's check)
             for candidate in scene.candidates:
-                if scene.identity(candidate) == identity:
-                    return scene, candidate
+                for runs in (candidate, scene.half_step(candidate)):
+                    if scene.identity(runs) == identity:
+                        return scene, runs
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
 
     def settings(self, identity: str) -> dict:
