@@ -7,9 +7,10 @@ The real search (analysis/scene_search.py) replayed on noisy ladders whose true 
 (analysis/answer_rate.py): a PT candidate on the ratio-2 ladder 30 .. 7680 (9 rungs), true mean
 error (n / 30)^-1/2 crossing the target within the ladder, per-run noise with coefficient of
 variation uniform on [0.3, 1.0] (the issue's decay: about 0.7), realisations 8, max_realisations 32.
-Each ensemble is run under three rules for a rung's one-sided bound: the old 95 % per rung, the
-shipped Bonferroni correction over the ladder (1 - 0.05 / rungs: scene_search.answer_confidence) and
-one over rungs and seed blocks (1 - 0.05 / (rungs blocks)). Prints, per ensemble and rule, the rate
+Each ensemble is run under three rules for a rung's one-sided bound: the old 95 % a look, a
+Bonferroni correction over the ladder's rungs only (1 - 0.05 / rungs) and the shipped one over
+rungs and seed blocks, every look the answer could rest on (1 - 0.05 / (rungs blocks):
+scene_search.answer_confidence). Prints, per ensemble and rule, the rate
 of false answers with its Clopper-Pearson 95 % interval, the searches that met nothing, the mean runs
 and particle-runs (sum of n, the cost) a search, and the answers' mean rungs above the ideal one.
 """
@@ -30,10 +31,10 @@ from particle_entropy.analysis.resampling import CONFIDENCE  # noqa: E402
 
 LADDER = [30 * 2**k for k in range(9)]
 REALISATIONS, MOST = 8, 32
-RULES = {
-    "95 % per rung (old)": lambda c: CONFIDENCE,
-    "1 - 0.05 / rungs (shipped)": S.answer_confidence,
-    "1 - 0.05 / (rungs blocks)": lambda c: 1.0 - (1.0 - CONFIDENCE) / (len(c.ladder()) * MOST // REALISATIONS),
+RULES = {  # name: a rung's one-sided confidence (scene, candidate) -> q
+    "95 % a look (old)": lambda s, c: CONFIDENCE,
+    "1 - 0.05 / rungs": lambda s, c: 1.0 - (1.0 - CONFIDENCE) / len(c.ladder()),
+    "1 - 0.05 / (rungs blocks) (shipped)": S.answer_confidence,
 }
 ENSEMBLES = {  # name: (noise, width, seed)
     "lognormal, crossing anywhere": ("lognormal", 1.0, 50),
@@ -70,7 +71,7 @@ def main(argv=None) -> None:
                 outcomes = [o for part in pool.map(_chunk, [(rule, c) for c in chunks]) for o in part]
                 s = A.summary(outcomes)
                 print(
-                    f"  {rule:28s} false {s['false']:4d}/{s['ladders']} = {100 * s['rate']:.2f} % "
+                    f"  {rule:36s} false {s['false']:4d}/{s['ladders']} = {100 * s['rate']:.2f} % "
                     f"[{100 * s['lo']:.2f}, {100 * s['hi']:.2f}]  not met {s['not_met']}  "
                     f"runs {s['runs']:.1f}  particle-runs {s['particle_runs']:,.0f}  "
                     f"rungs above ideal {s['above_ideal']:.2f}  ({time.perf_counter() - start:.0f} s)",

@@ -112,6 +112,26 @@ def search(scene: Scene, law, max_plans: int | None = None) -> tuple[int | None,
     return (int(met["n"].min()) if len(met) else None), table
 
 
+def settled(scene: Scene, law) -> int | None:
+    """The answer of the brute force the search equals (tests/test_scene_search.py holds them equal):
+    each affordable rung of the only candidate, from the lowest, given a seed block more while open
+    and judged by the real rule (scene_search.judge and state); the lowest that passes (None: none).
+    No tables and no rounds: fast enough for thousands of ladders in a test."""
+    cand = scene.candidates[0]
+    for n in scene_search.affordable(scene, cand):
+        block = 0
+        while True:
+            last = scene_search.seeds(scene, cand, 0, block)[1]
+            row = scene_search.judge(scene, cand, np.array([law(n, seed) for seed in range(last + 1)]))
+            verdict = scene_search.state(scene, cand, row)
+            if verdict != scene_search.OPEN:
+                break
+            block += 1
+        if verdict == scene_search.PASS:
+            return n
+    return None
+
+
 def binomial_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:
     """Clopper-Pearson two-sided ``confidence`` interval of a rate k / n (scipy.stats.binomtest)."""
     from scipy.stats import binomtest
