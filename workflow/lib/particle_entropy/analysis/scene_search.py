@@ -170,10 +170,11 @@ def answer_confidence(scene: Scene, candidate: Candidate) -> float:
     """The one-sided confidence of each look at a rung's bound, Bonferroni-corrected over every look
     the answer could rest on: 1 - (1 - CONFIDENCE) / (rungs blocks), rungs the candidate's ladder's,
     blocks the seed blocks a rung may run (_blocks; FD: one, and no margin). The search takes the
-    lowest passing rung of up to ``rungs``, and judges a straddling rung again after each block, so
-    at 95 % a look a rung whose mean is above the target passed once in 4 to 6 ladders where it sat
-    at the target (benchmarks/answer_rate.py); a look for each rung alone (1 - 0.05 / rungs) still
-    passed in 7.8 %. A constant of the candidate, so a rung's state depends on its own runs only."""
+    lowest passing rung of up to ``rungs``, and judges a straddling rung again after each block: at
+    95 % a look, or corrected over the rungs alone, a rung whose true mean is above the target became
+    the answer in far more than 5 % of the hardest noisy ladders (benchmarks/answer_rate.py; the
+    rates: docs/scenes.md). A constant of the candidate, so a rung's state depends on its own runs
+    only and the search still equals brute force."""
     return 1.0 - (1.0 - CONFIDENCE) / (len(candidate.ladder()) * _blocks(scene, candidate))
 
 
