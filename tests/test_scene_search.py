@@ -367,8 +367,9 @@ def test_a_run_that_never_goes_negative_has_no_negative_step():
 
 # The search's answer equals brute force: every affordable rung run, each settled by the same rule
 # (seed blocks while its interval straddles the target, up to max_realisations), the answer the
-# lowest rung whose upper bound meets the target, at one-sided 1 - 0.05 / rungs (Bonferroni over the
-# candidate's ladder). The brute force below judges with its own Student t.
+# lowest rung whose upper bound meets the target, at one-sided 1 - 0.05 / (rungs blocks) (Bonferroni
+# over every look at every rung of the candidate's ladder). The brute force below judges with its own
+# Student t.
 
 
 def _settled_bound(scene, cand, n, law, ci) -> tuple[float, int]:
@@ -382,7 +383,8 @@ def _settled_bound(scene, cand, n, law, ci) -> tuple[float, int]:
     while True:
         errors += [law(ci, n, seed) for seed in range(len(errors), len(errors) + r)]
         e = np.array(errors)
-        level = 1.0 - 0.05 / len(cand.ladder())  # Bonferroni over the ladder: the answer holds with 95 %
+        looks = len(cand.ladder()) * scene.max_realisations // scene.realisations  # every rung's every block
+        level = 1.0 - 0.05 / looks  # Bonferroni over them: the answer holds with 95 %
         margin = 0.0 if fd else t.ppf(level, e.size - 1) * e.std(ddof=1) / math.sqrt(e.size)
         straddles = e.mean() - margin < scene.value < e.mean() + margin
         if fd or not straddles or e.size >= scene.max_realisations:
@@ -512,10 +514,9 @@ def test_a_straddling_rung_gets_seed_blocks_until_it_settles():
     assert plan[plan["half_step"]][["n", "first", "last"]].values.tolist() == [[60, *b] for b in blocks]
     row = table[~table["half_step"]].set_index("n").loc[60]
     assert row["meets"] and 8 < row["realisations"] <= scene.max_realisations
-    assert (
-        row["realisations"] == 8 * len(blocks)
-        and S.upper_bound(np.array([law(0, 60, s) for s in range(8)]), S.answer_confidence(scene.candidates[0])) > 1
-    )
+    first = np.array([law(0, 60, s) for s in range(8)])
+    assert row["realisations"] == 8 * len(blocks)
+    assert S.upper_bound(first, S.answer_confidence(scene, scene.candidates[0])) > 1
     # a mean at the target: refined to max_realisations, then failing; the answer above it
     law = lambda ci, n, seed: (1.0 + (0.3 if seed % 2 else -0.3)) if n == 60 else (1.5 if n < 60 else 0.1)  # noqa: E731
     answers, out, _ = _answers(scene, law)
@@ -615,21 +616,36 @@ def test_only_rungs_that_can_still_be_the_answer_are_refined():
     assert rows.loc[480, "realisations"] < scene.max_realisations and not rows.loc[480, "meets"]
 
 
-def test_a_recommended_rung_is_above_the_target_in_expectation_at_most_5_percent_of_the_time():
-    """Issue 50, point 7: the search tests rung after rung and takes the lowest that passes, so each
-    rung's bound at 95 % gave a false answer (true mean error above the target) in about 10 % of noisy
-    ladders. On a fixed ensemble of 160 (analysis/answer_rate.py: true mean (n / 30)^-1/2 crossing the
-    target within a 9-rung ladder, lognormal per-run noise of cv 0.3-1.0) the real search, at the
-    Bonferroni level, is wrong in at most 5 % (7 of 160); at 95 % a rung it was 13 of 160 (8.1 %)."""
+@pytest.mark.parametrize(
+    "rule, holds",
+    [(None, True), (lambda scene, c: 0.95, False), (lambda scene, c: 1 - 0.05 / len(c.ladder()), False)],
+    ids=["shipped", "95 % a look", "rungs only"],
+)
+def test_a_recommended_rung_is_above_the_target_in_expectation_at_most_5_percent_of_the_time(rule, holds, monkeypatch):
+    """Issue 50, point 7: the search takes the lowest of up to 9 rungs that passes and looks at a
+    straddling rung again after each seed block. On a fixed ensemble of the hardest ladders
+    (analysis/answer_rate.py: true mean (n / 30)^-1/2 with the rung below the crossing at most 3.5 %
+    above the target, lognormal per-run noise of cv 0.3-1.0, blocks of 8 up to 32) the shipped bound,
+    Bonferroni over every look (1 - 0.05 / 36), recommends a rung above the target in expectation
+    at most 5 % of the time; the old 95 % a look and a correction over the rungs alone do not. The
+    brute force the search equals (settled; held equal above and on a sample here) keeps it fast."""
+    from dataclasses import replace
+
     from particle_entropy.analysis import answer_rate as A
 
     ladder = PT_LADDER["ladder"]
     scene = A.ladder_scene(ladder, realisations=8, max_realisations=32)
-    assert S.answer_confidence(scene.candidates[0]) == pytest.approx(1 - 0.05 / 9)
-    ladders = A.noisy_ladders(ladder, 160, seed=7, seeds=32)
-    out = A.false_answer_rate(scene, ladders)
-    assert out["ladders"] == 160 and out["not_met"] < 24
-    assert out["rate"] <= 0.05, out
+    if rule is None:
+        assert S.answer_confidence(scene, scene.candidates[0]) == pytest.approx(1 - 0.05 / 36)
+    else:
+        monkeypatch.setattr(S, "answer_confidence", rule)
+    ladders = A.noisy_ladders(ladder, 2000, seed=52, seeds=32, width=0.1)
+    answers = [A.settled(replace(scene, value=lad.target), lad.law) for lad in ladders]
+    false = sum(bool(a is not None and lad.means[a] > lad.target) for a, lad in zip(answers, ladders))
+    assert sum(a is None for a in answers) < 200
+    assert (false / len(ladders) <= 0.05) is holds, false
+    for a, lad in list(zip(answers, ladders))[:8]:  # the search itself gives the same answers
+        assert A.search(replace(scene, value=lad.target), lad.law)[0] == a
 
 
 def test_an_answer_that_misses_the_target_at_half_its_step_is_not_recommended():

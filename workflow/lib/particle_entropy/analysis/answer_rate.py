@@ -114,6 +114,48 @@ def search(scene: Scene, law, max_plans: int | None = None) -> tuple[int | None,
     return (int(met["n"].min()) if len(met) else None), table
 
 
+def settled(scene: Scene, law) -> int | None:
+    """The answer of the brute force the search equals (tests/test_scene_search.py holds them equal):
+    each affordable rung of the only candidate, from the lowest, given a seed block more while open
+    and judged by the real rule (scene_search.judge and state); the lowest that passes (None: none).
+    No tables and no rounds: fast enough for thousands of ladders in a test."""
+    cand = scene.candidates[0]
+    for n in scene_search.affordable(scene, cand):
+        block = 0
+        while True:
+            last = scene_search.seeds(scene, cand, 0, block)[1]
+            row = scene_search.judge(scene, cand, np.array([law(n, seed) for seed in range(last + 1)]))
+            verdict = scene_search.state(scene, cand, row)
+            if verdict != scene_search.OPEN:
+                break
+            block += 1
+        if verdict == scene_search.PASS:
+            return n
+    return None
+
+
+def rung_pass_rate(scene: Scene, mean: float, cv: float, draws: int, seed: int) -> tuple[float, float]:
+    """How often one rung of ``scene``'s only candidate whose per-run errors are lognormal with
+    ``mean`` and coefficient of variation ``cv`` passes the target: (on its first seed block alone,
+    once settled by the real rule: scene_search.judge and state), over ``draws`` seed draws."""
+    cand = scene.candidates[0]
+    s = math.sqrt(math.log1p(cv * cv))
+    rng = np.random.default_rng(seed)
+    errors = mean * np.exp(s * rng.standard_normal((draws, scene.blocks * scene.realisations)) - 0.5 * s * s)
+    first = settled_pass = 0
+    for e in errors:
+        block = 1
+        while True:
+            row = scene_search.judge(scene, cand, e[: block * scene.realisations])
+            first += block == 1 and row["meets"]
+            verdict = scene_search.state(scene, cand, row)
+            if verdict != scene_search.OPEN:
+                break
+            block += 1
+        settled_pass += verdict == scene_search.PASS
+    return first / draws, settled_pass / draws
+
+
 def binomial_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[float, float]:
     """Clopper-Pearson two-sided ``confidence`` interval of a rate k / n (scipy.stats.binomtest)."""
     from scipy.stats import binomtest
@@ -122,20 +164,26 @@ def binomial_interval(k: int, n: int, confidence: float = CONFIDENCE) -> tuple[f
     return float(ci.low), float(ci.high)
 
 
-def outcome(scene: Scene, ladder: NoisyLadder) -> dict:
+def outcome(scene: Scene, ladder: NoisyLadder, replay: str = "search") -> dict:
     """The real search on one ladder (``scene``: one particle candidate over the ladder's rungs, its
     target replaced by the ladder's): its answer (None: not met), whether the answer is above the
     target in expectation (``false``), its rungs above the lowest that truly meets it, the runs and
-    particle-runs (sum of n) the search made."""
-    answer, table = search(replace(scene, value=ladder.target), ladder.law)
+    particle-runs (sum of n) the search made. ``replay`` "settled": the brute force's answer (the
+    same; settled), fast, without the search's runs (NaN)."""
+    at = replace(scene, value=ladder.target)
+    if replay == "settled":
+        answer, runs_, particle_runs = settled(at, ladder.law), math.nan, math.nan
+    else:
+        answer, table = search(at, ladder.law)
+        runs_, particle_runs = int(table["realisations"].sum()), int((table["realisations"] * table["n"]).sum())
     rungs = sorted(ladder.means)
     ideal = next(i for i, n in enumerate(rungs) if ladder.means[n] <= ladder.target)
     return {
         "answer": answer,
-        "false": answer is not None and ladder.means[answer] > ladder.target,
+        "false": bool(answer is not None and ladder.means[answer] > ladder.target),
         "above_ideal": math.nan if answer is None else rungs.index(answer) - ideal,
-        "runs": int(table["realisations"].sum()),
-        "particle_runs": int((table["realisations"] * table["n"]).sum()),
+        "runs": runs_,
+        "particle_runs": particle_runs,
     }
 
 
@@ -160,9 +208,10 @@ def summary(outcomes: list[dict]) -> dict:
     }
 
 
-def false_answer_rate(scene: Scene, ladders: list[NoisyLadder]) -> dict:
-    """How often the search's answer is above the target in expectation over ``ladders`` (summary)."""
-    return summary([outcome(scene, lad) for lad in ladders])
+def false_answer_rate(scene: Scene, ladders: list[NoisyLadder], replay: str = "search") -> dict:
+    """How often the search's answer is above the target in expectation over ``ladders`` (summary;
+    ``replay``: outcome's)."""
+    return summary([outcome(scene, lad, replay) for lad in ladders])
 
 
 def ladder_scene(ladder: list[int], realisations: int = 8, max_realisations: int = 32) -> Scene:

@@ -2,16 +2,16 @@
 
 For each candidate, the smallest rung of its affordable ladder (Candidate.ladder, within the budget)
 whose mean error meets the target: the one-sided upper bound mean + t_q s / sqrt(R) of R
-realisations, q = 1 - 0.05 / rungs (answer_confidence: the answer, not each rung, holds with 95 %)
-(FD is deterministic: one run, its error). The answer is the brute
-force's, as if every rung had run: errors need not fall with n (noise; FD central's error can rise
-with it). A particle rung whose interval straddles the target (mean - t_0.95 se < target < mean +
-t_0.95 se) gets another block of ``realisations`` seeds until it falls on one side or reaches
-``max_realisations`` (state): its final state depends on its own seeds only. The search climbs CLIMB
-rungs a round until a rung passes (or the top is reached), then runs in one round every unvisited
-rung below the lowest pass (on a ratio-2 ladder they cost about what that rung does), refining
-straddling rungs that can still be the answer in the same rounds; it stops once every rung below
-the lowest pass has run and settled (_next_rungs). Each round is a Snakemake checkpoint whose plan
+realisations, q = 1 - 0.05 / (rungs blocks) (answer_confidence: Bonferroni over every look at every
+rung, so that the answer, not each look, holds with 95 %; FD is deterministic: one run, its error).
+The answer is the brute force's, as if every rung had run: errors need not fall with n (noise; FD
+central's error can rise with it). A particle rung whose interval straddles the target (mean - t_q
+se < target < mean + t_q se) gets another block of ``realisations`` seeds until it falls on one
+side or reaches ``max_realisations`` (state): its final state depends on its own seeds only. The
+search climbs CLIMB rungs a round until a rung passes (or the top is reached), then runs in one
+round every unvisited rung below the lowest pass (on a ratio-2 ladder they cost about what that
+rung does), refining straddling rungs that can still be the answer in the same rounds; it stops
+once every rung below the lowest pass has run and settled (_next_rungs). Each round is a Snakemake checkpoint whose plan
 names the run tables to make; the path depends on the config and the errors only, never on timings.
 The rounds, plans, seed blocks and the rounds' inputs are the search engine's (search.py; the kind:
 SceneSearch); this module is the rule for a candidate's next rungs (_next_rungs) and the result.
@@ -63,9 +63,10 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
     "error_mean": "the mean error of the scene's `measure` at t_final over the realisations",
     "error_lo": "lower end of the mean's two-sided 95 % interval (Student t; FD: the error)",
     "error_hi": "upper end of that interval",
-    "error_upper95": "the mean's one-sided upper bound at 1 - 0.05 / rungs of the candidate's ladder (Student t, "
-    "Bonferroni-corrected so that the answer, the lowest passing rung, holds with 95 %; FD: the error): the rung "
-    "meets the target when it is <= `target`",
+    "error_upper95": "the mean's one-sided upper bound at 1 - 0.05 / (rungs blocks), rungs those of the "
+    "candidate's ladder and blocks the seed blocks a rung may run, `max_realisations` / `realisations` (Student t, "
+    "Bonferroni-corrected over every look at every rung so that the answer, the lowest passing rung, holds with "
+    "95 %; FD: the error): the rung meets the target when it is <= `target`",
     "meets": "the rung is scored and `error_upper95` <= `target`",
     "unscored": "why the rung cannot be judged (a concentration below -1e-12 of the total at any step: its "
     "first such step, the minimum and, for FD in a flow, the grid Peclet and Courant numbers; more than 1e-3 of "
@@ -172,13 +173,16 @@ def upper_bound(errors: np.ndarray, confidence: float = CONFIDENCE) -> float:
     return float(errors.mean() + _t_margin(errors, confidence))
 
 
-def answer_confidence(candidate: Candidate) -> float:
-    """The one-sided confidence of each rung's bound, Bonferroni-corrected over the candidate's
-    ladder: 1 - (1 - CONFIDENCE) / (its rungs). The search takes the lowest of up to that many rungs
-    that passes, so each at 95 % would let a rung above the target through once in a few ladders
-    (benchmarks/answer_rate.py); at this level the answer, not each rung, holds with 95 %. A
-    constant of the candidate, so a rung's state still depends on its own runs only."""
-    return 1.0 - (1.0 - CONFIDENCE) / len(candidate.ladder())
+def answer_confidence(scene: Scene, candidate: Candidate) -> float:
+    """The one-sided confidence of each look at a rung's bound, Bonferroni-corrected over every look
+    the answer could rest on: 1 - (1 - CONFIDENCE) / (rungs blocks), rungs the candidate's ladder's,
+    blocks the seed blocks a rung may run (_blocks; FD: one, and no margin). The search takes the
+    lowest passing rung of up to ``rungs``, and judges a straddling rung again after each block: at
+    95 % a look, or corrected over the rungs alone, a rung whose true mean is above the target became
+    the answer in far more than 5 % of the hardest noisy ladders (benchmarks/answer_rate.py; the
+    rates: docs/scenes.md). A constant of the candidate, so a rung's state depends on its own runs
+    only and the search still equals brute force."""
+    return 1.0 - (1.0 - CONFIDENCE) / (len(candidate.ladder()) * _blocks(scene, candidate))
 
 
 def seeds(scene: Scene, candidate: Candidate, base_seed: int, block: int = 0) -> tuple[int, int]:
@@ -195,6 +199,25 @@ def block_size(scene: Scene, candidate: Candidate) -> int:
 
 # judged(): a row per (candidate, n, half_step) run; result() folds the half-step rows into their answers'
 JUDGED_COLUMNS = [*list(RESULT_COLUMN_DOCS)[: list(RESULT_COLUMN_DOCS).index("COMIC_points") + 1], "half_step"]
+
+
+def judge(scene: Scene, candidate: Candidate, errors: np.ndarray, reason: str = "") -> dict:
+    """A rung's verdict from its runs' errors: realisations, error mean, its two-sided 95 % interval
+    (t), its one-sided upper bound at answer_confidence, whether that meets the target (never if the
+    rung is unscored: ``reason``), and ``reason``. The judged row's part that state() reads."""
+    errors = np.asarray(errors, dtype=float)
+    mean = float(errors.mean())
+    half = _t_margin(errors, 0.5 * (1.0 + CONFIDENCE))  # two-sided
+    up = upper_bound(errors, answer_confidence(scene, candidate))
+    return {
+        "realisations": int(errors.size),
+        "error_mean": mean,
+        "error_lo": mean - half,
+        "error_hi": mean + half,
+        "error_upper95": up,
+        "meets": bool(not reason and up <= scene.value),
+        "unscored": reason,
+    }
 
 
 def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
@@ -215,22 +238,13 @@ def judged(scene: Scene, runs: pd.DataFrame) -> pd.DataFrame:
         records = [every[i] for i in groups.indices[(ci, n, at_half)]]
         reason = next((why for why in (unscored(scene, r) for r in records) if why), "")
         errs = np.array([error(scene, r) for r in records])
-        k = errs.size
-        half = _t_margin(errs, 0.5 * (1.0 + CONFIDENCE))  # two-sided
-        up = upper_bound(errs, answer_confidence(cand))
         rows.append(
             {
                 "candidate": int(ci),
                 "label": cand.label,
                 "method": cand.case.method,
                 "n": int(n),
-                "realisations": int(k),
-                "error_mean": float(errs.mean()),
-                "error_lo": float(errs.mean() - half),
-                "error_hi": float(errs.mean() + half),
-                "error_upper95": up,
-                "meets": bool(not reason and up <= scene.value),
-                "unscored": reason,
+                **judge(scene, cand, errs, reason),
                 "steps": float(g["steps"].mean()),
                 "work": float(g["work"].mean()),
                 "cost_s": scene.cost_s(cand.case.method, g["steps"].mean(), g["work"].mean()),
@@ -273,9 +287,9 @@ PASS, FAIL, OPEN = "pass", "fail", "open"
 
 def state(scene: Scene, candidate: Candidate, row) -> str:
     """A visited rung's state from its judged row: PASS (its upper bound meets the target), FAIL
-    (settled: unscored, FD, its one-sided 95 % lower bound mean - t_0.95 se at or above the target,
-    or ``max_realisations`` run) or OPEN (its interval straddles the target: another seed block may
-    settle it). A function of the rung's own runs only."""
+    (settled: unscored, FD, its one-sided lower bound mean - t_q se at or above the target, q the
+    bound's answer_confidence, or ``max_realisations`` run) or OPEN (its interval straddles the
+    target: another seed block may settle it). A function of the rung's own runs only."""
     if row["meets"]:
         return PASS
     if row["unscored"] or candidate.case.method == "fd" or row["realisations"] >= scene.max_realisations:
