@@ -35,7 +35,7 @@ from ..experiments import reactive
 from ..numerics.compiled import kernels_folder
 from .crate import crate_folder_problem
 from .invocation import runs_no_job, snakemake_options
-from .runlock import FolderBusy, hold
+from .runlock import LockRefused, hold
 from .sweeps import RUN_PATTERN, SUMMARY_PATTERN
 from .verify import (
     CORRUPT_SUFFIX,
@@ -169,7 +169,7 @@ def preflight(
     if not look_only:
         try:
             note = hold("results")
-        except FolderBusy as e:
+        except LockRefused as e:
             raise error(str(e)) from None
         if note:
             print(note, file=sys.stderr)
