@@ -4,6 +4,7 @@ the search judging a reactive run's table."""
 
 import json
 import math
+import os
 from dataclasses import replace
 from pathlib import Path
 
@@ -364,4 +365,26 @@ def test_a_bad_reference_is_set_aside_before_a_run_and_named(tmp_path, monkeypat
     assert len(lines) == 1 and "0123456789ab.json" in lines[0] and "rebuilds it" in lines[0]
     assert preflight.set_aside_corrupt_tables("results", look_only=True) == [
         "results/scenes/references/0123456789ab.json"
+    ]
+
+
+def test_only_the_references_folder_s_own_entries_are_judged_and_each_is_set_aside(tmp_path, monkeypatch):
+    """A folder in a reference's place holding a .json stopped the run: the file inside was judged
+    after its folder had been moved aside, and could not be moved. Only the folder's own entries
+    are references; a folder, a link to nothing and a pipe there are each set aside, none read."""
+    from particle_entropy.pipeline import preflight
+
+    monkeypatch.chdir(tmp_path)
+    folder = tmp_path / "results" / "scenes" / "references"
+    (folder / "a.json").mkdir(parents=True)
+    (folder / "a.json" / "inner.json").write_text("{}")
+    (folder / "b.json").symlink_to(tmp_path / "nowhere")
+    os.mkfifo(folder / "c.json")  # reading it would block for ever
+    lines = []
+    moved = preflight.set_aside_bad_references("results", report=lines.append)
+    assert [p.name for p in moved] == ["a.json", "b.json", "c.json"]
+    assert ["a folder" in lines[0], "a link to nothing" in lines[1], "not a regular file" in lines[2]] == [True] * 3
+    assert (folder / "a.json.corrupt" / "inner.json").exists() and not (folder / "a.json").exists()
+    assert preflight.set_aside_corrupt_tables("results", look_only=True) == [
+        f"results/scenes/references/{n}.json" for n in "abc"
     ]

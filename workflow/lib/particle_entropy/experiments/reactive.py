@@ -147,7 +147,8 @@ def _load(path: str | os.PathLike) -> tuple[dict | None, str | None]:
     not match, or a digest other than its file's name or its physics'."""
     path = Path(path)
     if not path.is_file():  # never read a pipe (it would block) or a folder
-        return None, "it is a folder" if path.is_dir() else "it is not a regular file"
+        what = "a folder" if path.is_dir() else "a link to nothing" if path.is_symlink() else "not a regular file"
+        return None, f"it is {what}"
     try:
         ref = json.loads(path.read_bytes().decode("utf-8"))
     except OSError as e:

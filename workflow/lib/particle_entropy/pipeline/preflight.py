@@ -105,13 +105,24 @@ def crate_requested(options: Mapping | None) -> bool:
 REFERENCES = Path(reactive.REFERENCE_PATTERN).parent.relative_to("results")
 
 
+def references_in(root="results", suffix=".json") -> list[Path]:
+    """The entries of the references folder below ``root`` whose names end in ``suffix``, sorted:
+    only its own (REFERENCE_PATTERN is flat), never what a folder in a reference's place holds."""
+    folder = Path(root) / REFERENCES
+    try:
+        names = os.listdir(folder)
+    except OSError:  # no reference yet, or no folder there: the scene_reference job says so
+        return []
+    return sorted(folder / name for name in names if name.endswith(suffix))
+
+
 def set_aside_bad_references(root="results", report=print) -> list[Path]:
     """Set aside (verify.set_aside) every reference file below ``root`` that reactive.problem
     refuses (damaged, no or a wrong checksum, another physics' file copied in), reporting each in
     one line, so that the run rebuilds it; returns those moved. Every file is read each time: they
     are few and small. One that cannot be moved raises TableError."""
     moved = []
-    for path in tables_below(Path(root) / REFERENCES, ".json"):
+    for path in references_in(root):
         problem = reactive.problem(path)
         if problem is None:
             continue
@@ -140,7 +151,7 @@ def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS, e
         except TableError as e:
             raise error(str(e)) from None
     aside = tables_below(root, f".parquet{CORRUPT_SUFFIX}")
-    aside += tables_below(Path(root) / REFERENCES, f".json{CORRUPT_SUFFIX}")
+    aside += references_in(root, f".json{CORRUPT_SUFFIX}")
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     return sorted(m for m in missing if not Path(m).exists())
 
