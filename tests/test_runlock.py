@@ -133,5 +133,17 @@ def test_holders_come_from_the_kernel_s_list_of_locks(tmp_path):
         f"3: FLOCK  ADVISORY  WRITE 45 {dev}:{st.st_ino + 1} 0 EOF\n"
     )
     assert runlock.lock_holders(st, locks) == [42]
+    # a lock listed under another device by the same inode number: named only when the process has
+    # this very file open (an overlay's device differs; an unrelated file may share the number)
+    held = os.open(tmp_path, os.O_RDONLY)
+    try:
+        locks.write_text(
+            f"1: FLOCK  ADVISORY  WRITE 0 {dev}:{st.st_ino} 0 EOF\n"  # pid 0: outside this pid namespace
+            f"2: FLOCK  ADVISORY  WRITE {os.getppid()} 00:99:{st.st_ino} 0 EOF\n"
+            f"3: FLOCK  ADVISORY  WRITE {os.getpid()} 00:99:{st.st_ino} 0 EOF\n"
+        )
+        assert runlock.lock_holders(st, locks) == [os.getpid()]
+    finally:
+        os.close(held)
     assert runlock.lock_holders(st, tmp_path / "missing") == []
     assert runlock.holder_named("pid 42 on x in /y", []) == "pid 42 on x in /y"  # none named: the record

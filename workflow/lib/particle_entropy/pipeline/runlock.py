@@ -102,11 +102,31 @@ def lock_holders(st: os.stat_result, locks: str | os.PathLike = "/proc/locks") -
         words = line.split()
         if "->" in words or len(words) < 6 or words[1] != "FLOCK" or not words[4].isdigit():  # "->": a waiter
             continue
+        if int(words[4]) == 0:  # a holder outside this pid namespace, or whose pid is freed: unnamed
+            continue
         if words[5] == dev:
             exact.add(int(words[4]))
         elif words[5].rsplit(":", 1)[-1] == str(st.st_ino):
             by_inode.add(int(words[4]))
-    return sorted(exact or by_inode)
+    # an inode number alone may be another file's, on another device: only a process that has ours open
+    return sorted(exact or {pid for pid in by_inode if has_open(pid, st)})
+
+
+def has_open(pid: int, st: os.stat_result) -> bool:
+    """Whether process ``pid`` has the file of ``st`` open (its /proc fd links; False where they
+    cannot be read)."""
+    try:
+        fds = os.listdir(f"/proc/{pid}/fd")
+    except OSError:
+        return False
+    for fd in fds:
+        try:
+            other = os.stat(f"/proc/{pid}/fd/{fd}")
+        except OSError:  # closed since it was listed
+            continue
+        if (other.st_dev, other.st_ino) == (st.st_dev, st.st_ino):
+            return True
+    return False
 
 
 def holder_named(recorded: str, holders: list[int]) -> str:
