@@ -610,6 +610,17 @@ def _texts(ax) -> str:
     return "\n".join(t.get_text() for t in ax.texts)
 
 
+def _points(ax) -> list[tuple[float, float]]:
+    """The finite (x, y) points drawn with markers in ``ax`` (not the target line, not the caps)."""
+    return [
+        (float(x), float(y))
+        for line in ax.get_lines()
+        if line.get_marker() not in (None, "None", "", "_")  # "_": an error bar's cap
+        for x, y in zip(*line.get_data())
+        if np.isfinite(x) and np.isfinite(y)
+    ]
+
+
 def test_a_scene_whose_errors_are_nan_is_drawn_saying_so(tmp_path):
     """Issue 50 (10): a scene table whose every candidate stopped on 'target undefined' (realisations
     0, errors NaN) crashed plot_scene in matplotlib's log scale. It draws no point for a NaN error,
@@ -643,3 +654,4 @@ def test_a_scene_whose_errors_are_nan_is_drawn_saying_so(tmp_path):
     fig = draw(some)
     save_figure(fig, tmp_path / "some.png", tmp_path / "some.pdf")
     assert "Not drawn: 1 of 2 rungs, 1 without an error (NaN)" in _texts(fig.axes[0])
+    assert _points(fig.axes[0]) == [(some.loc[0, "cost_s"], 0.1)]
