@@ -124,3 +124,60 @@ def test_two_boxes_that_meet_converge_within_their_bounds():
     assert 1.9 < m.order < 2.1
     assert 0.0 < m.value <= 0.8  # the scarcer species' mass
     assert np.all(ref.c_points.error < np.abs(ref.c_points.values[0] - ref.c_points.values[2]))
+
+
+def test_richardson_extrapolates_only_near_the_scheme_s_order():
+    h = np.array([0.4, 0.2, 0.1])
+    second = RD.richardson(*(1.5 + h**2))
+    assert second.asymptotic and second.value == pytest.approx(1.5, rel=1e-14)
+    # order 1 (a kink) or 5 (a lucky cancellation): the finest grid's value, its error at least |f3 - f2|
+    first, fifth = RD.richardson(*(1.5 + h)), RD.richardson(*(1.5 + h**5))
+    assert not first.asymptotic and first.value == 1.6 and first.error == pytest.approx(0.1, rel=1e-12)
+    assert not fifth.asymptotic and fifth.value == 1.5 + 0.1**5 and fifth.error == pytest.approx(0.2**5 - 0.1**5)
+    assert fifth.error >= abs(fifth.value - 1.5)  # the truth within the stated error, where p = 5 would not be
+    same = RD.richardson(0.25, 0.25, 0.25)  # every grid agrees (a decay's mass): exact
+    assert same.asymptotic and same.error == 0.0
+    mixed = RD.richardson([1.9, 1.51024], [1.7, 1.50032], [1.6, 1.50001])
+    assert mixed.asymptotic.tolist() == [False, False]
+
+
+def test_the_default_grid_puts_every_box_edge_on_a_face_of_all_three_grids():
+    a, b = Source.of("box", a=-0.7, b=0.3), Source.of("box", a=0.3, b=1.1)
+    lo, hi, n = RD.aligned_grid([a, b], 1e-3, 20.0)
+    wlo, whi = RD.window([a, b], 1e-3, 20.0)
+    assert lo <= wlo and hi >= whi and RD.COARSE_CELLS <= n <= RD.ALIGN_SLACK * RD.COARSE_CELLS
+    for level in range(3):
+        dx = (hi - lo) / (n * 2**level)
+        faces = (np.array([-0.7, 0.3, 1.1]) - lo) / dx
+        np.testing.assert_allclose(faces, faces.round(), rtol=0, atol=1e-8)
+    smooth = Source.of("gaussian", x0=0.0, sd=0.5)
+    assert RD.aligned_grid([smooth], D, T) == (*RD.window([smooth], D, T), RD.COARSE_CELLS)
+
+
+def test_a_decaying_box_s_extrapolation_is_far_inside_its_stated_error():
+    # the box's edges on faces (the default grid): order 2 at every point, the fine grid's error the
+    # estimate's size, the extrapolated value 1e-3 of it from the exact one. With the edges inside
+    # cells (the plain window) the extrapolation kept 2 to 8 % of the error
+    lam, box = 0.7, Source.of("box", a=-1.0, b=1.0)
+    points = np.array([-1.6, -1.2, -0.5, 0.0, 0.7, 1.3, 2.0])
+    exact = box.density(points, D, 0.0, T) * math.exp(-lam * T)
+    ref = RD.reference(box, 0.0, D, Decay(lam), T, points)
+    a = ref.a_points
+    assert ref.plan.aligned and np.all(a.asymptotic) and np.all(np.abs(a.order - 2.0) < 0.01)
+    np.testing.assert_allclose(np.abs(a.values[2] - exact) / a.error, 1.0, atol=0.01)
+    assert np.all(np.abs(a.value - exact) < 0.01 * a.error)
+
+
+def test_a_fast_reaction_s_steps_are_capped_and_its_plan_is_known_before_it_runs():
+    # the kinetics are exact within a step: k C0 t = 1e9 plans no more work than MAX_WORK, where the
+    # kinetic rule asked for 2.5e8 steps on the coarsest grid
+    box = Source.of("box", a=-1.0, b=1.0)
+    for k in (1e-7, 1e8):
+        how = RD.plan(box, 0.5, 1e-5, Bimolecular(k), 20.0)
+        assert how.work <= RD.MAX_WORK and how.aligned
+        assert how.capped == (k > 1.0) and how.n_steps >= how.by_r
+    assert how.by_kinetics == pytest.approx(0.5 * 1e8 * 20.0 / RD.COARSE_KINETIC)
+    small = RD.plan(box, 0.5, 1e-5, Bimolecular(1e8), 20.0, max_work=1e6)
+    assert small.n_steps < how.n_steps and small.work <= 1e6
+    with pytest.raises(RD.CostError, match="above the bound of 1e\\+03 cell-steps"):
+        RD.reference(box, 0.5, 1e-5, Bimolecular(1e8), 20.0, max_work=1e3)

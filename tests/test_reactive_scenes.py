@@ -388,3 +388,99 @@ def test_only_the_references_folder_s_own_entries_are_judged_and_each_is_set_asi
     assert preflight.set_aside_corrupt_tables("results", look_only=True) == [
         f"results/scenes/references/{n}.json" for n in "abc"
     ]
+
+
+@pytest.mark.parametrize("lam_t", [1e-300, 1e-200, 1e-10, 1e-3])
+def test_a_decay_s_product_down_to_1e_300_is_exact_at_every_point(lam_t):
+    # issue 50: 1 - exp(-lambda t) cancelled to 0 at lambda t = 1e-300 (every error NaN) and was off
+    # by ~1e-6 at 1e-10; -expm1 keeps its digits, and C at the points is the plume times it
+    scene = Scene.from_config("r", spec(reaction={"kind": "decay", "rate": lam_t / 20.0}))
+    ref = _ref(scene)
+    exact = sum((-1) ** (n + 1) * lam_t**n / math.factorial(n) for n in range(1, 8))  # 1 - exp(-x)'s series
+    assert ref["product_mass"] == pytest.approx(exact, rel=1e-15)
+    assert ref["product_series"][-1] == pytest.approx(exact, rel=1e-14)
+    plume = scene.source.density(ref["points"], scene.D, scene.v, scene.t_final)
+    assert np.all(plume > 0.0)
+    np.testing.assert_allclose(ref["c_points"], plume * exact, rtol=1e-14)
+    np.testing.assert_allclose(ref["a_points"] + ref["c_points"], plume, rtol=1e-15)
+
+
+def test_well_mixed_s_reference_holds_an_independent_solve_within_its_stated_error():
+    # issue 50: config's well_mixed stated M_C = 0.9449719679 +- 5.0e-9 at an observed order of 5.06,
+    # 169 of its errors from a method-of-lines BDF solve on three grids (order 2.00): 0.9449728047.
+    # The boxes' edges now sit on cell faces: order ~2, and that solve within the stated error
+    both = {"kind": "bimolecular", "k": 2.0, "B": {"source": {"kind": "box", "a": -1.0, "b": 1.0}, "mass": 1.0}}
+    scene = Scene.from_config("w", spec(v=0.0, reaction=both, target={"measure": "rmse", "value": 1e-3}))
+    ref = _ref(scene)
+    assert ref["edges_on_faces"] and ref["product_asymptotic"]
+    assert 1.5 < ref["product_order"] < 2.5
+    assert abs(ref["product_mass"] - 0.9449728047) <= ref["product_error"] < 1e-5
+    assert ref["a_asymptotic"].dtype == bool and ref["a_asymptotic"].size == ref["points"].size
+
+
+def _timed(scene):
+    import time
+
+    start = time.perf_counter()
+    out = reactive.compute(reactive.physics(scene))
+    return out, time.perf_counter() - start
+
+
+def test_a_sweep_of_k_c0_t_from_1e_6_to_1e9_ends_or_is_refused_in_bounded_time(monkeypatch):
+    # issue 50: k = 1e5 still ran after 240 s, k = 1e12 planned 5e12 steps. Every plan of the sweep
+    # keeps to MAX_WORK; computed under a tenth of it (to keep the test short) each ends within 10
+    # times the bound's estimate, the capped ones flagged where their order leaves the band, and a
+    # scene whose diffusion rule alone exceeds the bound is refused by key path before any step
+    from particle_entropy.numerics import reaction_diffusion as RD
+
+    box = {"kind": "box", "a": -0.5, "b": 0.5}
+    sweep = [1e-6, 1e-3, 1.0, 1e2, 1e4, 1e6, 1e8, 1e9]
+    scenes = [
+        Scene.from_config(
+            "x",
+            spec(
+                D=1e-5,
+                v=0.0,
+                source=box,
+                reaction={"kind": "bimolecular", "k": kct / 10.0, "B": {"uniform": 0.5}},
+                candidates=[FD, MTPT],
+            ),
+        )
+        for kct in sweep
+    ]
+    assert all(reactive.plan(reactive.physics(s)).work <= RD.MAX_WORK for s in scenes)
+    monkeypatch.setattr(RD, "MAX_WORK", 3e6)
+    bound = 10.0 * RD.MAX_WORK * RD.SECONDS_PER_CELL_STEP  # ~4 s: slack for a loaded machine
+    made = []
+    for kct, scene in zip(sweep, scenes):
+        out, seconds = _timed(scene)
+        assert seconds < bound + 1.0, (kct, seconds)
+        assert out["product_asymptotic"] or out["kinetic_steps_capped"], kct
+        assert out["product_error"] < 1e-2 * out["product_mass"], kct
+        made.append((out["product_mass"], out["product_error"]))
+    assert made[0][0] == pytest.approx(1e-6, rel=1e-5) and np.all(np.diff([m for m, _ in made]) >= 0)
+    # instant reaction at equal D: A - B diffuses, its zero stays at the box's edges, and B diffuses in
+    # from both sides, C0 sqrt(4 D t / pi) each: M_C = 0.5 + sqrt(4 D t / pi) = 0.5159577
+    instant = 0.5 + math.sqrt(4e-5 * 20.0 / math.pi)
+    assert abs(made[-1][0] - instant) <= made[-1][1]
+    import time
+
+    start = time.perf_counter()
+    with pytest.raises(SettingError) as refused:  # a narrow pulse at D = 1e-4: r's rule asks 1e3 steps
+        _extreme({"kind": "bimolecular", "k": 1e8, "B": {"uniform": 0.5}})
+    assert time.perf_counter() - start < 1.0
+    assert refused.value.name == "scenes.x.reaction.k" and refused.value.value == 1e8
+    assert "at most 3e+06 cell-steps" in refused.value.allowed and "finest of three grids" in refused.value.allowed
+
+
+def test_the_reference_rule_s_code_hash_covers_the_solver():
+    # a stale reference is rebuilt: scene_reference's code param hashes what its script imports, the
+    # solver (imported lazily in compute) included
+    from pathlib import Path
+
+    from particle_entropy.pipeline.codeversion import closure, script_imports
+
+    script = Path(__file__).parents[1] / "workflow" / "scripts" / "scene_reference.py"
+    assert {"experiments.reactive", "numerics.reaction_diffusion"} <= set(closure(script_imports(script)))
+    rule = (Path(__file__).parents[1] / "workflow" / "rules" / "scenes.smk").read_text()
+    assert 'code=script_code(SCRIPTS / "scene_reference.py")' in rule

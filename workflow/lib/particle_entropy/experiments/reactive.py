@@ -2,12 +2,18 @@
 judged against at t_final, with its own error stated.
 
 - A decay is exact: the conservative plume (core/reference.py) times exp(-lambda t), and the
-  product's mass 1 - exp(-lambda t); its error is zero.
+  product's mass 1 - exp(-lambda t), computed as -expm1(-lambda t); its error is zero.
 - A + B -> C is solved once on a fine grid in the frame moving with v, where the problem is pure
   reaction-diffusion with no numerical dispersion from advection (numerics/reaction_diffusion.py:
   Strang splitting of the closed-form kinetics around Crank-Nicolson), on three grids refined by 2
   in space and time; each quantity is Richardson-extrapolated and its error estimated from the
-  three. Where A and B start uniform and equal, this is also the well-mixed C0 / (1 + k C0 t).
+  three, or, where the observed order is far from 2 (``*_asymptotic`` false), the finest grid's
+  value with a conservative error. Where A and B start uniform and equal, this is also the
+  well-mixed C0 / (1 + k C0 t). Its cost is known before it runs (``plan``), and scene
+  validation refuses a reference past numerics/reaction_diffusion's MAX_WORK.
+
+The rule scene_reference passes the code hash of its script's imports (pipeline/codeversion.py:
+this module and numerics/reaction_diffusion.py, lazy imports included), so an edit reruns it.
 
 The reference is keyed by a digest of the physics it depends on (``digest``), as runs are, so two
 scenes of the same physics share one file (REFERENCE_PATTERN). The file carries the SHA-256 of its
@@ -67,55 +73,88 @@ def path(scene) -> str:
     return REFERENCE_PATTERN.format(digest=digest(scene))
 
 
+def _inputs(physics: dict):
+    """(reaction, source, D, v, t_final, points) of a reference's ``physics``."""
+    from ..core.sources import Source
+
+    pts = np.array([float.fromhex(p) for p in physics["points"]])
+    reaction, source = Reaction.of(physics["reaction"]), Source.of(**physics["source"])
+    return reaction, source, physics["D"], physics["v"], physics["t_final"], pts
+
+
+def _b(reaction):
+    """B as numerics/reaction_diffusion takes it: C0, or (its source, its mass)."""
+    return reaction.b_uniform if reaction.b_source is None else (reaction.b_source, reaction.b_mass)
+
+
+def plan(physics: dict):
+    """What computing the reference of ``physics`` will take, before it runs (a
+    reaction_diffusion.Plan: cells, steps, work, estimated seconds), or None for a decay's closed form."""
+    reaction, source, D, _, t, _ = _inputs(physics)
+    if reaction.kind == "decay":
+        return None
+    from ..numerics.reaction_diffusion import plan as rd_plan
+
+    return rd_plan(source, _b(reaction), D, reaction.kinetics, t)
+
+
 def compute(physics: dict) -> dict:
     """The reference of a reactive scene at t_final from its ``physics`` (what ``digest`` covers, so
     that nothing else, a target or a candidate, can change it): the product's mass and A's and C's
-    concentrations at the measurement points, each with its error estimate and observed order, and
-    the product's mass over time (SERIES times) -> a JSON-ready mapping."""
-    from ..core.sources import Source
-
-    reaction = Reaction.of(physics["reaction"])
-    source = Source.of(**physics["source"])
-    D, v, t = physics["D"], physics["v"], physics["t_final"]
-    pts = np.array([float.fromhex(p) for p in physics["points"]])
+    concentrations at the measurement points, each with its error estimate, observed order and
+    whether that order is the scheme's (``*_asymptotic``: else the finest grid's value, its error
+    stated conservatively, reaction_diffusion.richardson), and the product's mass over time (SERIES
+    times) -> a JSON-ready mapping."""
+    reaction, source, D, v, t, pts = _inputs(physics)
     times = t * np.arange(1, SERIES + 1) / SERIES
     if reaction.kind == "decay":
+        # the product 1 - exp(-lambda t) as -expm1(-lambda t): no cancellation below lambda t ~ eps
+        made = -math.expm1(-reaction.kinetics.rate * t)
         left = math.exp(-reaction.kinetics.rate * t)
         plume = source.density(pts, D, v, t)
         zero = [0.0] * pts.size
         return {
             "method": "closed form: the conservative plume times exp(-lambda t)",
-            "product_mass": 1.0 - left,
+            "product_mass": made,
             "product_error": 0.0,
             "product_order": math.nan,
+            "product_asymptotic": True,
             "points": pts.tolist(),
             "a_points": (plume * left).tolist(),
             "a_error": zero,
-            "c_points": (plume * (1.0 - left)).tolist(),
+            "a_asymptotic": [True] * pts.size,
+            "c_points": (plume * made).tolist(),
             "c_error": zero,
+            "c_asymptotic": [True] * pts.size,
             "times": times.tolist(),
             "product_series": (-np.expm1(-reaction.kinetics.rate * times)).tolist(),
             "seconds": [0.0],
         }
     from ..numerics.reaction_diffusion import reference
 
-    b = reaction.b_uniform if reaction.b_source is None else (reaction.b_source, reaction.b_mass)
-    ref = reference(source, b, D, reaction.kinetics, t, pts, v=v, times_per_run=SERIES)
-    fine = ref.fine
+    ref = reference(source, _b(reaction), D, reaction.kinetics, t, pts, v=v, times_per_run=SERIES)
+    fine, how = ref.fine, ref.plan
     return {
         "method": "Richardson extrapolation of Strang-split Crank-Nicolson on three grids, moving with v",
         "product_mass": float(ref.product_mass.value),
         "product_error": float(ref.product_mass.error),
         "product_order": float(ref.product_mass.order),
+        "product_asymptotic": bool(ref.product_mass.asymptotic),
         "points": pts.tolist(),
         "a_points": np.asarray(ref.a_points.value, dtype=float).tolist(),
         "a_error": np.asarray(ref.a_points.error, dtype=float).tolist(),
+        "a_asymptotic": np.asarray(ref.a_points.asymptotic, dtype=bool).tolist(),
         "c_points": np.asarray(ref.c_points.value, dtype=float).tolist(),
         "c_error": np.asarray(ref.c_points.error, dtype=float).tolist(),
+        "c_asymptotic": np.asarray(ref.c_points.asymptotic, dtype=bool).tolist(),
         "times": fine.times.tolist(),
         "product_series": fine.masses[:, 2].tolist(),
         "cells": int(fine.x.size),
         "steps": int(fine.n_steps),
+        "window": [how.lo, how.hi],
+        "edges_on_faces": how.aligned,
+        "kinetic_steps_capped": how.capped,
+        "estimated_seconds": how.seconds,
         "seconds": list(ref.seconds),
     }
 
@@ -189,4 +228,7 @@ def read(path: str | os.PathLike) -> dict:
             ref[name] = np.asarray(ref[name], dtype=np.float64)
     except (KeyError, TypeError, ValueError):  # whole, but of another layout
         raise ReferenceFileError(f"reference {path}: its {name} is no list of numbers; delete it and rerun") from None
+    for name in ("a_asymptotic", "c_asymptotic"):  # references written before the flag hold none
+        if name in ref:
+            ref[name] = np.asarray(ref[name], dtype=bool)
     return ref

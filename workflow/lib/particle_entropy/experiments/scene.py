@@ -458,11 +458,31 @@ def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
             )
 
 
+def _check_reference_cost(scene: Scene) -> None:
+    """SettingError naming scenes.<name>.reaction.k where the scene's reference (experiments/reactive.py)
+    would take more than numerics/reaction_diffusion's MAX_WORK: its plan, known before any job, and
+    its estimate in the message. The kinetic rule's steps are capped at that bound; what is refused
+    is a reference whose diffusion rule (r <= 1/4 on the coarsest grid) alone exceeds it."""
+    from ..numerics.reaction_diffusion import MAX_WORK, SECONDS_PER_CELL_STEP
+    from .reactive import physics, plan
+
+    how = plan(physics(scene))
+    if how is None or how.work <= MAX_WORK:
+        return
+    raise SettingError(
+        scene.key("reaction.k"),
+        scene.reaction.kinetics.k,
+        f"a reaction whose reference takes at most {MAX_WORK:.3g} cell-steps (~{MAX_WORK * SECONDS_PER_CELL_STEP:.3g} "
+        f"s); this one's would take {how.describe()}",
+    )
+
+
 def _check_reactive(scene: Scene) -> None:
     """SettingError naming a candidate that cannot carry the scene's reaction: an MTPT scheme other than
     the symmetric transfer (the authors' loop moves one species)."""
     if scene.reaction is None:
         return
+    _check_reference_cost(scene)
     for i, c in enumerate(scene.candidates):
         if c.case.method == "pt" and scene.reaction.kind == "bimolecular":
             _check_pair_probability(scene, i, c)
@@ -541,10 +561,11 @@ class Scenes(Mapping):
         return self._specs[name]
 
     def _owner(self, identity: str) -> tuple[Scene, Candidate]:
-        for scene in self.values():
+        for scene in self.values():  # each candidate, and each at half its step (an answer's check)
             for candidate in scene.candidates:
-                if scene.identity(candidate) == identity:
-                    return scene, candidate
+                for runs in (candidate, scene.half_step(candidate)):
+                    if scene.identity(runs) == identity:
+                        return scene, runs
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
 
     def settings(self, identity: str) -> dict:

@@ -162,6 +162,9 @@ def candidate_summary(rows: pd.DataFrame) -> dict:
             "cost_s": float(best["cost_s"]),
             "realisations": int(best["realisations"]),
         }
+        holds = best.get("holds_at_half_step")
+        if holds is False:  # it misses the target at half its step: the answer depends on its step
+            out["answer"]["half_step_error"] = float(best["half_step_error"])
     else:
         run = rows[rows["realisations"] > 0]
         out["answer"] = None
@@ -191,6 +194,7 @@ def scene_summary(table: pd.DataFrame) -> dict:
 def _best(summary: dict, methods: Sequence[str]) -> dict | None:
     """The cheapest answer among a scene's candidates of these methods (None: none meets the target)."""
     met = [c for c in summary["candidates"] if c["method"] in methods and c["answer"]]
+    met = [c for c in met if "half_step_error" not in c["answer"]]  # an answer that depends on its step
     return min(met, key=lambda c: c["answer"]["cost_s"], default=None)
 
 
@@ -265,7 +269,10 @@ def _answer(c: Mapping, with_label: bool = True) -> str:
     runs = f" ({a['realisations']} realisations)" if c["method"] in PARTICLES else ""
     below = a["n_below"]
     rungs = f"{symbol} = {integer(a['n'])}" if below is None else f"{symbol} in {interval(below, a['n'])}"
-    return f"{name}{rungs}, {seconds(a['cost_s'])} s{runs}"
+    step = ""
+    if "half_step_error" in a:
+        step = f", but not at half its step (error {a['half_step_error']:.2g} there): depends on its step"
+    return f"{name}{rungs}, {seconds(a['cost_s'])} s{runs}{step}"
 
 
 def scene_table(numbers: Mapping) -> str:
