@@ -204,6 +204,17 @@ def test_a_folder_or_pipe_with_a_table_name_is_set_aside_without_reading_it(tmp_
     assert corrupt_tables(tmp_path) == {pipe: "it is not a regular file"}
 
 
+def test_a_folder_in_a_table_s_place_holding_a_table_is_set_aside_whole(tmp_path):
+    """The table inside was judged after its folder had been moved aside, and the run stopped on
+    "it cannot be moved aside (No such file or directory)"."""
+    inner = tmp_path / "runs" / "a.parquet" / "inner.parquet"
+    inner.parent.mkdir(parents=True)
+    inner.write_bytes(b"PAR1 cut short")
+    lines = []
+    assert verify.set_aside_corrupt(tmp_path, report=lines.append) == [inner.parent]
+    assert (tmp_path / "runs" / "a.parquet.corrupt" / "inner.parquet").exists() and len(lines) == 1
+
+
 # --- digests remembered against size, mtime and inode (a workflow start rereads no unchanged table)
 
 HOUR_NS = 3600 * 10**9

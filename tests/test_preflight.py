@@ -79,3 +79,17 @@ def test_a_folder_that_cannot_be_written_raises_the_given_error(tmp_path, monkey
     (tmp_path / ".snakemake").write_text("a file where Snakemake keeps its state")
     with pytest.raises(Refused, match=".snakemake"):
         P.preflight(True, ["pytest"], local=True, library=tmp_path, error=Refused)
+
+
+def test_a_run_with_a_folder_at_its_lock_path_is_refused_before_any_change(tmp_path, monkeypatch):
+    class Refused(Exception):
+        pass
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "results" / ".run.lock").mkdir(parents=True)
+    bad = tmp_path / "results" / "runs" / "x.parquet"
+    bad.parent.mkdir(parents=True)
+    bad.write_bytes(b"PAR1 truncated")
+    with pytest.raises(Refused, match=r"results/\.run\.lock is no lock file \(it is a folder\)"):
+        P.preflight(False, ["snakemake", "-j2"], local=True, library=tmp_path, error=Refused)
+    assert bad.exists()  # refused before any table was judged

@@ -2,8 +2,11 @@
 to closed forms, each model's reactive run held to its conservative twin or to the reference, and
 the search judging a reactive run's table."""
 
+import json
 import math
+import os
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -298,6 +301,93 @@ def test_the_models_steps_do_not_grow_with_k_and_pt_is_refused_where_its_pair_ru
         _refused(spec(reaction={"kind": "bimolecular", "k": 1e300, "B": {"uniform": 0.5}})).name
         == "scenes.r.reaction.k"
     )
+
+
+def _written(tmp_path, **over):
+    """A decay scene's reference written at its own path below tmp_path (its physics, its path)."""
+    physics = reactive.physics(Scene.from_config("r", spec(**over)))
+    path = tmp_path / f"{reactive.key(physics)}.json"
+    reactive.write(physics, str(path))
+    return physics, path
+
+
+def test_a_reference_carries_its_checksum_and_is_read_only_when_it_is_its_own(tmp_path):
+    """Issue 50 (10): another scene's valid reference copied over a decay scene's was used (errors
+    0.331 where 2.4e-5 was true), and random bytes there ended the jobs in a UnicodeDecodeError.
+    Now a reference is read only when its checksum holds and its digest is its name's and its
+    physics'; otherwise a one-line ReferenceFileError (a TableReadError: no traceback) names it."""
+    physics, path = _written(tmp_path)
+    ref = reactive.read(path)
+    assert reactive.problem(path) is None and ref["digest"] == path.stem and len(ref["sha256"]) == 64
+    assert ref["product_mass"] == pytest.approx(1 - math.exp(-0.02 * 20.0))
+    _, other = _written(tmp_path, reaction={"kind": "decay", "rate": 0.05})
+    bad = {
+        "another scene's": other.read_bytes(),
+        "random bytes": np.random.default_rng(5).bytes(3000),
+        "cut short": path.read_bytes()[:500],
+        "edited": path.read_bytes().replace(b'"product_error": 0.0', b'"product_error": 0.5'),
+        "no checksum": path.read_bytes().replace(b'"sha256"', b'"sha257"'),
+    }
+    good = path.read_bytes()
+    for what, data in bad.items():
+        path.write_bytes(data)
+        why = reactive.problem(path)
+        assert why, what
+        with pytest.raises(reactive.ReferenceFileError) as err:
+            reactive.read(path)
+        assert str(path) in str(err.value) and "\n" not in str(err.value), what
+    assert "not its name's" in (path.write_bytes(bad["another scene's"]) and reactive.problem(path))
+    # a checksum made anew over another physics' content under this name: the physics' digest differs
+    forged = json.loads(other.read_bytes())
+    forged["digest"] = path.stem
+    forged["sha256"] = reactive.content_sha256(forged)
+    path.write_text(json.dumps(forged))
+    assert "physics' digest" in reactive.problem(path)
+    path.write_bytes(good)
+    assert reactive.problem(path) is None
+
+
+def test_a_bad_reference_is_set_aside_before_a_run_and_named(tmp_path, monkeypatch):
+    from particle_entropy.pipeline import preflight
+
+    monkeypatch.chdir(tmp_path)
+    folder = tmp_path / "results" / "scenes" / "references"
+    folder.mkdir(parents=True)
+    _, good = _written(folder)
+    _, other = _written(folder, reaction={"kind": "decay", "rate": 0.05})
+    bad = folder / "0123456789ab.json"
+    bad.write_bytes(other.read_bytes())
+    lines = []
+    assert preflight.set_aside_bad_references("results", report=lines.append) == [
+        Path("results/scenes/references/0123456789ab.json")
+    ]
+    assert good.exists() and other.exists() and not bad.exists() and (folder / "0123456789ab.json.corrupt").exists()
+    assert len(lines) == 1 and "0123456789ab.json" in lines[0] and "rebuilds it" in lines[0]
+    assert preflight.set_aside_corrupt_tables("results", look_only=True) == [
+        "results/scenes/references/0123456789ab.json"
+    ]
+
+
+def test_only_the_references_folder_s_own_entries_are_judged_and_each_is_set_aside(tmp_path, monkeypatch):
+    """A folder in a reference's place holding a .json stopped the run: the file inside was judged
+    after its folder had been moved aside, and could not be moved. Only the folder's own entries
+    are references; a folder, a link to nothing and a pipe there are each set aside, none read."""
+    from particle_entropy.pipeline import preflight
+
+    monkeypatch.chdir(tmp_path)
+    folder = tmp_path / "results" / "scenes" / "references"
+    (folder / "a.json").mkdir(parents=True)
+    (folder / "a.json" / "inner.json").write_text("{}")
+    (folder / "b.json").symlink_to(tmp_path / "nowhere")
+    os.mkfifo(folder / "c.json")  # reading it would block for ever
+    lines = []
+    moved = preflight.set_aside_bad_references("results", report=lines.append)
+    assert [p.name for p in moved] == ["a.json", "b.json", "c.json"]
+    assert ["a folder" in lines[0], "a link to nothing" in lines[1], "not a regular file" in lines[2]] == [True] * 3
+    assert (folder / "a.json.corrupt" / "inner.json").exists() and not (folder / "a.json").exists()
+    assert preflight.set_aside_corrupt_tables("results", look_only=True) == [
+        f"results/scenes/references/{n}.json" for n in "abc"
+    ]
 
 
 @pytest.mark.parametrize("lam_t", [1e-300, 1e-200, 1e-10, 1e-3])

@@ -268,7 +268,7 @@ def test_the_result_columns_are_the_documented_ones():
     assert list(S.result(scene, table).columns) == list(S.RESULT_COLUMN_DOCS)
 
 
-def test_a_budget_below_every_first_rung_answers_over_budget():
+def test_a_budget_below_every_first_rung_answers_over_budget(tmp_path):
     """Issue 39, point 13: the table of a scene that ran nothing was a KeyError; docs/scenes.md
     promises each candidate's "over budget"."""
     tiny = Scene.from_config(
@@ -282,9 +282,13 @@ def test_a_budget_below_every_first_rung_answers_over_budget():
     assert out["stopped"].str.startswith("over budget: n = ").all()
     assert not out["meets"].any() and not out["recommended"].any() and not out["comic_best"].any()
     assert out["cost_s"].tolist() == [tiny.run_cost(c, c.ladder()[0]) for c in tiny.candidates]
-    from particle_entropy.figures.scene import scene as draw
+    import matplotlib
 
-    draw(out)  # the figure says so rather than failing
+    matplotlib.use("Agg")
+    from particle_entropy.figures.scene import scene as draw
+    from particle_entropy.figures.style import save_figure
+
+    save_figure(draw(out), tmp_path / "s.png", tmp_path / "s.pdf")  # the figure says so rather than failing
 
 
 def test_the_round_cap_follows_the_longest_ladder():
@@ -614,6 +618,57 @@ def test_only_rungs_that_can_still_be_the_answer_are_refined():
     assert answers == {0: 60} == _brute_force(scene, law)  # 60 (filled) passes below 120 (refined)
     assert rows.loc[120, "realisations"] == scene.max_realisations  # settled (it passes at 32)
     assert rows.loc[480, "realisations"] < scene.max_realisations and not rows.loc[480, "meets"]
+
+
+def _texts(ax) -> str:
+    return "\n".join(t.get_text() for t in ax.texts)
+
+
+def _points(ax) -> list[tuple[float, float]]:
+    """The finite (x, y) points drawn with markers in ``ax`` (not the target line, not the caps)."""
+    return [
+        (float(x), float(y))
+        for line in ax.get_lines()
+        if line.get_marker() not in (None, "None", "", "_")  # "_": an error bar's cap
+        for x, y in zip(*line.get_data())
+        if np.isfinite(x) and np.isfinite(y)
+    ]
+
+
+def test_a_scene_whose_errors_are_nan_is_drawn_saying_so(tmp_path):
+    """Issue 50 (10): a scene table whose every candidate stopped on 'target undefined' (realisations
+    0, errors NaN) crashed plot_scene in matplotlib's log scale. It draws no point for a NaN error,
+    and panel (a) says how many it left out, with every rung or some."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from particle_entropy.experiments import reactive
+    from particle_entropy.figures.scene import scene as draw
+    from particle_entropy.figures.style import save_figure
+
+    spec = {
+        "v": 0.01,
+        "t_final": 20.0,
+        "reaction": {"kind": "decay", "rate": 0.02},
+        "target": {"measure": "rmse", "value": 0.05},
+        "candidates": [FD, MTPT],
+    }
+    scene = Scene.from_config("s", spec)
+    ref = {k: np.asarray(v) if isinstance(v, list) else v for k, v in reactive.compute(reactive.physics(scene)).items()}
+    why = "the reference's own error at the points (RMS 1) is not below the target 0.05"
+    plan = S.SceneSearch(scene, ref).round(None, [], 0)
+    out = S.with_reference(scene, S.result(scene, S.judged(scene, S.read_runs(plan, [])), why), plan, [], ref)
+    assert out["error_mean"].isna().all() and (out["realisations"] == 0).all()
+    fig = draw(out)
+    save_figure(fig, tmp_path / "nan.png", tmp_path / "nan.pdf")  # drawing it is what failed
+    assert "No point drawn: 2 without an error (NaN)" in _texts(fig.axes[0])
+    some = out.copy()
+    some.loc[0, ["error_mean", "error_lo", "error_hi", "error_upper95"]] = [0.1, 0.05, 0.15, 0.14]
+    some.loc[0, "unscored"] = ""
+    fig = draw(some)
+    save_figure(fig, tmp_path / "some.png", tmp_path / "some.pdf")
+    assert "Not drawn: 1 of 2 rungs, 1 without an error (NaN)" in _texts(fig.axes[0])
+    assert _points(fig.axes[0]) == [(some.loc[0, "cost_s"], 0.1)]
 
 
 @pytest.mark.parametrize(

@@ -1251,3 +1251,48 @@ def test_user_scenes_named_peclet_are_their_own_and_the_sweep_draws_only_its_sce
         "results/scenes/",
     )
     assert "results/scenes/peclet/round~0.parquet" in mine, mine
+
+
+DECAY_SCENE = {
+    "scenes": {
+        "decay": {
+            "D": 1.0e-3,
+            "v": 0.01,
+            "t_final": 20.0,
+            "source": {"kind": "point", "x0": 0.0},
+            "reaction": {"kind": "decay", "rate": 0.02},
+            "target": {"measure": "rmse", "value": 0.05},
+            "realisations": 2,
+            "candidates": [
+                {"method": "fd", "kernel": "implicit", "advection": "upwind", "fd_dt": 0.5, "n_range": [16, 64]},
+                {"method": "mtpt", "kernel": "collision", "eta": 1, "n_range": [30, 60]},
+            ],
+        }
+    }
+}
+
+
+def test_a_bad_reference_and_a_corrupt_scene_table_are_rebuilt_by_the_same_scenes_run(tmp_path):
+    """Issue 50 (10): another scene's valid reference copied over a decay scene's was used (rc 0,
+    errors 0.331 where 2.4e-5 was true), and a corrupt scene table was set aside but not rebuilt by
+    `snakemake scenes` (rc 0, the table missing). Both are now set aside and rebuilt in one run."""
+    from particle_entropy.experiments import reactive
+
+    work, config = tmp_path / "work", tmp_path / "decay.yaml"
+    config.write_text(yaml.safe_dump(DECAY_SCENE))
+    run_snakemake(work, "scenes", "--configfile", TINY, config)
+    table = work / "results/scenes/decay.parquet"
+    (reference,) = (work / "results/scenes/references").glob("*.json")
+    before, good = pd.read_parquet(table), reference.read_bytes()
+    physics = json.loads(good)["physics"]
+    other = tmp_path / "other.json"
+    reactive.write({**physics, "reaction": {"kind": "decay", "rate": 0.05}}, str(other))
+    shutil.copy(other, reference)  # another scene's valid reference in its place
+    table.write_bytes(table.read_bytes()[:100])  # a scene table cut short
+    proc = run_snakemake(work, "scenes", "--configfile", TINY, config)
+    out = proc.stdout + proc.stderr
+    assert f"corrupt reference {reference.relative_to(work)}: its digest" in out
+    assert "corrupt table results/scenes/decay.parquet" in out
+    assert {"scene_reference", "scene_table"} <= _planned_rules(proc)
+    assert reference.read_bytes() == good and reactive.problem(reference) is None
+    pd.testing.assert_frame_equal(pd.read_parquet(table), before)

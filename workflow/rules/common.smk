@@ -96,10 +96,35 @@ def all_targets():
     """The default target (inputs.default_targets) after the set-aside tables that a rule here
     writes: Snakemake does not rerun a job for a missing output when the output a target asked
     for exists (a figure's source data beside its PNG, a section's bootstrap table beside its
-    COMIC table). A path of an older layout, which no rule writes, is left. Called once every
-    rule is defined."""
-    rebuilt = [t for t in CORRUPT if any(r.is_producer(t) for r in workflow.rules)]
+    COMIC table). A path of an older layout, which no rule writes, is left, and so are scene
+    references (only the scenes target knows whose they are). Called once every rule is defined."""
+    references = Path(REFERENCE_PATTERN).parent.as_posix()  # the scenes target's (scene_files_set_aside)
+    rebuilt = [t for t in CORRUPT if not t.startswith(references) and any(r.is_producer(t) for r in workflow.rules)]
     return rebuilt + inputs.default_targets(CONFIG)
+
+
+def scene_files_set_aside(wildcards=None):
+    """The files of this config's scenes set aside and not yet rebuilt (CORRUPT): their tables,
+    plans, runs and references, and the Peclet sweep's data. The `scenes` target makes them, for
+    the reason all_targets gives; files of scenes no longer configured are left. Evaluated only
+    when `scenes` is planned, and each scene built only when one of its files is set aside."""
+    aside = [t for t in CORRUPT if t.startswith("results/scenes")]
+    if not aside:
+        return []
+    scenes = [SCENES[name] for name in SCENES]
+    ids = {scene.identity(c) for scene in scenes for c in scene.candidates}
+    references = {reactive_reference_path(scene) for scene in scenes if scene.reaction is not None}
+    sweep = ["results/scenes_peclet.parquet"] if config.get("scenes_peclet") else []
+
+    def ours(path):
+        parts = Path(path).parts  # results, scenes, <name>.parquet | <name> | <run digest>, ...
+        return (
+            path in references
+            or path in sweep
+            or (len(parts) > 2 and parts[2].removesuffix(".parquet") in {*SCENES, *ids})
+        )
+
+    return [t for t in aside if ours(t)]
 
 
 # summarise.smk's text is the summaries' code (a run: block, no script): it names these two, so

@@ -185,3 +185,4 @@ rule scenes:
         expand("figures/scene_{name}.png", name=SCENES),
         ["figures/scenes_peclet.png"] if config.get("scenes_peclet") else [],
         "results/scenes_numbers.json",
+        scene_files_set_aside,  # set aside before this run (pipeline/preflight.py): rebuilt now

@@ -5,7 +5,9 @@ point with its 95 % interval), the target as a line (the budget, if any, dotted)
 candidate and resolution starred; (b) COMIC at the common measurement points against resolution for
 every candidate, the COMIC-best ringed; for a reactive scene instead the product's mass against
 time: the reference, the recommended model and each candidate's finest visited rung (mean over
-seeds). Unscored runs (negative concentrations) are drawn hollow and named below.
+seeds). Unscored runs (negative concentrations) are drawn hollow and named below. A rung without
+an error (NaN: not run, as when the reference cannot judge the target) or at error 0 has no place
+on the log axis: it is not drawn, and panel (a) says how many are missing.
 """
 
 from __future__ import annotations
@@ -30,8 +32,10 @@ def scene(table: pd.DataFrame):
     name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
     labels = list(dict.fromkeys(table["label"]))
     reactive = "product_series" in table
+    drawable = _on_log_axes(table)
     for i, label in enumerate(labels):
-        rows = table[table["label"] == label].sort_values("n")
+        every = table[table["label"] == label].sort_values("n")
+        rows = every[drawable[every.index]]  # a NaN or zero error has no place on the log axis
         colour, marker = AUTO_COLOURS[i % len(AUTO_COLOURS)], AUTO_MARKERS[i % len(AUTO_MARKERS)]
         scored = rows["unscored"] == ""
         err = np.vstack([rows["error_mean"] - rows["error_lo"], rows["error_hi"] - rows["error_mean"]])
@@ -58,7 +62,7 @@ def scene(table: pd.DataFrame):
                 mec=colour,
             )
         if reactive:
-            top = rows[rows["product_series"].map(len) > 0].tail(1)
+            top = every[every["product_series"].map(len) > 0].tail(1)
             for _, r in top.iterrows():
                 bx.plot(
                     r["series_times"],
@@ -69,9 +73,10 @@ def scene(table: pd.DataFrame):
                     label=f"{label}, n = {r['n']:,}",
                 )
             continue
+        scored = every["unscored"] == ""
         bx.plot(
-            rows.loc[scored, "n"],
-            rows.loc[scored, "COMIC_points"],
+            every.loc[scored, "n"],
+            every.loc[scored, "COMIC_points"],
             color=colour,
             marker=marker,
             ms=5,
@@ -83,7 +88,7 @@ def scene(table: pd.DataFrame):
     if np.isfinite(budget):
         ax.axvline(budget, color=BLACK, ls=":", lw=1.0, label=f"budget {budget:g} s a run")
     best = table[table["recommended"]]
-    if len(best):
+    if len(best) and drawable[best.index[0]]:
         r = best.iloc[0]
         ax.plot(
             [r["cost_s"]],
@@ -109,6 +114,7 @@ def scene(table: pd.DataFrame):
             ls="none",
             label=f"COMIC-best: {r['label']}, n = {r['n']:,}",
         )
+    _say_what_is_not_drawn(ax, table, drawable, target)  # before the log scales: limits they can take
     style_axes(
         ax, "a", f"scene {name}: error against cost", MEASURE_LABEL[measure], "counted cost of one run [s]", logx=True
     )
@@ -126,7 +132,8 @@ def scene(table: pd.DataFrame):
         axes.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=1, frameon=False)
     notes = sorted({f"{lab}: {why}" for lab, why in zip(table["label"], table["unscored"]) if why})
     if not len(best):
-        closest = table[table["unscored"] == ""].sort_values("error_upper95").head(1)
+        closest = table[(table["unscored"] == "") & np.isfinite(table["error_upper95"])]
+        closest = closest.sort_values("error_upper95").head(1)
         if len(closest):
             c = closest.iloc[0]
             notes.insert(
@@ -140,6 +147,37 @@ def scene(table: pd.DataFrame):
         bottom = 0.045 * (1 + text.count("\n"))  # room for the notes; rect is (left, bottom, width, height)
         fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))
     return fig
+
+
+def _on_log_axes(table: pd.DataFrame) -> pd.Series:
+    """Which rows panel (a) can place: a finite error above 0 at a finite cost above 0."""
+    err, cost = table["error_mean"].astype(float), table["cost_s"].astype(float)
+    return np.isfinite(err) & (err > 0) & np.isfinite(cost) & (cost > 0)
+
+
+def _say_what_is_not_drawn(ax, table: pd.DataFrame, drawable: pd.Series, target: float) -> None:
+    """Name in panel (a) the rungs it cannot draw (a NaN or zero error); with none drawn, keep a
+    log axis about the target line (matplotlib cannot log-scale an axis with no positive value)."""
+    missing = int((~drawable).sum())
+    if not missing:
+        return
+    err = table["error_mean"].astype(float)
+    nan, zero = int((~np.isfinite(err)).sum()), int((err == 0).sum())
+    parts = [f"{nan} without an error (NaN)" if nan else "", f"{zero} at error 0" if zero else ""]
+    rest = missing - nan - zero
+    parts.append(f"{rest} at no positive cost" if rest else "")
+    what = " and ".join(p for p in parts if p)
+    lead = "No point drawn" if missing == len(table) else f"Not drawn: {missing} of {len(table)} rungs"
+    text = f"{lead}: {what}" if missing == len(table) else f"{lead}, {what}"
+    if missing == len(table):
+        text += "\n(the notes below say why)" if (table["unscored"] != "").any() else ""
+        low = target if np.isfinite(target) and target > 0 else 1.0
+        ax.set_ylim(low / 10, low * 10)
+        cost = table["cost_s"].astype(float)
+        cost = cost[np.isfinite(cost) & (cost > 0)]
+        ax.set_xlim(*((cost.min() / 3, cost.max() * 3) if len(cost) else (1e-4, 1.0)))
+    y = 0.8 if missing == len(table) else 0.97  # above the target line, which sits mid-axis when none is drawn
+    ax.text(0.5, y, text, transform=ax.transAxes, ha="center", va="top", fontsize=8, color="0.2")
 
 
 def _product_panel(bx, table: pd.DataFrame, best: pd.DataFrame) -> None:

@@ -78,7 +78,9 @@ def beyond_default_target(rules) -> list[str]:
     """The targets of these ``rules`` (the workflow's) outside the default one (the scenes and
     optimum searches, the mechanism figure): the crate describes those a run of this same config made."""
     by_name = {r.name: r for r in rules}
-    found = [str(f) for name in ("scenes", "optimum") if name in by_name for f in by_name[name].input]
+    found = [
+        str(f) for name in ("scenes", "optimum") if name in by_name for f in by_name[name].input if not callable(f)
+    ]
     if "plot_fig9_mechanism" in by_name:
         found += [str(f) for f in by_name["plot_fig9_mechanism"].output]
     return found

@@ -27,13 +27,15 @@ import os
 import re
 import sys
 from collections.abc import Mapping, Sequence
+from functools import partial
 from pathlib import Path
 
 from ..core.case import Case
+from ..experiments import reactive
 from ..numerics.compiled import kernels_folder
 from .crate import crate_folder_problem
 from .invocation import runs_no_job, snakemake_options
-from .runlock import FolderBusy, hold
+from .runlock import LockRefused, hold
 from .sweeps import RUN_PATTERN, SUMMARY_PATTERN
 from .verify import (
     CORRUPT_SUFFIX,
@@ -43,6 +45,7 @@ from .verify import (
     folder_problems,
     numba_cache_folders,
     numba_cache_problem,
+    set_aside,
     set_aside_corrupt,
     tables_below,
 )
@@ -98,16 +101,57 @@ def crate_requested(options: Mapping | None) -> bool:
     return any(t == "crate" or Path(t).as_posix().startswith(CRATE_DIR) for t in options.get("targets") or [])
 
 
-def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS, error=RuntimeError) -> list[str]:
-    """Move the corrupt tables below ``root`` aside (see the module) and return the tables set
-    aside, now or before, and not yet rebuilt. ``look_only``: read no table and move none, only
-    name those set aside before. A table that cannot be moved (a read-only results/): ``error``."""
-    if not look_only:
+# a reactive scene's references (experiments/reactive.py), below results/: checked as tables are
+REFERENCES = Path(reactive.REFERENCE_PATTERN).parent.relative_to("results")
+
+
+def references_in(root="results", suffix=".json") -> list[Path]:
+    """The entries of the references folder below ``root`` whose names end in ``suffix``, sorted:
+    only its own (REFERENCE_PATTERN is flat), never what a folder in a reference's place holds."""
+    folder = Path(root) / REFERENCES
+    try:
+        names = os.listdir(folder)
+    except OSError:  # no reference yet, or no folder there: the scene_reference job says so
+        return []
+    return sorted(folder / name for name in names if name.endswith(suffix))
+
+
+def set_aside_bad_references(root="results", report=print) -> list[Path]:
+    """Set aside (verify.set_aside) every reference file below ``root`` that reactive.problem
+    refuses (damaged, no or a wrong checksum, another physics' file copied in), reporting each in
+    one line, so that the run rebuilds it; returns those moved. Every file is read each time: they
+    are few and small. One that cannot be moved raises TableError."""
+    moved = []
+    for path in references_in(root):
+        problem = reactive.problem(path)
+        if problem is None:
+            continue
         try:
-            set_aside_corrupt(root, digests, named_columns, report=lambda line: print(line, file=sys.stderr))
+            target = set_aside(path)
+        except OSError as e:
+            raise TableError(
+                f"corrupt reference {path}: {problem}; it cannot be moved aside ({e.strerror or e}): "
+                "make its folder writable, or delete it, and rerun"
+            ) from None
+        report(f"corrupt reference {path}: {problem}; moved to {target.name}; the scenes target rebuilds it")
+        moved.append(path)
+    return moved
+
+
+def set_aside_corrupt_tables(root="results", look_only=False, digests=DIGESTS, error=RuntimeError) -> list[str]:
+    """Move the corrupt tables and references below ``root`` aside (see the module) and return
+    those set aside, now or before, and not yet rebuilt. ``look_only``: read no file and move
+    none, only name those set aside before. One that cannot be moved (a read-only results/):
+    ``error``."""
+    if not look_only:
+        report = partial(print, file=sys.stderr)
+        try:
+            set_aside_corrupt(root, digests, named_columns, report=report)
+            set_aside_bad_references(root, report=report)
         except TableError as e:
             raise error(str(e)) from None
     aside = tables_below(root, f".parquet{CORRUPT_SUFFIX}")
+    aside += references_in(root, f".json{CORRUPT_SUFFIX}")
     missing = [str(p)[: -len(CORRUPT_SUFFIX)] for p in aside]
     return sorted(m for m in missing if not Path(m).exists())
 
@@ -136,7 +180,7 @@ def preflight(
     if not look_only:
         try:
             note = hold("results")
-        except FolderBusy as e:
+        except LockRefused as e:
             raise error(str(e)) from None
         if note:
             print(note, file=sys.stderr)

@@ -262,6 +262,8 @@ def set_aside_corrupt(root, digests=None, expected=None, report=print) -> list[P
     further change."""
     moved = []
     for path, problem in corrupt_tables(root, digests, expected).items():
+        if not os.path.lexists(path):  # inside a folder in a table's place, set aside before it
+            continue
         try:
             target = set_aside(path)
         except OSError as e:
