@@ -561,9 +561,12 @@ class Scenes(Mapping):
         return self._specs[name]
 
     def _owner(self, identity: str) -> tuple[Scene, Candidate]:
-        for scene in self.values():  # each candidate, and each at half its step (an answer's check)
-            for candidate in scene.candidates:
-                for runs in (candidate, scene.half_step(candidate)):
+        # each candidate's runs first; only then those at half a step (an answer's check), whose
+        # candidates a particle's resolved first step must be built for
+        for halved in (False, True):
+            for scene in self.values():
+                for candidate in scene.candidates:
+                    runs = scene.half_step(candidate) if halved else candidate
                     if scene.identity(runs) == identity:
                         return scene, runs
         raise KeyError(f"no scene candidate has runs keyed {identity!r}")
