@@ -121,13 +121,15 @@ def _law(ci, n, seed):
 
 
 def _scene_runs(plan: pd.DataFrame) -> pd.DataFrame:
+    """The runs of a scene's plan as read_runs gives them: a row per seed (a half step's error: the same law)."""
     rows = []
     for r in plan.itertuples():
         for seed in range(int(r.first), int(r.last) + 1):
             e = _law(r.candidate, r.n, seed)
             rows.append(
                 {
-                    **{"candidate": r.candidate, "n": r.n, "seed": seed, "SSE_points": 15 * e * e},
+                    **{"candidate": r.candidate, "n": r.n, "half_step": r.half_step, "seed": seed},
+                    "SSE_points": 15 * e * e,
                     **{"COMIC_points": math.log(e), "H_C": 0.0, "H_C_analytic": 0.0, "E": 1.0, "E_analytic": 1.0},
                     **{"mass_min": 0.0, "negative_step": -1, "negative_t": math.nan, "negative_dt": math.nan},
                     **{"mass_total": 1.0, "dV": 0.1, "work": 100.0 * r.n, "steps": 100.0, "core_s": 0.01},
@@ -149,18 +151,47 @@ def _scene(value: float) -> Scene:
     [(0.01, 0, 14, 5, "97aa8e6fc5beaff3"), (0.002, 3, 16, 5, "247692b46caea620"), (0.03, 0, 18, 7, "6add29fd08eccf64")],
 )
 def test_scene_plans_are_those_of_the_code_before_the_engine(value, seed, rows, last, digest):
+    """The plan's own rungs are the frozen plan of the code before the engine; the answer's check at half
+    its step (added since) is one more row per answer, the answer's rung on its own seed blocks."""
     search = S.SceneSearch(_scene(value))
     plan, written = search.first_plan(seed), 1
     while not plan["done"].all():
+        assert written < search.max_plans, "the search did not stop within max_plans"
         previous = plan
         plan = search.next_plan(plan, _scene_runs(plan), seed)
         written += 1
         # a plan continues the one before: its rows first, unchanged, then the new round's
         assert plan.iloc[: len(previous)].drop(columns="done").equals(previous.drop(columns="done"))
         assert (plan.iloc[len(previous) :]["round"] == E.next_round(previous)).all()
-    assert (len(plan), int(plan["round"].max()), _digest(plan)) == (rows, last, digest)
+    own, checks = plan[~plan["half_step"]], plan[plan["half_step"]]
+    frozen = own.drop(columns="half_step")
+    assert (len(frozen), int(frozen["round"].max()), _digest(frozen)) == (rows, last, digest)
+    table = S.judged(search.scene, _scene_runs(own))
+    for ci, cand in enumerate(search.scene.candidates):
+        passing = table[(table["candidate"] == ci) & table["meets"]]
+        mine = checks[checks["candidate"] == ci]
+        if passing.empty:
+            assert mine.empty
+            continue
+        answer = own[(own["candidate"] == ci) & (own["n"] == passing["n"].min())]
+        assert mine[["n", "first", "last"]].values.tolist() == answer[["n", "first", "last"]].values.tolist()
+        assert (mine["label"] == search.scene.half_step(cand).label).all()
+    assert len(checks) >= 1
     assert written <= search.max_plans == S.max_rounds(search.scene)
     assert list(plan.columns) == S.PLAN_COLUMNS
+
+
+def test_a_scene_search_refuses_runs_that_would_make_it_repeat_itself():
+    """Runs that hide which are half-step checks would replan the same check every round: refused."""
+    search = S.SceneSearch(_scene(0.01))
+    plan = search.first_plan(0)
+    while not plan["half_step"].any():
+        plan = search.next_plan(plan, _scene_runs(plan), 0)
+    with pytest.raises(ValueError, match="'half_step' column"):
+        search.next_plan(plan, _scene_runs(plan).drop(columns="half_step"), 0)
+    hidden = _scene_runs(plan).assign(half_step=False)  # the checks read as the rung's own runs
+    with pytest.raises(RuntimeError, match=r"would run fd implicit upwind dt=0.025 at n = 256 on seeds 0-0 again"):
+        search.next_plan(plan, hidden, 0)
 
 
 def test_seed_blocks_follow_the_runs_a_point_has():
