@@ -367,7 +367,7 @@ def next_plan(
     if undefined:
         return new_plan(rows, PLAN_COLUMNS, done=True)
     if runs is not None and len(runs) and "half_step" not in runs:
-        raise ValueError("a scene's runs need their 'half_step' column (read_runs): without it no answer's check is seen")
+        raise ValueError("a scene's runs need their 'half_step' column (read_runs): without it no check is seen")
     table = judged(scene, runs) if runs is not None and len(runs) else pd.DataFrame(columns=JUDGED_COLUMNS)
     planned = {(r["candidate"], r["n"], r["half_step"], r["first"], r["last"]) for r in rows}
     added = False
@@ -381,7 +381,8 @@ def next_plan(
             label = scene.half_step(cand).label if at_half else cand.label
             row = {"candidate": ci, "label": label, "n": int(n), "half_step": at_half, "first": lo, "last": hi}
             if (ci, int(n), at_half, lo, hi) in planned:  # a search that repeats a run would never end
-                raise RuntimeError(f"scene {scene.name}: round {k} would run {label} at n = {n} on seeds {lo}-{hi} again")
+                where = f"{label} at n = {n} on seeds {lo}-{hi}"
+                raise RuntimeError(f"scene {scene.name}: round {k} would run {where} again")
             rows.append({**row, "round": k})
             added = True
     return new_plan(rows, PLAN_COLUMNS, done=not added)
