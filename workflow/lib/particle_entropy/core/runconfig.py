@@ -12,6 +12,7 @@ import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
+from .reactions import Reaction
 from .reference import Reference
 from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION, DEFAULT_KERNEL
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
@@ -168,10 +169,15 @@ class RunConfig:
     window: float | None = None  # the measurement points' span: None = the paper's (at rest) or fd_length
     # FD in a flow: the step that follows the grid, dt0 = courant dx / |v| (resolved()); None: dt0 as given
     courant: float | None = None
+    # an operator applied after each transport step (core/reactions.Reaction: its kinetics and B), or None:
+    # a conservative run of one species
+    reaction: Reaction | None = None
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
             object.__setattr__(self, "source", Source.of(**self.source))
+        if isinstance(self.reaction, Mapping):
+            object.__setattr__(self, "reaction", Reaction.of(self.reaction))
 
     @classmethod
     def of(

@@ -233,8 +233,7 @@ class Scene:
     def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
         """The checked run of a candidate at resolution n."""
         settings = self.settings(candidate)
-        settings.pop("reaction", None)  # the transport's run; a reactive run adds its reaction (models/reactive_run.py)
-        settings["source"] = self.source
+        settings["source"], settings["reaction"] = self.source, self.reaction
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
     def half_step(self, candidate: Candidate) -> Candidate:
@@ -408,7 +407,7 @@ def _reaction(name: str, spec) -> Reaction | None:
         raise SettingError(_key(name, f"reaction.{e.param}"), e.value, e.allowed) from None
 
 
-# what a candidate of a reactive scene may be: the models that carry a reaction (models/reactive_run.py)
+# what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 
 
@@ -439,14 +438,14 @@ def _check_species_b(name: str, reaction: Reaction, source: Source, width: float
 def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
     """SettingError naming a PT candidate's resolutions where Benson & Meerschaert's pair probability
     k m_p dt v(0) (m_p = 1 / N, v(0) = 1 / sqrt(8 pi D dt)) exceeds 1 at its largest step: it holds
-    from N >= k sqrt(dt / (8 pi D)) on (models/reactive.max_pair_probability)."""
+    from N >= k sqrt(dt / (8 pi D)) on (models/reaction_step.max_pair_probability)."""
     from ..core.timegrid import time_steps
-    from ..models.reactive import max_pair_probability
+    from ..models.reaction_step import max_pair_probability
 
     k = scene.reaction.kinetics.k
     for n in (c.n_lo, *c.rungs):
         cfg = scene.run_config(c, n)
-        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # reactive_run's grid
+        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # the runner's grid
         if max_pair_probability(k, 1.0 / n, scene.D, dt) > 1.0:
             least = math.ceil(k * math.sqrt(dt / (8.0 * math.pi * scene.D)))
             key = "ladder" if c.rungs else "n_range"

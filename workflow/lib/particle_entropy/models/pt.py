@@ -118,6 +118,17 @@ def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator, v: float 
     return x + step if v == 0.0 else (x + v * dt) + step
 
 
+def step(xs: list[np.ndarray], D: float, dt: float, rng: np.random.Generator, v: float = 0.0, period=None) -> list:
+    """One step of every species' particles (``xs``, one position array each, walked in order): the
+    walk, then folded into the periodic [0, period) (a reaction's domain, in the frame moving with v),
+    or sorted (the reconstructions need the order)."""
+    out = []
+    for x in xs:
+        x = walk(x, D, dt, rng, v)
+        out.append(np.sort(x) if period is None else np.mod(x, period))
+    return out
+
+
 def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     """Particle positions, masses and the reconstructed concentration at each particle."""
     h = reconstruction_width(cfg, t)
