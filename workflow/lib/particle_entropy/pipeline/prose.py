@@ -276,7 +276,7 @@ def _answer(c: Mapping, with_label: bool = True) -> str:
 
 
 def scene_table(numbers: Mapping) -> str:
-    """The README's scene table: per scene its Peclet number, target, the cheapest candidate that
+    """The scene table of docs/scenes.md: per scene its Peclet number, target, the cheapest candidate that
     meets it, every other candidate's answer and the COMIC-best rung."""
     lines = [
         "| scene | Péclet v L / D | target at t_final | cheapest that meets it (interval of n, counted cost a run) "
@@ -298,7 +298,7 @@ def scene_table(numbers: Mapping) -> str:
 
 
 def sweep_table(numbers: Mapping) -> str:
-    """The README's Peclet sweep: per Peclet number the cheapest grid and particle answers."""
+    """The Peclet sweep of docs/scenes.md: per Peclet number the cheapest grid and particle answers."""
     lines = [
         "| Pe | best grid: scheme, n, grid Péclet, Courant, counted cost | best particles: N, counted cost | cheaper |",
         "|---:|---|---|---|",
