@@ -10,7 +10,7 @@ stays put if the config moves): a Gaussian A (x0 0, sd 0.02) carried by v 0.5 wi
 scene of config.yaml (--config): boxes of A and B side by side, carried 10 L, target |product| 0.02.
 The candidates are the benchmark's own, each at one resolution (--n KEY=N; defaults below, the FD
 ones the rung each scene recommends): FD TVD at Courant 0.75 and FD upwind at Courant 0.5 (n), MTPT
-collision eta 1 and PT adaptive (N), the particles at dt_growth 1.05 (MTPT) and 1.01 (PT).
+collision eta 1 and PT adaptive (N), MTPT at the default dt_growth (run_settings.DT_GROWTH), PT at 1.01.
 
 Steps: each candidate runs at its own step and at that step halved --halvings times (KEY=COUNT),
 as Scene.half_step halves it: FD's Courant number; a particle's dt0 and growth - 1, which halves

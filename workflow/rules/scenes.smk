@@ -142,8 +142,8 @@ rule plot_scenes_peclet:
         "../scripts/plot_scenes_peclet.py"
 
 
-# The numbers the README quotes from the scene tables (pipeline/prose.py): docs/numbers.json is this
-# file of a finished paper run, and `prose --check` holds the README and docs/ to it.
+# The numbers the README and docs/scenes.md quote from the scene tables (pipeline/prose.py):
+# docs/numbers.json is this file of a finished paper run, and `prose --check` holds the pages to it.
 rule scene_numbers:
     input:
         expand("results/scenes/{name}.parquet", name=SCENES),

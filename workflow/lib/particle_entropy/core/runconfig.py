@@ -193,7 +193,7 @@ class RunConfig:
         **settings,
     ) -> RunConfig:
         """A run from the case's dimensions and ``settings``; an unset (or None) kernel or
-        dt_growth takes the method's default (DEFAULT_KERNEL; 1.05 for particles, 1 for FD)."""
+        dt_growth takes the method's default (DEFAULT_KERNEL; run_settings.DT_GROWTH for particles, 1 for FD)."""
         case = Case(
             method,
             DEFAULT_KERNEL.get(method) if kernel is None else kernel,
