@@ -12,6 +12,7 @@ from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 from .conservation import check_particle_mass
+from .walk import walk
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -41,7 +42,7 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
         x = x + cfg.v * dt
     d_walk = (1.0 - cfg.eta) * cfg.D
     if d_walk > 0:
-        x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
+        x = walk(x, d_walk, dt, rng)
         order = np.argsort(x, kind="stable")
         x, m, label = x[order], m[order], label[order]
     sigma, beta = kernel_for_step(cfg, dt, t_end)  # (0, 0) when eta D = 0

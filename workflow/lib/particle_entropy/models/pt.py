@@ -112,12 +112,6 @@ def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
     return cfg.source.positions(cfg.n, rng)
 
 
-def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator, v: float = 0.0) -> np.ndarray:
-    """Random-walk step X <- X + v dt + sqrt(2 D dt) xi (the Ito equation of Section 2)."""
-    step = math.sqrt(2.0 * D * dt) * rng.standard_normal(x.size)
-    return x + step if v == 0.0 else (x + v * dt) + step
-
-
 def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
     """Particle positions, masses and the reconstructed concentration at each particle."""
     h = reconstruction_width(cfg, t)

@@ -38,6 +38,7 @@ import numpy as np
 from ..core.reactions import Bimolecular, Decay, decay_factor  # noqa: F401  (the kinetics, re-exported)
 from ..numerics.kernels import beta_sph, collision_sigma
 from .conservation import MassError
+from .walk import walk
 
 A, B, C = 0, 1, 2  # rows of an MTPT particle's masses
 # PT pairs farther apart than this many standard deviations of their separation (sqrt(4 D dt)) are
@@ -167,7 +168,7 @@ def mtpt_step(
     before = _conserved(reaction, masses)
     d_walk = (1.0 - eta) * D
     if d_walk > 0.0:
-        x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
+        x = walk(x, d_walk, dt, rng)
         if domain is not None:
             x = reflect(x, *domain)
         order = np.argsort(x, kind="stable")
@@ -254,10 +255,9 @@ def pt_step(xa, xb, xc, reaction, m_p: float, D: float, dt: float, length: float
     ``reaction`` (Decay or Bimolecular) removes the reacted ones and adds C particles
     -> (xa, xb, xc). Raises MassError when a count the reaction conserves (A + C, and B + C or B) changed."""
     before = reaction.conserved(float(xa.size), float(xb.size), float(xc.size))
-    s = math.sqrt(2.0 * D * dt)
-    xa = np.mod(xa + s * rng.standard_normal(xa.size), length)
-    xb = np.mod(xb + s * rng.standard_normal(xb.size), length)
-    xc = np.mod(xc + s * rng.standard_normal(xc.size), length)
+    xa = np.mod(walk(xa, D, dt, rng), length)
+    xb = np.mod(walk(xb, D, dt, rng), length)
+    xc = np.mod(walk(xc, D, dt, rng), length)
     keep_a, keep_b, new_c = particle_reaction(reaction, xa, xb, m_p, D, dt, length, rng)
     xa, xb, xc = xa[keep_a], xb[keep_b], np.concatenate([xc, new_c])
     after = reaction.conserved(float(xa.size), float(xb.size), float(xc.size))

@@ -13,6 +13,7 @@ from ..core import measures as M
 from ..core.records import Recorder, arrow_table
 from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
+from .walk import walk
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -85,7 +86,7 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> d
     _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        x = np.sort(pt.walk(x, cfg.D, dt, rng, cfg.v))
+        x = np.sort(walk(x, cfg.D, dt, rng, cfg.v))
         _row(rec, cfg, k, t, dt, pt.measure(cfg, x, t))
     return pt.final_state(cfg, x, t)
 
