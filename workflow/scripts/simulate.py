@@ -20,7 +20,7 @@ w = snakemake.wildcards
 cfg = RunConfig.for_case(Case.from_wildcards(w), **snakemake.params.settings).resolved()
 reference = None
 if cfg.reaction is not None:
-    from particle_entropy.experiments.reactive import read
+    from particle_entropy.core.reference_file import read
 
     reference = read(snakemake.input.reference)
 seeds = range(int(w.first), int(w.last) + 1)

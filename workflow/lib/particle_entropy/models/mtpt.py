@@ -12,6 +12,7 @@ from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 from .conservation import check_particle_mass
+from .walk import walk as ito_walk
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -37,7 +38,7 @@ def walk(x, m, label, d_walk: float, dt: float, rng: np.random.Generator, domain
     """The random walk with ``d_walk`` = (1 - eta) D of every particle (reflected into ``domain`` (lo, hi)
     when given), re-sorted -> (x, m, label); ``m`` (N,) or (species, N), its columns moved with x."""
     if d_walk > 0:
-        x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
+        x = ito_walk(x, d_walk, dt, rng)
         if domain is not None:
             x = reflect(x, *domain)
         order = np.argsort(x, kind="stable")

@@ -11,6 +11,7 @@ from ..core.runconfig import RunConfig
 from ..numerics import gauss
 from ..numerics.gauss import gauss_transform
 from ..numerics.kernels import h_de
+from .walk import walk
 
 
 def reconstruction_width(cfg: RunConfig, t: float) -> float:
@@ -110,12 +111,6 @@ def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
     if cfg.at_rest:
         return np.zeros(cfg.n)
     return cfg.source.positions(cfg.n, rng)
-
-
-def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator, v: float = 0.0) -> np.ndarray:
-    """Random-walk step X <- X + v dt + sqrt(2 D dt) xi (the Ito equation of Section 2)."""
-    step = math.sqrt(2.0 * D * dt) * rng.standard_normal(x.size)
-    return x + step if v == 0.0 else (x + v * dt) + step
 
 
 def step(xs: list[np.ndarray], D: float, dt: float, rng: np.random.Generator, v: float = 0.0, period=None) -> list:
