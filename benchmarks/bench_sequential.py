@@ -27,7 +27,7 @@ import numpy as np
 
 from particle_entropy.core.run_settings import DT_GROWTH
 from particle_entropy.numerics import sequential_kernels
-from particle_entropy.numerics.kernels import collision_sigma
+from particle_entropy.numerics.bandwidths import collision_sigma
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import sequential_reference  # noqa: E402  (the loop before issue 20, kept as the tests' reference)

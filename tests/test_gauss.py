@@ -9,8 +9,8 @@ import pytest
 from conftest import dense_kernel
 
 from particle_entropy.numerics import fastexp, gauss, gauss_kernels
+from particle_entropy.numerics.bandwidths import CUTOFF_SIGMAS
 from particle_entropy.numerics.gauss import gauss_transform
-from particle_entropy.numerics.kernels import CUTOFF_SIGMAS
 
 # Both methods drop pairs farther apart than CUTOFF_SIGMAS sigma (documented); each dropped
 # term is below exp(-CUTOFF_SIGMAS^2 / 2) |q_j|. The error bound used below is therefore

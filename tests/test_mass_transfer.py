@@ -238,7 +238,7 @@ def _variance_added(scheme_sigma, truncation, beta=0.5, sigma=0.05):
 
 def test_truncation_loses_the_cut_variance_and_widening_restores_it():
     # a step of Eq. 19 adds beta x (kernel variance); a kernel cut at 3 widths has 0.9733 of it
-    from particle_entropy.numerics.kernels import truncated_variance_fraction as f
+    from particle_entropy.numerics.bandwidths import truncated_variance_fraction as f
 
     whole = _variance_added(lambda s: s, None)
     cut = _variance_added(lambda s: s, 3.0)

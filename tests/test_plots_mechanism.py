@@ -15,7 +15,7 @@ matplotlib.use("Agg")
 
 from particle_entropy.core.case import Case, rows_of  # noqa: E402
 from particle_entropy.figures.fig9_mechanism import fig9_mechanism, truncation_floor  # noqa: E402
-from particle_entropy.numerics.kernels import truncated_variance_fraction  # noqa: E402
+from particle_entropy.numerics.bandwidths import truncated_variance_fraction  # noqa: E402
 
 EQUATIONS = Case("mtpt", "collision", eta=1.0)
 CUT = Case("mtpt", "collision", eta=1.0, truncation=3.0)

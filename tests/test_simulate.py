@@ -14,7 +14,7 @@ from particle_entropy.core.io import write_parquet
 from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.models.simulate import run
-from particle_entropy.numerics.kernels import h_de
+from particle_entropy.numerics.bandwidths import h_de
 
 D = 1e-3
 T = 1000.0
@@ -402,7 +402,7 @@ def test_sequential_collision_runs_conserve_mass(scheme):
 
 
 def test_compensated_scheme_widens_the_cut_kernel():
-    from particle_entropy.numerics.kernels import collision_sigma, truncated_variance_fraction
+    from particle_entropy.numerics.bandwidths import collision_sigma, truncated_variance_fraction
 
     cfg = dict(method="mtpt", kernel="collision", n=100, t_final=1.0, truncation=3.0)
     cut, _ = run(RunConfig.of(**cfg))

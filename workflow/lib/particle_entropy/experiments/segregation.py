@@ -25,7 +25,7 @@ import numpy as np
 
 from ..core.reactions import Bimolecular
 from ..core.timegrid import steps_growing_with_time
-from ..numerics.kernels import beta_sph, collision_sigma
+from ..numerics.bandwidths import beta_sph, collision_sigma
 
 METHODS = ("pt", "mtpt")
 

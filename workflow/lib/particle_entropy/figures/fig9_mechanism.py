@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 from ..core.case import Case, rows_of
 from ..core.labels import case_label, variant_text
-from ..numerics.kernels import truncated_variance_fraction
+from ..numerics.bandwidths import truncated_variance_fraction
 from .fig9 import PAPER_STYLES as FIG9_STYLES
 from .style import (
     BLACK,

@@ -10,7 +10,7 @@ import numpy as np
 from ..core import measures as M
 from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
-from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
+from ..numerics.bandwidths import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 from .conservation import check_particle_mass
 from .walk import walk as ito_walk
 

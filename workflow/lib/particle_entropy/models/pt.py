@@ -9,8 +9,8 @@ import numpy as np
 from ..core import measures as M
 from ..core.runconfig import RunConfig
 from ..numerics import gauss
+from ..numerics.bandwidths import h_de
 from ..numerics.gauss import gauss_transform
-from ..numerics.kernels import h_de
 from .walk import walk
 
 

@@ -1,4 +1,4 @@
-"""Kernels and sums that the models call: kernel widths, weights and cut-offs (`kernels`: Eqs. 17,
+"""Kernels and sums that the models call: kernel widths, weights and cut-offs (`bandwidths`: Eqs. 17,
 20, 23, 26), exact windowed and fast Gauss transforms without an N x N matrix (`gauss`), the
 symmetric mass transfer (`mass_transfer`: Eqs. 16-21; several species by one P),
 the authors' sequential pairwise loop (`sequential`), the vectorising exp they share (`fastexp`), the

@@ -34,8 +34,8 @@ import math
 import numpy as np
 
 from ..core.registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE
+from .bandwidths import cutoff_radius
 from .compiled import kernels
-from .kernels import cutoff_radius
 
 P_TERMS = 24
 # Box widths of the fast Gauss transform, in sigma, that fgt_plan chooses from: wide boxes

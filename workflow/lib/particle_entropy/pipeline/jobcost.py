@@ -19,7 +19,7 @@ import numpy as np
 from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..core.runcost import StepWork
-from ..numerics.kernels import collision_sigma, cutoff_radius, h_sph
+from ..numerics.bandwidths import collision_sigma, cutoff_radius, h_sph
 
 STEP_S = {"fd": 3e-5, "pt": 5e-5, "mtpt": 8e-5}  # a step's own cost (measures, records) [s]
 UNIT_S = {"fd": 1.5e-8, "pt": 3e-8, "mtpt": 2.5e-7}  # per node or particle and step [s]

@@ -1,4 +1,5 @@
-"""Kernel widths of the paper: collision kernel (Eq. 17), h_DE (Eq. 23), h_SPH (Eq. 26)."""
+"""Kernel widths (bandwidths) of the paper: collision kernel (Eq. 17), h_DE (Eq. 23), h_SPH (Eq. 26);
+the compiled loops are the *_kernels modules."""
 
 from __future__ import annotations
 

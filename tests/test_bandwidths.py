@@ -13,7 +13,7 @@ from particle_entropy.core.sources import Source
 from particle_entropy.models.mtpt import kernel_for_step
 from particle_entropy.models.pt import reconstruction_width
 from particle_entropy.models.simulate import run
-from particle_entropy.numerics.kernels import (
+from particle_entropy.numerics.bandwidths import (
     beta_sph,
     collision_sigma,
     gaussian_pdf,
