@@ -5,6 +5,7 @@ the ladder of resolutions its search may visit (analysis/scene_search.py)."""
 
 from __future__ import annotations
 
+import copy
 import functools
 import hashlib
 import json
@@ -421,6 +422,10 @@ class Scenes(Mapping):
         self._check = check  # a further check of each built scene (the workflow's memory check)
         self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
         self._built: dict[str, Scene] = {}
+        # The jobs' lookups by digest, each filled once, a scene at a time as lookups reach it (_find):
+        self._runs: dict[str, tuple[Scene, Candidate]] = {}  # identity -> the scene and runs it keys
+        self._references: dict[str, dict] = {}  # a reference's key -> its physics
+        self._indexed: set[tuple] = set()  # the parts of scenes already in these
 
     def __getitem__(self, name: str) -> Scene:
         if name not in self._built:
@@ -442,16 +447,36 @@ class Scenes(Mapping):
         """The config of scene ``name`` as written (a Peclet scene: its base with its v)."""
         return self._specs[name]
 
+    def _find(self, index: dict, key: str, parts, add):
+        """``index[key]``, adding the scenes' ``parts`` to ``index`` in their order, each once in the
+        life of this mapping (``add(part)``), until it holds ``key``; None if no part has it. A lookup
+        thus builds the scenes only up to the one it needs (a bad scene after it blocks none of its
+        jobs), and no identity is digested twice however many jobs look one up."""
+        for part in parts:
+            if key in index:
+                break
+            if part not in self._indexed:
+                add(part)
+                self._indexed.add(part)
+        return index.get(key)
+
+    def _add_runs(self, part: tuple) -> None:
+        """The identities of one scene's candidates' runs (their half-step twins' if ``halved``); the
+        first scene and candidate of an identity keep it (equal identities: equal settings)."""
+        _, name, halved = part
+        scene = self[name]
+        for candidate in scene.candidates:
+            runs = scene.half_step(candidate) if halved else candidate
+            self._runs.setdefault(scene.identity(runs), (scene, runs))
+
     def _owner(self, identity: str) -> tuple[Scene, Candidate]:
-        # each candidate's runs first; only then those at half a step (an answer's check), whose
+        # every scene's own runs first; only then those at half a step (an answer's check), whose
         # candidates a particle's resolved first step must be built for
-        for halved in (False, True):
-            for scene in self.values():
-                for candidate in scene.candidates:
-                    runs = scene.half_step(candidate) if halved else candidate
-                    if scene.identity(runs) == identity:
-                        return scene, runs
-        raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+        parts = (("runs", name, halved) for halved in (False, True) for name in self)
+        found = self._find(self._runs, identity, parts, self._add_runs)
+        if found is None:
+            raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+        return found
 
     def settings(self, identity: str) -> dict:
         """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
@@ -469,10 +494,16 @@ class Scenes(Mapping):
         the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
         from . import reactive
 
-        for scene in self.values():
-            if scene.reaction is not None and reactive.key(physics := reactive.physics(scene)) == key:
-                return physics
-        raise KeyError(f"no reactive scene has a reference keyed {key!r}")
+        def add(part: tuple) -> None:
+            scene = self[part[1]]
+            if scene.reaction is not None:
+                physics = reactive.physics(scene)
+                self._references.setdefault(reactive.key(physics), physics)
+
+        found = self._find(self._references, key, (("reference", name) for name in self), add)
+        if found is None:
+            raise KeyError(f"no reactive scene has a reference keyed {key!r}")
+        return copy.deepcopy(found)  # the index's own stays as built
 
 
 def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
