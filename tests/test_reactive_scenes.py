@@ -73,6 +73,20 @@ def test_a_measure_the_reaction_cannot_judge_is_refused():
     assert err.name == "scenes.r.target.measure" and "makes no product" in err.allowed
 
 
+def test_a_run_too_long_for_its_steps_is_refused_by_its_key_path_before_the_reference_is_planned():
+    """The reference's points are a run's (reactive.points): its plan must wait for the runs' checks,
+    or their refusal escapes unnamed, as `dt0`."""
+    err = _refused(
+        spec(
+            reaction=MIXED,
+            t_final=1e6,
+            D=1e-9,
+            candidates=[{"method": "fd", "kernel": "implicit", "n_range": [64, 1024]}],
+        )
+    )
+    assert err.name == "scenes.r.t_final" and "what fd implicit" in err.allowed
+
+
 def test_a_reference_job_finds_its_physics_and_a_run_its_reference_by_digest():
     got = scenes(
         {

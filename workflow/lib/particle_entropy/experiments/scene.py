@@ -361,10 +361,10 @@ class Scene:
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
         scene = replace(scene, budget=budget, max_realisations=most, reaction=reaction)
-        scene_checks.check_reactive(scene)
         scene_checks.check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             c.check_runs(scene, i, s.candidates[i].model_fields_set)
+        scene_checks.check_reactive(scene)  # after the runs: the reference's points are a run's
         defined.check(scene, defined.closed_form(scene))  # a target its closed-form reference can judge
         return scene
 
