@@ -1,7 +1,9 @@
 """A scene (config `scenes.<name>`, declared by settings.SCENE): a problem of the user's own (D, a
 uniform v, a source, the observation time, the domains) with the candidate models to compare and the
 accuracy they must reach. A scene knows each candidate's runs: their settings, their identity and
-the ladder of resolutions its search may visit (analysis/scene_search.py)."""
+the ladder of resolutions its search may visit (analysis/scene_search.py). Each part checks its own
+values (a candidate here, its source and reaction in core/); the rules between the parts are in
+experiments/scene_checks.py."""
 
 from __future__ import annotations
 

@@ -26,7 +26,7 @@ HALF_DIGITS = math.sqrt(sys.float_info.epsilon)
 def check_window(key: Callable[[str], str], fd_length: float, extent: float, D: float, t_final: float) -> None:
     """SettingError naming scenes.<name>.fd_length (``key("fd_length")``) unless the window reaches
     REACH sqrt(4 D t_final) beyond the sources' extent (``extent``: the half width around A's centre
-    holding A's source and B's plume, scene.extent) on either side, as the paper's [-6, 6] at
+    holding A's source and B's plume, as scene.py's _extent gives it) on either side, as the paper's [-6, 6] at
     t = 1000: its zero ends then absorb at most 2 erfc(3) = 4.4e-5 of each species' mass by t_final
     (an upper bound: a flow only lowers it); a window of +- 1 sqrt(2 D t_final) lost a third."""
     need = 2.0 * (extent + REACH * math.sqrt(4.0 * D * t_final))
