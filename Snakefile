@@ -15,7 +15,7 @@ from particle_entropy.pipeline.configcheck import load_yaml
 # at most 1 MB, as written) before it is loaded. A --configfile was loaded, by Snakemake's command
 # line before this file runs, so it is refused here after the fact; one Snakemake cannot load at all
 # (missing, a folder, not UTF-8, nested too deep, a pipe, a device) stops there with Snakemake's own
-# error (README: "Config files"). The README: a --configfile is trusted like the Snakefile.
+# error (docs/running.md: "Config files"). The README: a --configfile is trusted like the Snakefile.
 for _config_file in (["config.yaml"] if Path("config.yaml").exists() else []) + list(workflow.overwrite_configfiles):
     load_yaml(_config_file)
 

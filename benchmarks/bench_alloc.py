@@ -27,12 +27,13 @@ import json, math, statistics, sys, time
 import numpy as np
 from particle_entropy.models import fd, mtpt
 from particle_entropy.core.runconfig import RunConfig
+from particle_entropy.core.run_settings import DT_GROWTH
 n, repeats = int(sys.argv[1]), int(sys.argv[2])
 if sys.argv[3] == "keep":
     from particle_entropy.core.heap import keep_freed_pages
     assert keep_freed_pages()
 out = {}
-D, dt, t = 1e-3, 0.01 * 1.05**174, 1000.0
+D, dt, t = 1e-3, 0.01 * DT_GROWTH**174, 1000.0
 rng = np.random.default_rng(0)
 x = np.sort(rng.uniform(-5, 5, n))
 m0 = np.exp(-x * x / (4 * D * t)); m0 /= m0.sum()

@@ -9,7 +9,7 @@ step) and ``fast`` (sequential_kernels._sweep_fma, the default, equal to it to r
 largest difference is printed, relative to the total mass). States: N positions uniform on
 [-Omega/2, Omega/2] stored in random order, a Gaussian plume of variance 2 D t as masses, the
 collision kernel at eta = 1 cut at 3 widths, at steps 100, 140 and 174 of the authors' time grid
-(dt0 = 0.01, growth 1.05): the late steps hold most of a run's pair updates. A pair update is
+(dt0 = 0.01, growth run_settings.DT_GROWTH): the late steps hold most of a run's pair updates. A pair update is
 one (i, j) exchange; the count is measured on the state, not modelled. Each timing is the least
 of ``repeats`` alternating runs (ref, exact, fast, ref, ...), after one untimed run of each;
 ``/ref`` is a form's time over the reference's.
@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from particle_entropy.core.run_settings import DT_GROWTH
 from particle_entropy.numerics import sequential_kernels
 from particle_entropy.numerics.kernels import collision_sigma
 
@@ -39,8 +40,8 @@ def state(n: int, step: int, seed: int = 0):
     """(x sorted, m, storage labels, sigma) of a collision-kernel run before ``step``."""
     rng = np.random.default_rng(seed)
     x = np.sort(rng.uniform(-OMEGA / 2, OMEGA / 2, n))
-    dt = 0.01 * 1.05**step
-    t = 0.01 * (1.05**step - 1.0) / 0.05
+    dt = 0.01 * DT_GROWTH**step
+    t = 0.01 * (DT_GROWTH**step - 1.0) / (DT_GROWTH - 1.0)
     m = np.exp(-x * x / (4.0 * D * t))
     return x, m / m.sum(), rng.permutation(n).astype(np.int64), collision_sigma(1.0, D, dt)
 

@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from particle_entropy.core.run_settings import DT_GROWTH
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.core.timegrid import time_steps
 from particle_entropy.core.timegrid import times as step_times
@@ -36,7 +37,7 @@ from particle_entropy.numerics.gauss import CUTOFF_SIGMAS, gauss_transform, neig
 from particle_entropy.numerics.mass_transfer import mass_transfer
 
 D = 1e-3
-WIDTHS = {"early": math.sqrt(4 * D * 0.01), "late": math.sqrt(4 * D * 0.01 * 1.05**174)}
+WIDTHS = {"early": math.sqrt(4 * D * 0.01), "late": math.sqrt(4 * D * 0.01 * DT_GROWTH**174)}
 MEMORY_LIMIT = 4e9  # bytes: baselines that would need more are skipped with a reason
 
 

@@ -7,7 +7,7 @@ named), the rungs calibrate_scene_costs.py would time (its ``rungs``: up to four
 ladder's low end to the highest rung counted at most --max-s) run at seed base_seed in this
 process, as the jobs run them, side by side and interleaved --repeat times: the conservative run
 of the rung's RunConfig (models/simulate.py, rule simulate_scene) and the reactive run of the same
-RunConfig with the scene's reaction (models/reactive_run.py, rule simulate_reactive_scene, judged
+RunConfig with the scene's reaction (models/simulate.py, rule simulate_scene, judged
 against the scene's reference, read from results/scenes/references/ or computed once here), after
 one untimed run of each at the candidate's lowest rung (numba's kernels loaded). Each is timed as
 calibrate_scene_costs.py times it, by the sum of its steps' times (the tables' `wall_s`), but
@@ -35,6 +35,7 @@ import os
 import statistics
 import time
 from collections import defaultdict
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -45,7 +46,7 @@ from particle_entropy.core.heap import keep_freed_pages
 from particle_entropy.core.runcost import StepWork
 from particle_entropy.experiments import reactive
 from particle_entropy.experiments.scene import scenes
-from particle_entropy.models import reactive_run, simulate
+from particle_entropy.models import simulate
 from particle_entropy.pipeline.configcheck import load_yaml
 
 
@@ -86,14 +87,14 @@ def measure(config: dict, names: list[str], max_s: float, repeat: int) -> dict[s
             picked = rungs(scene, cand, max_s)
             if picked:  # untimed: numba's kernels of both runs loaded before either is timed
                 low = scene.run_config(cand, picked[0], seed=seed)
-                simulate.run_seeds_arrow(low, [low.seed])
-                reactive_run.run_seeds_arrow(low, scene.reaction, ref, [low.seed])
+                simulate.run_seeds_arrow(replace(low, reaction=None), [low.seed])
+                simulate.run_seeds_arrow(low, [low.seed], reference=ref)
             for n in picked:
                 cfg = scene.run_config(cand, n, seed=seed)
                 cons, react = [], []
                 for _ in range(repeat):  # interleaved: both runs see the same machine
-                    cons.append(steps_cpu(simulate.run_seeds_arrow(cfg, [cfg.seed])))
-                    react.append(steps_cpu(reactive_run.run_seeds_arrow(cfg, scene.reaction, ref, [cfg.seed])))
+                    cons.append(steps_cpu(simulate.run_seeds_arrow(replace(cfg, reaction=None), [cfg.seed])))
+                    react.append(steps_cpu(simulate.run_seeds_arrow(cfg, [cfg.seed], reference=ref)))
                 step_s, work_s = transport_parts(scene, cfg)
                 row = {
                     "what": f"{name}: {cand.label} n={n}",

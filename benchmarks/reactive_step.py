@@ -10,7 +10,7 @@ stays put if the config moves): a Gaussian A (x0 0, sd 0.02) carried by v 0.5 wi
 scene of config.yaml (--config): boxes of A and B side by side, carried 10 L, target |product| 0.02.
 The candidates are the benchmark's own, each at one resolution (--n KEY=N; defaults below, the FD
 ones the rung each scene recommends): FD TVD at Courant 0.75 and FD upwind at Courant 0.5 (n), MTPT
-collision eta 1 and PT adaptive (N), the particles at dt_growth 1.05 (MTPT) and 1.01 (PT).
+collision eta 1 and PT adaptive (N), MTPT at the default dt_growth (run_settings.DT_GROWTH), PT at 1.01.
 
 Steps: each candidate runs at its own step and at that step halved --halvings times (KEY=COUNT),
 as Scene.half_step halves it: FD's Courant number; a particle's dt0 and growth - 1, which halves
@@ -19,7 +19,7 @@ dt_n = dt0 g^n = dt0 + (g - 1) t at every time. A particle may instead run the g
 --halvings times. Every step of a candidate runs the same seeds (base seed 0, 1, ...), so the
 change a halving makes is measured paired, seed by seed.
 
-Measured on each run's last row (models/reactive_run.run_arrow, judged against the scene's
+Measured on each run's last row (models/simulate.run_arrow, judged against the scene's
 reference, experiments/reactive.compute): the signed product error mass_C / M_C,ref - 1, the
 product's RMSE at the scene's points sqrt(SSE_points_C / points), and the scene's own measure
 (|product error| or that RMSE). Printed, per step: the step in force at t_final / 2, the mean of
@@ -48,7 +48,7 @@ from particle_entropy.analysis.step_error import mean_interval, observed_order  
 from particle_entropy.core.timegrid import time_steps  # noqa: E402
 from particle_entropy.experiments import reactive  # noqa: E402
 from particle_entropy.experiments.scene import Candidate, Scene  # noqa: E402
-from particle_entropy.models import reactive_run  # noqa: E402
+from particle_entropy.models import simulate  # noqa: E402
 from particle_entropy.pipeline.configcheck import load_yaml  # noqa: E402
 
 CARRIED = {
@@ -118,7 +118,7 @@ def run_level(scene: Scene, cand: Candidate, n: int, seeds: list[int], ref: dict
     for seed in seeds:
         cfg = scene.run_config(cand, n, seed=seed)
         start = time.process_time()
-        table = reactive_run.run_arrow(cfg, scene.reaction, ref)
+        table, _ = simulate.run_arrow(cfg, reference=ref)
         last = table.slice(table.num_rows - 1).to_pylist()[0]
         cpu += time.process_time() - start
         product.append(last["mass_C"] / ref["product_mass"] - 1.0)

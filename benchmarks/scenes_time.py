@@ -1,4 +1,4 @@
-"""How long `snakemake -j2 scenes` takes, and what each scene answers (the README's scene table).
+"""How long `snakemake -j2 scenes` takes, and what each scene answers (docs/scenes.md's table of answers).
 
     python benchmarks/scenes_time.py WORKDIR        # runs the scenes in WORKDIR (a finished paper run or empty)
 

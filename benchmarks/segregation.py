@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow" / "lib")
 from particle_entropy.analysis.segregation import loglog_slope, slope_interval, well_mixed_ratio  # noqa: E402
 from particle_entropy.core.reactions import well_mixed  # noqa: E402
 from particle_entropy.experiments import segregation as S  # noqa: E402
-from particle_entropy.models import reactive as R  # noqa: E402
+from particle_entropy.models import reaction_step as R  # noqa: E402
 
 
 def run_one(job: tuple[S.Segregation, int]) -> tuple[np.ndarray, np.ndarray, float]:

@@ -127,11 +127,12 @@ def test_the_module_runs_as_the_page_says():
 
 
 def test_the_readme_and_the_page_name_the_case_folder_as_the_code_builds_it():
-    """The README's output layout and this page spell a case's folder from case.CASE_DIR, every segment
-    included (a grid~ segment was once missing from both)."""
+    """The README, the full output layout and this page spell a case's folder from case.CASE_DIR, every
+    segment included (a grid~ segment was once missing from both)."""
     folder = columnsdoc.CASE_FOLDER
     assert folder.count("/") == 7 and folder.endswith("/grid~R")  # method, kernel and six dimensions
     assert folder in (ROOT / "README.md").read_text()
+    assert folder in (ROOT / "docs" / "running.md").read_text()
     assert folder in (ROOT / "docs" / "columns.md").read_text()
 
 

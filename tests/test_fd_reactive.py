@@ -1,8 +1,10 @@
-"""FD carrying a reaction (models/fd_reactive.py): a decay is the conservative run times
+"""FD carrying a reaction (the runner's FD species rows, models/fd.transport, reacted by
+models/reaction_step.react_masses): a decay is the conservative run times
 exp(-lambda t) for every transport scheme, and upwind's numerical dispersion makes more product
 than the reaction-diffusion reference where a front of A runs into a uniform B."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -10,7 +12,7 @@ import pytest
 from particle_entropy.core.reactions import Bimolecular, Decay
 from particle_entropy.core.sources import Source
 from particle_entropy.models import fd
-from particle_entropy.models.fd_reactive import run_reactive, transport_step
+from particle_entropy.models.reaction_step import react_masses
 from particle_entropy.numerics import reaction_diffusion as RD
 
 
@@ -18,6 +20,26 @@ def _nodes(lo, hi, dx):
     """FD nodes lo + k dx, k = 0..N (models/fd.grid's layout)."""
     n = round((hi - lo) / dx)
     return lo + dx * np.arange(n + 1), n
+
+
+def transport_step(solve, c):
+    """The nodes c after one FD transport step (fd.transport of one row; the ends held)."""
+    rows = np.array(c, dtype=np.float64)[None, :]
+    fd.transport(solve, rows)
+    return rows[0]
+
+
+def run_reactive(solve, a0, b0, kinetics, dt, steps, dx):
+    """``steps`` of FD at a fixed dt as the runner takes them: every species row by ``solve``, then the
+    nodes' masses reacted -> (A, B, C concentrations at the end, the product made after each step)."""
+    rows = np.vstack([a0, np.zeros_like(a0) + b0, np.zeros_like(a0)]).astype(np.float64)
+    made = np.zeros(steps + 1)
+    for k in range(1, steps + 1):
+        fd.transport(solve, rows)
+        masses = rows * dx
+        made[k] = made[k - 1] + react_masses(kinetics, masses, dx, dt, k * dt, "fd")
+        rows = masses / dx
+    return SimpleNamespace(a=rows[0], b=rows[1], c=rows[2], made=made)
 
 
 SOLVERS = {

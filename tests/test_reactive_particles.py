@@ -1,4 +1,5 @@
-"""Reactions on particles (models/reactive.py, numerics/species_transfer.py): MTPT decay against the
+"""Reactions on particles (models/reaction_step.py, the species rows of numerics/mass_transfer.py, the
+runner's steps as experiments/segregation.py runs them on its domains): MTPT decay against the
 conservative run, convergence of MTPT and PT to the well-mixed law C0 / (1 + k C0 t) as N grows,
 PT's statistics against the exact laws, and the mass bookkeeping of every step."""
 
@@ -7,13 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from particle_entropy.core.reactions import well_mixed
-from particle_entropy.models import reactive as R
+from particle_entropy.core.reactions import Bimolecular, Decay, well_mixed
+from particle_entropy.core.timegrid import steps_growing_with_time
+from particle_entropy.experiments import segregation as S
+from particle_entropy.models import pt
+from particle_entropy.models import reaction_step as R
 from particle_entropy.models.conservation import MassError
 from particle_entropy.numerics.mass_transfer import mass_transfer
-from particle_entropy.numerics.species_transfer import mass_transfer_species
 
-KERNELS = [R.CollisionKernel(), R.SPHKernel(0.005)]  # SPH: beta = 2 eta D dt / h^2 up to 2: substeps
+KERNELS = [None, 0.005]  # the collision kernel; SPH of width h: beta = 2 eta D dt / h^2 up to 2: substeps
 
 
 def _pulse(n, rng):
@@ -29,19 +32,19 @@ def test_species_transfer_moves_each_species_as_mass_transfer_does():
     rng = np.random.default_rng(0)
     x = np.sort(rng.random(300))
     m = rng.random((3, 300))
-    res = mass_transfer_species(x, m, 0.01, 0.5)
+    res = mass_transfer(x, m, 0.01, 0.5)
     for i in range(3):
         np.testing.assert_allclose(res.mass[i], mass_transfer(x, m[i], 0.01, 0.5).mass, rtol=1e-14, atol=1e-16)
 
 
 @pytest.mark.parametrize("kernel", KERNELS, ids=["collision", "sph"])
 def test_mtpt_decay_is_the_conservative_run_times_the_exponential(kernel):
-    lam, D, eta, dts = 3.0, 1e-3, 0.5, R.time_steps(0.5, 0.025)
+    lam, D, eta, dts = 3.0, 1e-3, 0.5, steps_growing_with_time(0.5, 0.025)
     runs = {}
     for rate in (0.0, lam):
         rng = np.random.default_rng(7)
         x, masses = _pulse(400, rng)
-        _, ca, _, x, masses = R.run_mtpt(x, masses, R.Decay(rate), 1 / 400, D, eta, dts, rng, kernel, (0.0, 1.0))
+        _, ca, _, x, masses = S.run_mtpt(x, masses, Decay(rate), 1 / 400, D, eta, dts, rng, kernel, (0.0, 1.0))
         runs[rate] = (x, masses, ca)
     (x0, m0, _), (x1, m1, _) = runs[0.0], runs[lam]
     np.testing.assert_array_equal(x0, x1)  # the same walks: reactions draw no random numbers
@@ -58,7 +61,7 @@ def test_mtpt_uniform_equal_masses_follow_the_well_mixed_law_to_round_off():
     x = np.sort(rng.random(n))
     masses = np.zeros((3, n))
     masses[R.A] = masses[R.B] = c0 / n
-    t, ca, cb, _, _ = R.run_mtpt(x, masses, R.Bimolecular(k), 1 / n, 1e-3, 0.5, R.time_steps(1.0, 0.1), rng)
+    t, ca, cb, _, _ = S.run_mtpt(x, masses, Bimolecular(k), 1 / n, 1e-3, 0.5, steps_growing_with_time(1.0, 0.1), rng)
     np.testing.assert_allclose(ca, c0 / (1 + k * c0 * t), rtol=1e-13)
     np.testing.assert_allclose(cb, ca, rtol=1e-13)
 
@@ -85,9 +88,9 @@ def test_mtpt_converges_to_the_well_mixed_law_as_n_grows():
     # noise of N: each particle starts with only A or only B (mtpt_uniform_labels)
     def run(n, seed):
         rng = np.random.default_rng(seed)
-        x, m = R.mtpt_uniform_labels(n, 1.0, 1.0, rng)
-        dts = R.time_steps(T_FINAL, 0.02)
-        _, ca, _, _, _ = R.run_mtpt(x, m, R.Bimolecular(K), 1 / n, D_MIX, 0.5, dts, rng, domain=(0.0, 1.0))
+        x, m = S.mtpt_uniform_labels(n, 1.0, 1.0, rng)
+        dts = steps_growing_with_time(T_FINAL, 0.02)
+        _, ca, _, _, _ = S.run_mtpt(x, m, Bimolecular(K), 1 / n, D_MIX, 0.5, dts, rng, domain=(0.0, 1.0))
         return ca[-1] - WELL_MIXED
 
     errors = _bias(run, (100, 400, 1600), 8)
@@ -97,8 +100,8 @@ def test_mtpt_converges_to_the_well_mixed_law_as_n_grows():
 
 def test_pt_converges_to_the_well_mixed_law_as_n_grows():
     def run(n, seed):
-        _, ca, _ = R.run_pt(
-            n, n, R.Bimolecular(K), 1.0, D_MIX, 1.0, R.time_steps(T_FINAL, 0.02), np.random.default_rng(seed)
+        _, ca, _ = S.run_pt(
+            n, n, Bimolecular(K), 1.0, D_MIX, 1.0, steps_growing_with_time(T_FINAL, 0.02), np.random.default_rng(seed)
         )
         return ca[-1] - WELL_MIXED
 
@@ -110,7 +113,9 @@ def test_pt_decay_matches_the_exponential_in_the_mean():
     lam, t_end, n, seeds = 2.0, 0.5, 20_000, 20
     ends = []
     for s in range(seeds):
-        _, ca, _ = R.run_pt(n, 0, R.Decay(lam), 1.0, 1e-3, 1.0, R.time_steps(t_end, 0.05), np.random.default_rng(s))
+        _, ca, _ = S.run_pt(
+            n, 0, Decay(lam), 1.0, 1e-3, 1.0, steps_growing_with_time(t_end, 0.05), np.random.default_rng(s)
+        )
         ends.append(ca[-1])
     mean, se = np.mean(ends), np.std(ends, ddof=1) / math.sqrt(seeds)
     assert abs(mean - math.exp(-lam * t_end)) < 3 * se
@@ -122,8 +127,8 @@ def test_pt_bimolecular_follows_the_well_mixed_law_at_early_time():
     n, t_end, seeds = 5000, 0.25, 10
     ends = []
     for s in range(seeds):
-        dts = R.time_steps(t_end, 5e-3)
-        _, ca, _ = R.run_pt(n, n, R.Bimolecular(K), 1.0, 1e-4, 1.0, dts, np.random.default_rng(100 + s))
+        dts = steps_growing_with_time(t_end, 5e-3)
+        _, ca, _ = S.run_pt(n, n, Bimolecular(K), 1.0, 1e-4, 1.0, dts, np.random.default_rng(100 + s))
         ends.append(ca[-1])
     wm = float(well_mixed(1.0, 1.0, K, t_end)[0])
     mean, se = np.mean(ends), np.std(ends, ddof=1) / math.sqrt(seeds)
@@ -136,38 +141,39 @@ def test_pt_bimolecular_follows_the_well_mixed_law_at_early_time():
 def test_mtpt_keeps_a_plus_c_and_b_plus_c_and_no_mass_negative(kernel):
     rng = np.random.default_rng(11)
     n = 600
-    x, m = R.mtpt_uniform_labels(n, 1.0, 1.0, rng)
+    x, m = S.mtpt_uniform_labels(n, 1.0, 1.0, rng)
     a0, b0 = m[R.A].sum(), m[R.B].sum()
     substeps = []
-    for i, dt in enumerate(R.time_steps(1.0, 0.05)):
-        x, m, s = R.mtpt_step(x, m, R.Bimolecular(5.0), 1 / n, 1e-3, 0.5, dt, rng, kernel, (0.0, 1.0), t=i)
+    for i, dt in enumerate(steps_growing_with_time(1.0, 0.05)):
+        x, m, s = S.mtpt_step(x, m, Bimolecular(5.0), 1 / n, 1e-3, 0.5, dt, rng, kernel, (0.0, 1.0), t=i)
         substeps.append(s)
     assert abs(m[R.A].sum() + m[R.C].sum() - a0) < 1e-13 * a0
     assert abs(m[R.B].sum() + m[R.C].sum() - b0) < 1e-13 * b0
     assert m.min() >= 0.0
     assert m[R.C].sum() > 0.3 * a0  # the reaction ran
-    if isinstance(kernel, R.SPHKernel):
+    if kernel is not None:
         assert max(substeps) > 1  # the split exchange was exercised
 
 
 def test_a_step_that_loses_reacted_mass_raises():
-    class Leaky(R.Bimolecular):
+    class Leaky(Bimolecular):
         def on_masses(self, ma, mb, dV, dt):
             na, nb, gained = super().on_masses(ma, mb, dV, dt)
             return na, nb, 0.5 * gained
 
     rng = np.random.default_rng(0)
-    x, m = R.mtpt_uniform_labels(100, 1.0, 1.0, rng)
+    x, m = S.mtpt_uniform_labels(100, 1.0, 1.0, rng)
     m[R.A] = m[R.B] = 0.01
     with pytest.raises(MassError, match="did not conserve A \\+ C"):
-        R.mtpt_step(x, m, Leaky(1.0), 0.01, 1e-3, 0.5, 0.1, rng)
+        S.mtpt_step(x, m, Leaky(1.0), 0.01, 1e-3, 0.5, 0.1, rng)
 
 
 def test_pt_keeps_counts_and_puts_c_between_the_pair():
     rng = np.random.default_rng(5)
     xa, xb, xc = rng.random(3000), rng.random(3000), np.empty(0)
     for _ in range(20):
-        xa, xb, xc = R.pt_step(xa, xb, xc, R.Bimolecular(1.0), 1 / 3000, 1e-4, 0.05, 1.0, rng)
+        moved = pt.step([xa, xb, xc], 1e-4, 0.05, rng, period=1.0)
+        xa, xb, xc = R.react_particles(Bimolecular(1.0), moved, 1 / 3000, 1e-4, 0.05, 1.0, rng)
     assert xa.size + xc.size == 3000 and xb.size + xc.size == 3000
     assert 0 < xc.size and np.all((xc >= 0) & (xc < 1))
 

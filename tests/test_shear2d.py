@@ -17,6 +17,7 @@ import pandas as pd
 import pytest
 from conftest import no_runtime_warnings
 
+from particle_entropy.core.records import TIMING_COLUMNS
 from particle_entropy.core.runconfig import SettingError
 from particle_entropy.core.settings import SHEAR_MAX_N as MAX_N
 from particle_entropy.models.shear2d import (
@@ -172,7 +173,7 @@ def test_mt_matches_dense_untruncated_reference():
     x, y = rng.uniform(0, cfg.length, 300), rng.uniform(0, 1, 300)
     m = rng.uniform(0, 1, 300) * (x < 3)
     m /= m.sum()
-    got, substeps, _, n_pairs = transfer_step(x, y, m, cfg)
+    got, substeps, _, n_pairs = transfer_step(np.column_stack([x, y]), m, cfg)
     assert n_pairs < 300 * 299 / 2  # the cut-off did drop pairs
 
     dx = np.abs(x[:, None] - x[None, :])
@@ -187,6 +188,73 @@ def test_mt_matches_dense_untruncated_reference():
     want = m + cfg.beta * (P @ m - m * P.sum(1))
     np.testing.assert_allclose(got, want, rtol=1e-10, atol=1e-15)
     assert kernel_cutoff(cfg) == pytest.approx(math.sqrt(2 * math.log(2e16)))
+
+
+# ---------------------------------------------------------------- the tables before the shared steps
+
+# From the code at commit 5399db0, before the walk (models/walk.py) and the transfer
+# (numerics/pair_transfer.py) were shared: run_shear(ShearConfig(case, n=2000, t_final=50, seed=0))
+# for the walks, and SMALL_HOLD for mt; floats as repr printed them.
+OLD_WALKS = {
+    "rw_nodrift": dict(
+        wall_fraction=0.173,
+        mean_y=0.5130552063816076,
+        x=[365.86174256528494, 266.42052578867384, 276.1878440788135],
+        y=[0.2010972944823712, 0.5239392016637888, 0.20500426560536017],
+        sum_x=402289.503498457,
+        sum_y=1026.1104127632152,
+    ),
+    "rw_drift": dict(
+        wall_fraction=0.089,
+        mean_y=0.49677880631059024,
+        x=[215.08534830180554, 210.93737896126908, 158.694529624494],
+        y=[0.03284340107873654, 0.770341720844198, 0.27564366346891933],
+        sum_x=391519.863940686,
+        sum_y=993.5576126211805,
+    ),
+}
+SMALL_HOLD = dict(case="mt", n=1500, t_final=30.0, seed=3, length=60.0, strip_lo=20.0, strip_hi=40.0)
+OLD_MT = dict(
+    wall_fraction=0.1015011440245978,
+    mean_y=0.5099792086566362,
+    max_offdiag_beta=0.3972440867453919,
+    mass_max=0.0020366598778004093,
+    sum_m2=0.002002796960500083,
+    sum_mx=35.23102604147818,
+)
+
+
+@pytest.mark.parametrize("case", sorted(OLD_WALKS))
+def test_random_walks_are_the_tables_before_the_shared_walk_to_the_bit(case):
+    """The shared walk draws (2, N) normals, x's row first, and adds in the old order: same bits."""
+    steps, state = run_shear(ShearConfig(case=case, n=2000, t_final=50.0, seed=0))
+    old = OLD_WALKS[case]
+    last = steps.iloc[-1]
+    assert last["wall_fraction"] == old["wall_fraction"] and last["mean_y"] == old["mean_y"]
+    assert state["x"].iloc[:3].tolist() == old["x"] and state["y"].iloc[:3].tolist() == old["y"]
+    assert state["x"].sum() == old["sum_x"] and state["y"].sum() == old["sum_y"]
+
+
+def test_mt_is_the_table_before_the_shared_transfer_to_round_off():
+    """Not to the bit (shear2d's docstring says why): the pair tensor is now (D_i + D_j)/2 of each
+    particle's D, not alpha (v_i + v_j)/2, and the weights keep the factor 1/sqrt(alpha_L alpha_T).
+    The positions take no random draws after the start, so the tables agree to round-off; the same
+    pairs and substeps to the count."""
+    steps, state = run_shear(ShearConfig(**SMALL_HOLD))
+    last = steps.iloc[-1]
+    m, x = state["mass"].to_numpy(), state["x"].to_numpy()
+    assert int(last["n_pairs"]) == 12249 and int(steps["n_pairs"].sum()) == 366667
+    assert int(steps["substeps"].sum()) == 30 and int(m.argmax()) == 246
+    got = dict(
+        wall_fraction=last["wall_fraction"],
+        mean_y=last["mean_y"],
+        max_offdiag_beta=last["max_offdiag_beta"],
+        mass_max=m.max(),
+        sum_m2=np.dot(m, m),
+        sum_mx=np.dot(m, x),
+    )
+    for key, want in OLD_MT.items():
+        assert got[key] == pytest.approx(want, rel=1e-12, abs=0.0), key
 
 
 # ---------------------------------------------------------------- walls, D = 0, settings
@@ -224,7 +292,8 @@ def test_determinism_per_seed():
         b_steps, b = run_shear(ShearConfig(seed=4, **kw))
         _, c = run_shear(ShearConfig(seed=5, **kw))
         pd.testing.assert_frame_equal(a, b)
-        pd.testing.assert_frame_equal(a_steps.drop(columns="wall_s"), b_steps.drop(columns="wall_s"))
+        timing = list(TIMING_COLUMNS)
+        pd.testing.assert_frame_equal(a_steps.drop(columns=timing), b_steps.drop(columns=timing))
         assert not np.array_equal(a["x"].to_numpy(), c["x"].to_numpy())
 
 

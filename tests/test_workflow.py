@@ -261,7 +261,7 @@ def test_more_seeds_add_only_new_blocks(tiny_run, tmp_path, tiny_config):
 
 
 # What each figure target of tests/data/tiny_config.yaml plans in an empty directory, written
-# out by hand from that file, not from the library (layout: README "Output layout"; seeds:
+# out by hand from that file, not from the library (layout: docs/running.md "Output layout"; seeds:
 # docs/architecture.md "Seeds"): results/{runs|snapshots}/<case>/seeds~A-B.parquet.
 # - <case> is method/kernel/n~N/eta~E/trunc~T/growth~G/scheme~S/grid~R. What a case leaves unset
 #   comes from case_defaults (eta 1, truncation none, dt_growth 1.3), else the paper's (scheme

@@ -228,7 +228,7 @@ def test_only_regular_files_of_bounded_size_are_read(tmp_path):
     ],
 )
 def test_snakemake_loads_a_configfile_before_the_workflow_runs(tmp_path, name, content, error):
-    """What remains uncaught (README, "Config files"): Snakemake's command line loads every
+    """What remains uncaught (docs/running.md, "Config files"): Snakemake's command line loads every
     --configfile (ConfigSettings) before the Snakefile's first line runs, so a file it cannot load
     stops there with its own error; check-config refuses each of them in one line."""
     from snakemake.settings.types import ConfigSettings

@@ -4,7 +4,11 @@
 # Their own target: `snakemake -j2 scenes`.
 
 
+# A scene's runs: conservative (kind `runs`), or with its reaction after every transport step (kind
+# `reactive`, models/simulate.py), judged against the scene's reference. One rule, the paper's script.
 rule simulate_scene:
+    input:
+        reference=lambda w: SCENES.reference_path(w.scene_id) if w.kind == "reactive" else [],
     output:
         SCENE_RUN_PATTERN,
     log:
@@ -13,7 +17,7 @@ rule simulate_scene:
         f"results/benchmarks/simulate_scene/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
     wildcard_constraints:
         scene_id=r"[0-9a-f]{12}",
-        kind="runs",
+        kind="runs|reactive",
     conda:
         "../../envs/particle-entropy.yaml"
     params:
@@ -21,29 +25,6 @@ rule simulate_scene:
         code=lambda w: SIM_CODE[w.method],
     script:
         "../scripts/simulate.py"
-
-
-# A reactive scene's runs (config scenes.<name>.reaction): the transport of simulate_scene with the
-# reaction after every step (models/reactive_run.py), judged against the scene's reference.
-rule simulate_reactive_scene:
-    input:
-        reference=lambda w: SCENES.reference_path(w.scene_id),
-    output:
-        SCENE_RUN_PATTERN,
-    log:
-        f"logs/scenes/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.log",
-    benchmark:
-        f"results/benchmarks/simulate_scene/{{scene_id}}/{{kind}}/{CASE_DIR}/seeds~{{first}}-{{last}}.tsv"
-    wildcard_constraints:
-        scene_id=r"[0-9a-f]{12}",
-        kind="reactive",
-    conda:
-        "../../envs/particle-entropy.yaml"
-    params:
-        settings=lambda w: SCENES.settings(w.scene_id),
-        code=script_code(SCRIPTS / "simulate_reactive.py"),
-    script:
-        "../scripts/simulate_reactive.py"
 
 
 # A reactive scene's reference (experiments/reactive.py), once per physics: the closed form of a
@@ -161,8 +142,8 @@ rule plot_scenes_peclet:
         "../scripts/plot_scenes_peclet.py"
 
 
-# The numbers the README quotes from the scene tables (pipeline/prose.py): docs/numbers.json is this
-# file of a finished paper run, and `prose --check` holds the README and docs/ to it.
+# The numbers the README and docs/scenes.md quote from the scene tables (pipeline/prose.py):
+# docs/numbers.json is this file of a finished paper run, and `prose --check` holds the pages to it.
 rule scene_numbers:
     input:
         expand("results/scenes/{name}.parquet", name=SCENES),

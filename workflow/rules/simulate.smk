@@ -5,7 +5,7 @@
 # what it computes. They are no input: no simulation reruns when they are rebuilt.
 
 # The code of a job: simulate.py, what it imports and its method's module, not the other methods'
-# (codeversion.simulation_code); simulate_scene (scenes.smk) runs the same code.
+# (codeversion.simulation_code); simulate_scene (scenes.smk), conservative or reactive, runs the same code.
 SIM_CODE = {m: simulation_code(m, METHODS, SCRIPTS / "simulate.py") for m in METHODS}
 
 

@@ -549,7 +549,7 @@ def run_path(scene: Scene, candidate: Candidate, n: int, first: int, last: int) 
     case = replace(candidate.case, n=int(n))
     if candidate in scene.candidates and scene.candidates.index(candidate) in scene.paper_runs:  # the paper's table
         return scene.paper_pattern.format(kind="runs", first=first, last=last, **case.wildcards())
-    kind = "runs" if scene.reaction is None else "reactive"  # rules simulate_scene, simulate_reactive_scene
+    kind = "runs" if scene.reaction is None else "reactive"  # rule simulate_scene's two kinds
     return SCENE_RUN_PATTERN.format(
         scene_id=scene.identity(candidate), kind=kind, first=first, last=last, **case.wildcards()
     )
@@ -576,7 +576,7 @@ def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
     return int(first["step"]), float(first["time"]), float(first["dt"]), smallest
 
 
-REACTIVE_ONLY = ("product_error", "SSE_points_C", "mass_lost_BC")  # a reactive run's columns (models/reactive_run)
+REACTIVE_ONLY = ("product_error", "SSE_points_C", "mass_lost_BC")  # a reactive run's columns (models/simulate.py)
 
 
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:

@@ -102,6 +102,12 @@ class Decay:
         ma = np.asarray(ma, dtype=np.float64)
         return ma * decay_factor(self.rate, dt), mb, -ma * math.expm1(-self.rate * dt)
 
+    def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng, pairs):
+        """PT's rule (A kept, B kept, new C positions): each A particle stays with probability
+        exp(-lambda dt), drawn against -expm1(-lambda dt) (> 0 however small lambda dt), its C where it was."""
+        keep = rng.random(xa.size) >= -math.expm1(-self.rate * dt)
+        return keep, np.ones(xb.size, dtype=bool), xa[~keep]
+
     @staticmethod
     def conserved(a: float, b: float, c: float) -> dict[str, float]:
         """The totals a decay keeps, from the totals of A, B and C: A + C and B."""
@@ -140,6 +146,11 @@ class Bimolecular:
         pa, pb = np.maximum(ma, 0.0), np.maximum(mb, 0.0)
         na, nb = bimolecular_step(pa, pb, self.k / dV, dt)
         return na + (ma - pa), nb + (mb - pb), bimolecular_reacted(pa, pb, self.k / dV, dt)
+
+    def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng, pairs):
+        """PT's rule (A kept, B kept, new C positions): Benson & Meerschaert's pairs on the periodic
+        [0, length), ``pairs`` (models/reaction_step.pair_reactions: the pair search is a model's)."""
+        return pairs(xa, xb, self.k, m_p, D, dt, length, rng)
 
     @staticmethod
     def conserved(a: float, b: float, c: float) -> dict[str, float]:
@@ -227,6 +238,29 @@ class Reaction:
         if "uniform" in b:
             return Reaction(Bimolecular(record["k"]), b_uniform=b["uniform"])
         return Reaction(Bimolecular(record["k"]), b_source=Source.of(**b["source"]), b_mass=b["mass"])
+
+    @property
+    def b_background(self) -> float:
+        """B's uniform concentration C0, which a model's ends hold and its transport carries B's departure
+        from; 0 for a plume of B or a decay [M/L]."""
+        return self.b_uniform if self.b_source is None else 0.0
+
+    def b_positions(self, m_p: float, length: float, lo: float, rng: np.random.Generator) -> np.ndarray:
+        """PT's B particles of mass m_p on the periodic [0, length) that starts at ``lo``: C0 length / m_p
+        uniform ones, or b_mass / m_p from B's plume; none for a decay."""
+        if not self.kinetics.CONSUMES_B:
+            return np.empty(0)
+        if self.b_source is None:
+            return rng.uniform(0.0, length, round(self.b_uniform * length / m_p))
+        return np.mod(self.b_source.positions(round(self.b_mass / m_p), rng) - lo, length)
+
+    def lost_bc(self, b_departure0: float, b_departure: float, c_total: float, scale: float) -> float:
+        """The fraction of B + C lost (through an FD window's ends) from B's initial departure from its
+        background ``b_departure0``, its departure now and C's total, over ``scale`` (B's mass, or 1 for a
+        uniform B); 0 where B is no reactant (a decay keeps B, whatever leaves)."""
+        if not self.kinetics.CONSUMES_B:
+            return 0.0
+        return (b_departure0 - (b_departure + c_total)) / scale
 
     def b_masses(self, x: np.ndarray, dV: float) -> np.ndarray:
         """B's initial mass on particles or nodes at ``x`` with spacing dV [M]: C0 dV each, or the plume's

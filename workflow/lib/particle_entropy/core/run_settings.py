@@ -16,6 +16,7 @@ from .registry import FGT_TOLERANCE, FGT_TOLERANCE_RANGE, LOOP_ARITHMETICS, SCHE
 
 MAX_SEED = 2**63 - 1  # seeds are int64 columns of every table
 NO_DEFAULT = object()  # a setting the config must give (or may leave out, with no default)
+DT_GROWTH = 1.05  # the paper's time-step growth dt_{n+1} / dt_n: every particle case's default
 
 
 @dataclass(frozen=True)
@@ -130,7 +131,7 @@ SETTINGS = (
         "numerics.transfer_tolerance",
         FGT_TOLERANCE,
         "fast Gauss transform error bound, relative to the summed |weights| within the cut-off "
-        "(1e-17 = round-off: mass conserved to 1e-13)",
+        "(the default is round-off: mass conserved to 1e-13)",
         low=FGT_TOLERANCE_RANGE[0],
         high=FGT_TOLERANCE_RANGE[1],
     ),
@@ -158,7 +159,7 @@ SETTINGS = (
     Setting(
         "dt_growth",
         "case_defaults.dt_growth",
-        1.05,
+        DT_GROWTH,
         "time-step growth factor dt_{n+1} = dt_growth dt_n (1 = fixed step time.fixed_dt; pt and mtpt only; at "
         "most 10: a larger factor reaches t_final in a few steps and overflows at 1e308)",
         low=1.0,

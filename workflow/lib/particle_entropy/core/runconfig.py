@@ -12,6 +12,7 @@ import numpy as np
 
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
+from .reactions import Reaction
 from .reference import Reference
 from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION, DEFAULT_KERNEL
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
@@ -168,10 +169,15 @@ class RunConfig:
     window: float | None = None  # the measurement points' span: None = the paper's (at rest) or fd_length
     # FD in a flow: the step that follows the grid, dt0 = courant dx / |v| (resolved()); None: dt0 as given
     courant: float | None = None
+    # an operator applied after each transport step (core/reactions.Reaction: its kinetics and B), or None:
+    # a conservative run of one species
+    reaction: Reaction | None = None
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it
             object.__setattr__(self, "source", Source.of(**self.source))
+        if isinstance(self.reaction, Mapping):
+            object.__setattr__(self, "reaction", Reaction.of(self.reaction))
 
     @classmethod
     def of(
@@ -187,7 +193,7 @@ class RunConfig:
         **settings,
     ) -> RunConfig:
         """A run from the case's dimensions and ``settings``; an unset (or None) kernel or
-        dt_growth takes the method's default (DEFAULT_KERNEL; 1.05 for particles, 1 for FD)."""
+        dt_growth takes the method's default (DEFAULT_KERNEL; run_settings.DT_GROWTH for particles, 1 for FD)."""
         case = Case(
             method,
             DEFAULT_KERNEL.get(method) if kernel is None else kernel,

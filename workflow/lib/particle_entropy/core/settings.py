@@ -685,7 +685,7 @@ SCENE = (
     ),
 )
 
-# A reactive scene's run (models/reactive_run.py) against its transport's, which `cost` prices: per
+# A reactive scene's run (models/simulate.py with its reaction) against its transport's, which `cost` prices: per
 # method, the factors on the counted cost's step part and work part, [x seconds a step, x seconds a
 # unit of work] (Scene.cost_model). MTPT moves three species through the transfer matrix and reacts
 # every particle; PT pairs A with B (Benson & Meerschaert) but draws no per-step measures; FD

@@ -95,3 +95,15 @@ def times(dt: np.ndarray, t_final: float | None = None) -> np.ndarray:
     if t_final is not None:
         t[-1] = t_final
     return t
+
+
+def steps_growing_with_time(t_end: float, dt0: float, growth: float = 0.0, dt_max: float = math.inf) -> np.ndarray:
+    """Step sizes reaching t_end exactly: dt0 while growth * t < dt0, then growth * t (steps that keep a
+    fixed fraction of the time elapsed, as the segregation runs need), never above dt_max; the last one
+    cut to land on t_end (time_steps grows each step by a factor instead)."""
+    out, t = [], 0.0
+    while t < t_end * (1.0 - 1e-12):
+        dt = min(max(dt0, growth * t), dt_max, t_end - t)
+        out.append(dt)
+        t += dt
+    return np.array(out)

@@ -46,7 +46,7 @@ SPEC = shared().Scene  # a scene's model: its keys, their ranges and the rules b
 
 SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
 USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (the schema's pattern)
-# what a candidate of a reactive scene may be: the models that carry a reaction (models/reactive_run.py)
+# what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 _CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
 
@@ -313,8 +313,7 @@ class Scene:
     def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
         """The checked run of a candidate at resolution n."""
         settings = self.settings(candidate)
-        settings.pop("reaction", None)  # the transport's run; a reactive run adds its reaction (models/reactive_run.py)
-        settings["source"] = self.source
+        settings["source"], settings["reaction"] = self.source, self.reaction
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
     def half_step(self, candidate: Candidate) -> Candidate:

@@ -98,14 +98,14 @@ def check_reactive(scene) -> None:
 def check_pair_probability(scene, i: int, c) -> None:
     """SettingError naming a PT candidate's resolutions where Benson & Meerschaert's pair probability
     k m_p dt v(0) (m_p = 1 / N, v(0) = 1 / sqrt(8 pi D dt)) exceeds 1 at its largest step: it holds
-    from N >= k sqrt(dt / (8 pi D)) on (models/reactive.max_pair_probability)."""
+    from N >= k sqrt(dt / (8 pi D)) on (models/reaction_step.max_pair_probability)."""
     from ..core.timegrid import time_steps
-    from ..models.reactive import max_pair_probability
+    from ..models.reaction_step import max_pair_probability
 
     k = scene.reaction.kinetics.k
     for n in (c.n_lo, *c.rungs):
         cfg = scene.run_config(c, n)
-        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # reactive_run's grid
+        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # the runner's grid
         if max_pair_probability(k, 1.0 / n, scene.D, dt) > 1.0:
             least = math.ceil(k * math.sqrt(dt / (8.0 * math.pi * scene.D)))
             key = "ladder" if c.rungs else "n_range"

@@ -59,6 +59,30 @@ def initial_concentration(cfg: RunConfig) -> np.ndarray:
     return cfg.source.masses(x, dx) / dx
 
 
+def transport(solve, rows: np.ndarray) -> None:
+    """One transport step of every species row of ``rows`` (species, N + 1), in place: each row's interior
+    by the step's solver ``solve`` (``solver``), its end nodes held (the zero boundary, or a background's
+    departure from itself)."""
+    for row in rows:
+        row[1:-1] = solve.solve(row[1:-1])
+
+
+def species_masses(rows: np.ndarray, dx: float, background: float) -> np.ndarray:
+    """The node masses (A, B, C) of FD's transported rows: each row's concentration times dx, B's row
+    being its departure from the uniform ``background`` [M/L] (its node mass C0 dx added back) [M]."""
+    masses = rows * dx
+    masses[1] = masses[1] + background * dx
+    return masses
+
+
+def species_rows(masses: np.ndarray, dx: float, background: float) -> np.ndarray:
+    """The inverse of species_masses: the rows FD's transport carries (concentrations; B's as its departure
+    from ``background``, which every scheme, the TVD limiter included, carries unchanged) [M/L]."""
+    rows = masses / dx
+    rows[1] = (masses[1] - background * dx) / dx
+    return rows
+
+
 def solver(cfg: RunConfig, dt: float, dx: float):
     """The solver of one step dt on the interior nodes: the case's diffusion scheme, with the
     advection term when v != 0 (implicit only)."""

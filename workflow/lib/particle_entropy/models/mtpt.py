@@ -12,6 +12,7 @@ from ..core.registry import SCHEME_RECORDS
 from ..core.runconfig import RunConfig
 from ..numerics.kernels import beta_sph, collision_sigma, h_sph, truncated_variance_fraction
 from .conservation import check_particle_mass
+from .walk import walk as ito_walk
 
 
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
@@ -33,17 +34,34 @@ def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
     return h, beta_sph(cfg.eta, cfg.D, dt, h)
 
 
+def walk(x, m, label, d_walk: float, dt: float, rng: np.random.Generator, domain=None):
+    """The random walk with ``d_walk`` = (1 - eta) D of every particle (reflected into ``domain`` (lo, hi)
+    when given), re-sorted -> (x, m, label); ``m`` (N,) or (species, N), its columns moved with x."""
+    if d_walk > 0:
+        x = ito_walk(x, d_walk, dt, rng)
+        if domain is not None:
+            x = reflect(x, *domain)
+        order = np.argsort(x, kind="stable")
+        x, m = x[order], m[..., order]
+        label = None if label is None else label[order]
+    return x, m, label
+
+
+def reflect(x: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Positions folded back into [lo, hi] by reflection at both walls (any number of crossings)."""
+    span = hi - lo
+    y = np.mod(x - lo, 2.0 * span)
+    return lo + np.where(y > span, 2.0 * span - y, y)
+
+
 def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Generator, order_rng=None):
     """Random walk with (1 - eta) D, re-sort, then one mass transfer with eta D (Eq. 19) by the
-    case's scheme -> (x, m, label, kernel width, beta, substeps). ``order_rng`` draws the
-    sequential loop's partner orders (default: ``rng``)."""
+    case's scheme, every species row of ``m`` ((N,) or (species, N)) by the same P
+    -> (x, m, label, kernel width, beta, substeps). ``order_rng`` draws the sequential loop's
+    partner orders (default: ``rng``); the authors' loop carries one species."""
     if cfg.v != 0.0:  # carried by the flow: a uniform shift leaves the order and the transfer alone
         x = x + cfg.v * dt
-    d_walk = (1.0 - cfg.eta) * cfg.D
-    if d_walk > 0:
-        x = x + math.sqrt(2.0 * d_walk * dt) * rng.standard_normal(x.size)
-        order = np.argsort(x, kind="stable")
-        x, m, label = x[order], m[order], label[order]
+    x, m, label = walk(x, m, label, (1.0 - cfg.eta) * cfg.D, dt, rng)
     sigma, beta = kernel_for_step(cfg, dt, t_end)  # (0, 0) when eta D = 0
     if sigma == 0.0 or beta == 0.0:
         return x, m, label, sigma, 0.0, 1
@@ -51,6 +69,8 @@ def step(cfg: RunConfig, x, m, label, dt: float, t_end: float, rng: np.random.Ge
     if scheme.sequential:
         from ..numerics.sequential import sequential_transfer  # a job loads only its scheme's kernels
 
+        if m.ndim != 1:
+            raise ValueError(f"scheme {cfg.scheme!r} (the authors' loop) carries one species, not {m.shape[0]}")
         m = sequential_transfer(
             x,
             m,

@@ -11,6 +11,7 @@ from ..core.runconfig import RunConfig
 from ..numerics import gauss
 from ..numerics.gauss import gauss_transform
 from ..numerics.kernels import h_de
+from .walk import walk
 
 
 def reconstruction_width(cfg: RunConfig, t: float) -> float:
@@ -112,10 +113,15 @@ def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
     return cfg.source.positions(cfg.n, rng)
 
 
-def walk(x: np.ndarray, D: float, dt: float, rng: np.random.Generator, v: float = 0.0) -> np.ndarray:
-    """Random-walk step X <- X + v dt + sqrt(2 D dt) xi (the Ito equation of Section 2)."""
-    step = math.sqrt(2.0 * D * dt) * rng.standard_normal(x.size)
-    return x + step if v == 0.0 else (x + v * dt) + step
+def step(xs: list[np.ndarray], D: float, dt: float, rng: np.random.Generator, v: float = 0.0, period=None) -> list:
+    """One step of every species' particles (``xs``, one position array each, walked in order): the
+    walk, then folded into the periodic [0, period) (a reaction's domain, in the frame moving with v),
+    or sorted (the reconstructions need the order)."""
+    out = []
+    for x in xs:
+        x = walk(x, D, dt, rng, v)
+        out.append(np.sort(x) if period is None else np.mod(x, period))
+    return out
 
 
 def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:

@@ -13,7 +13,21 @@ of advection by v_x (with periodic wrap in x):
 ``mt``          no random walk: masses exchange by Eq. 16 with the collision kernel of Eq. 17
                 written with the pair-averaged tensor D_ij = (D_i + D_j) / 2.
 
-Walkers reflect at the walls (y -> -y below 0, 2 - y above 1).
+Walkers reflect at the walls (y -> -y below 0, 2 - y above 1). This module keeps only the flow
+(``velocity``, ``dispersion``), the walls and the run; the steps are the shared ones of every
+model: the walk of models/walk.py on (N, 2) positions, the pairs of numerics/neighbours.py and the
+transfer of numerics/pair_transfer.py with per-particle tensors.
+
+The tables before these steps were shared (commit 5399db0): the walks are the same bits, since
+``walk`` draws xi as one (2, N) array, x's row first, as the shear's own walk did, and adds v dt,
+the step and the drift in its order (tests/test_shear2d.py holds them to frozen values). ``mt``
+is not the same bits, and cannot be while the transfer is the shared one: its pair tensor is
+(D_i + D_j)/2 of each particle's tensor, whose entries round as 0.5 (alpha v_i + alpha v_j)
+rather than alpha (v_i + v_j)/2, its weights keep the factor 1/sqrt(alpha_L alpha_T) that the
+old weights dropped, and its exponent sums dx^2/D_xx + dy^2/D_yy per pair. The positions of
+``mt`` take no random draws after the start, so the difference stays round-off: the same pairs
+and substeps, and, over the paper's 500 steps, masses, mean y and wall fractions within 4e-16 of
+the old ones (a test holds a small run to frozen values, relative 1e-12).
 
 Units: lengths [L], times [T], masses dimensionless (total 1). What the columns of the result
 tables mean is in pipeline/columnsdoc.py (``SHEAR_STEP_COLUMNS``, ``SHEAR_STATE_COLUMNS``), which
@@ -36,6 +50,8 @@ from ..core.run_settings import defaults
 from ..core.runconfig import SettingError, check_range, check_setting
 from ..core.shear_settings import SHEAR
 from ..core.timegrid import MAX_STEPS
+from ..numerics.neighbours import pairs_within
+from .walk import walk
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -50,6 +66,7 @@ KERNEL_TOL = 1e-16  # neglected kernel weights are below this fraction of a self
 # step must be well below the channel. The paper's is 0.022 (alpha_T = 1e-3, dt = 1): a tenth allows
 # alpha_T dt <= 0.02, 20 times it. A step as wide as the channel folds every walker onto a wall.
 STEP_FRACTION = 0.1
+PERIODIC_X = np.array([1.0, 0.0])  # times length: the periods of x and y (0: y is walled, not periodic)
 
 
 SHEAR_DEFAULTS = defaults(SHEAR)  # settings.SHEAR: each field's default, range and meaning
@@ -133,15 +150,20 @@ def velocity(y: np.ndarray) -> np.ndarray:
     return np.maximum(y - y * y, 0.0)
 
 
-def initial_state(cfg: ShearConfig, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Uniform positions over the domain; mass 1 shared equally by the particles in the strip."""
+def dispersion(y: np.ndarray, cfg: ShearConfig) -> np.ndarray:
+    """D(y) = diag(alpha_L v_x, alpha_T v_x) of each particle as (N, 2) diagonals [L^2/T]."""
+    return velocity(y)[:, None] * np.array([cfg.alpha_L, cfg.alpha_T])
+
+
+def initial_state(cfg: ShearConfig, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Uniform positions (N, 2) over the domain; mass 1 shared equally by the particles in the strip."""
     x = rng.uniform(0.0, cfg.length, cfg.n)
     y = rng.uniform(0.0, 1.0, cfg.n)
     inside = (x > cfg.strip_lo) & (x < cfg.strip_hi)
     m = np.zeros(cfg.n)
     if inside.any():
         m[inside] = 1.0 / inside.sum()
-    return x, y, m
+    return np.column_stack([x, y]), m
 
 
 def reflect(y: np.ndarray) -> np.ndarray:
@@ -150,19 +172,22 @@ def reflect(y: np.ndarray) -> np.ndarray:
     return np.where(y > 1.0, 2.0 - y, y)
 
 
-def random_walk_step(x, y, cfg: ShearConfig, rng: np.random.Generator, drift: bool):
-    """One Ito-Euler step dX = (v + [div D]) dt + B sqrt(2 dt) xi, B = diag(sqrt(alpha_L v), sqrt(alpha_T v)).
+def walls(pos: np.ndarray, cfg: ShearConfig) -> np.ndarray:
+    """Positions (N, 2) wrapped into 0 <= x < length and reflected into 0 <= y <= 1."""
+    return np.column_stack([np.mod(pos[:, 0], cfg.length), reflect(pos[:, 1])])
+
+
+def random_walk_step(pos, cfg: ShearConfig, rng: np.random.Generator, drift: bool) -> np.ndarray:
+    """One Ito-Euler step dX = (v + [div D]) dt + B sqrt(2 dt) xi of ``walk.walk`` with B B^T = D(y),
+    then the walls.
 
     div D = (0, alpha_T (1 - 2y)) for D = diag(alpha_L v_x(y), alpha_T v_x(y)); B is finite
     (zero) at the walls, so no NaN arises there.
     """
-    v = velocity(y)
-    xi = rng.standard_normal((2, x.size))
-    x_new = x + v * cfg.dt + np.sqrt(2.0 * cfg.alpha_L * v * cfg.dt) * xi[0]
-    y_new = y + np.sqrt(2.0 * cfg.alpha_T * v * cfg.dt) * xi[1]
-    if drift:
-        y_new = y_new + cfg.alpha_T * (1.0 - 2.0 * y) * cfg.dt
-    return np.mod(x_new, cfg.length), reflect(y_new)
+    y = pos[:, 1]
+    v = np.column_stack([velocity(y), np.zeros(y.size)])
+    a = np.column_stack([np.zeros(y.size), cfg.alpha_T * (1.0 - 2.0 * y)]) if drift else None
+    return walls(walk(pos, dispersion(y, cfg), cfg.dt, rng, v, a), cfg)
 
 
 # ---------------------------------------------------------------- mass transfer
@@ -171,71 +196,48 @@ def random_walk_step(x, y, cfg: ShearConfig, rng: np.random.Generator, drift: bo
 def kernel_cutoff(cfg: ShearConfig, v_max: float = V_MAX) -> float:
     """Cut-off s_c in scaled distance s^2 = dx^2/alpha_L + dy^2/alpha_T for the kernel of Eq. 17.
 
-    With the pair's W_ij = exp(-s^2 / (8 vbar dt)) / vbar (Eq. 17 with D_ij = vbar diag(alpha_L,
-    alpha_T), constants common to all pairs dropped) and vbar = (v_i + v_j)/2 >= v_i/2, a pair
-    beyond s_c has W_ij / W_ii <= 2 exp(-s_c^2 / (8 v_max dt)) = KERNEL_TOL, so each neglected
+    The pair's D_ij = vbar diag(alpha_L, alpha_T) with vbar = (v_i + v_j)/2 >= v_i/2 gives
+    W_ij / W_ii = (v_i / vbar) exp(-s^2 / (8 vbar dt)) (numerics/pair_transfer.py), so a pair
+    beyond s_c has W_ij / W_ii <= 2 exp(-s_c^2 / (8 v_max dt)) = KERNEL_TOL, and each neglected
     P_ij is below 1e-16 of the row and column sums it is normalised by.
     """
     return math.sqrt(8.0 * v_max * cfg.dt * math.log(2.0 / KERNEL_TOL))
 
 
-def neighbour_pairs(x, y, cfg: ShearConfig, cutoff: float) -> np.ndarray:
-    """Pairs (i, j), i < j, with scaled distance <= cutoff, periodic in x: an (n_pairs, 2) array.
+def transfer_directions(cfg: ShearConfig) -> int:
+    """The directions the transfer acts in: x and y, or x alone when alpha_T = 0 (the kernel is then
+    a delta in y, and a pair exchanges only at equal y)."""
+    return 2 if cfg.alpha_T > 0 else 1
 
-    Found by cKDTree on (x/sqrt(alpha_L), y/sqrt(alpha_T)) with a periodic box in x. With
-    alpha_T = 0 the kernel is a delta in y, so only pairs at identical y can interact: the tree
-    then searches x alone and ``pair_kernel`` gives the pairs with dy != 0 zero weight.
+
+def neighbour_pairs(pos, cfg: ShearConfig, cutoff: float) -> np.ndarray:
+    """Pairs (i, j), i < j, with scaled distance <= cutoff, periodic in x: an (n_pairs, 2) array
+    (numerics/neighbours.py on (x/sqrt(alpha_L), y/sqrt(alpha_T)), x alone when alpha_T = 0)."""
+    d = transfer_directions(cfg)
+    scale = 1.0 / np.sqrt([cfg.alpha_L, cfg.alpha_T][:d])
+    return pairs_within(pos[:, :d], cutoff, scale=scale, period=PERIODIC_X[:d] * cfg.length)
+
+
+def transfer_step(pos, m, cfg: ShearConfig, cutoff: float | None = None):
+    """One step of Eq. 16 by numerics/pair_transfer.py, Eq. 17 with D_ij = (D_i + D_j)/2 of the
+    particles' D(y) over the pairs within ``cutoff``: Returns (m, substeps, max_offdiag_beta, n_pairs).
+
+    A particle on a wall (v_i = 0, D_i = 0) has an infinite self weight, so it exchanges only
+    through the column-normalised half of P, with partners of finite D_ij; without such partners
+    it is isolated. With alpha_T = 0 the pairs at dy != 0 get weight 0.
     """
-    sx = 1.0 / math.sqrt(cfg.alpha_L)
-    if cfg.alpha_T > 0:
-        sy = 1.0 / math.sqrt(cfg.alpha_T)
-        pts = np.column_stack([np.mod(x * sx, cfg.length * sx), y * sy])
-        # y is not periodic: a box far larger than 1 * sy + cutoff never wraps
-        box = [cfg.length * sx, 4.0 * (sy + cutoff)]
-    else:
-        pts = np.mod(x * sx, cfg.length * sx)[:, None]
-        box = [cfg.length * sx]
-    # round-off may put a point exactly on the box edge; cKDTree needs [0, box)
-    pts[:, 0] = np.where(pts[:, 0] >= box[0], 0.0, pts[:, 0])
-    from scipy.spatial import cKDTree
+    from ..numerics import pair_transfer as pt  # numba: loaded by the jobs that step, not by plots
 
-    pairs = cKDTree(pts, boxsize=box).query_pairs(cutoff, output_type="ndarray")
-    return pairs.reshape(-1, 2).astype(np.int64, copy=False)
-
-
-def pair_kernel(x, y, pairs, cfg: ShearConfig) -> np.ndarray:
-    """Off-diagonal kernel W_ij of Eq. 17 with the tensor D_ij = (D_i + D_j)/2, up to a common constant.
-
-    D_ij = vbar diag(alpha_L, alpha_T) with vbar = (v_i + v_j)/2, so W_ij = exp(-s^2/(8 vbar dt))
-    / vbar with s^2 = dx^2/alpha_L + dy^2/alpha_T. The constant 1/(8 pi dt sqrt(alpha_L alpha_T))
-    is common to all pairs and to the self terms and cancels on normalising (Eq. 18); the 1/vbar
-    factor varies by pair and is kept. dx is the minimum image in x. Pairs with vbar = 0 (both
-    on a wall, D_ij = 0) get W_ij = 0, the kernel's limit for r != 0; with alpha_T = 0 so do
-    pairs with dy != 0.
-    """
-    from ..numerics.shear_kernels import pair_weights  # numba: loaded by the jobs that step, not by plots
-
-    return pair_weights(x, y, velocity(y), pairs, cfg.length, cfg.alpha_L, cfg.alpha_T, cfg.dt)
-
-
-def transfer_step(x, y, m, cfg: ShearConfig, cutoff: float | None = None):
-    """One step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 16) with P = (W/rowsum + W/colsum)/2 (Eq. 18).
-
-    Self weights W_ii = 1 / v_i (Eq. 17 at r = 0, constants dropped as in ``pair_kernel``); for
-    v_i = 0 (a particle on a wall) W_ii is infinite, so 1 / r_i = 0: its row of W/rowsum
-    vanishes and it exchanges only through the column-normalised half of P, with partners of
-    finite D_ij; without such partners it is isolated. The step is split into ``substeps``
-    equal parts of beta when beta * max_i sum_{j != i} P_ij > 1, so masses stay non-negative.
-    Returns (m, substeps, max_offdiag_beta, n_pairs).
-    """
     if cutoff is None:
         cutoff = kernel_cutoff(cfg)
-    pairs = neighbour_pairs(x, y, cfg, cutoff)
-    w = pair_kernel(x, y, pairs, cfg)
-    from ..numerics.shear_kernels import pair_transfer
-
-    m, substeps, c_max = pair_transfer(pairs, w, velocity(y), np.asarray(m, dtype=np.float64), float(cfg.beta))
-    return m, int(substeps), float(c_max), int(pairs.shape[0])
+    d = transfer_directions(cfg)
+    pairs = neighbour_pairs(pos, cfg, cutoff)
+    tensors = dispersion(pos[:, 1], cfg)[:, :d]  # per-particle diagonals
+    w = pt.pair_weights(pos[:, :d], tensors, pairs, cfg.dt, period=PERIODIC_X[:d] * cfg.length)
+    if d == 1:
+        w[pos[pairs[:, 0], 1] != pos[pairs[:, 1], 1]] = 0.0
+    m, substeps, c_max = pt.transfer(pairs, w, pt.self_weights(tensors), m, cfg.beta)
+    return m, substeps, c_max, int(pairs.shape[0])
 
 
 # ---------------------------------------------------------------- driver
@@ -261,17 +263,18 @@ def run_shear(
     cfg.check()
     rng = cfg.rng()
     if init is None:
-        x, y, m = initial_state(cfg, rng)
+        pos, m = initial_state(cfg, rng)
     else:
         x, y, m = (np.array(a, dtype=np.float64, copy=True) for a in init)
-        x = np.mod(x, cfg.length)
         if not (np.all((y >= 0) & (y <= 1)) and np.all(m >= 0) and x.shape == y.shape == m.shape):
             raise SettingError("init", "(x, y, mass)", "equal-length arrays with 0 <= y <= 1 and mass >= 0")
+        pos = np.column_stack([np.mod(x, cfg.length), y])
     is_mt = cfg.case == "mt"
     cutoff = kernel_cutoff(cfg) if is_mt else math.nan
     rec = Recorder(cfg.case_columns(), cfg.n_steps, progress)
 
     def record(step, substeps=0, c_max=0.0, n_pairs=0):
+        y = np.ascontiguousarray(pos[:, 1])
         if is_mt:
             total = m.sum()
             mean_y = float(np.dot(m, y) / total) if total > 0 else math.nan
@@ -293,14 +296,14 @@ def run_shear(
     record(0)
     for step in range(1, cfg.n_steps + 1):
         if is_mt:
-            x = np.mod(x + velocity(y) * cfg.dt, cfg.length)
-            m, substeps, c_max, n_pairs = transfer_step(x, y, m, cfg, cutoff)
+            pos[:, 0] = np.mod(pos[:, 0] + velocity(pos[:, 1]) * cfg.dt, cfg.length)
+            m, substeps, c_max, n_pairs = transfer_step(pos, m, cfg, cutoff)
             record(step, substeps, c_max, n_pairs)
         else:
-            x, y = random_walk_step(x, y, cfg, rng, drift=cfg.case == "rw_drift")
+            pos = random_walk_step(pos, cfg, rng, drift=cfg.case == "rw_drift")
             record(step)
     steps = rec.table().to_pandas()
     import pandas as pd  # here: the workflow's parse imports this module to check the shear section
 
-    state = pd.DataFrame({"x": x, "y": y, "mass": m, "case": cfg.case, "seed": int(cfg.seed)})
+    state = pd.DataFrame({"x": pos[:, 0], "y": pos[:, 1], "mass": m, "case": cfg.case, "seed": int(cfg.seed)})
     return steps, state

@@ -1,7 +1,34 @@
-"""Run one simulation and return its per-step table (and, on request, its final state)."""
+"""Run one simulation, conservative or reactive, and return its per-step table (and, on request, its
+final state): the one runner of every model.
+
+A run's state carries its species as a dimension: masses (species, N) on particles and rows
+(species, N + 1) on FD's nodes; PT carries one position array per species. A conservative run has one
+species. Each step moves every species by its model's transport step (models/fd, mtpt, pt), then
+applies the run's reaction (RunConfig.reaction, None when conservative) to the whole state: sequential
+non-iterative operator splitting, transport then reaction (Lie's order; Valocchi & Malmstead 1992,
+Water Resour. Res. 28: 1471; as RT3D reacts MT3D's nodes, Clement 1997), by the reaction kind's own
+node and particle rules (models/reaction_step.py).
+
+- FD: every species row on the fixed grid by the case's solver, then every node reacted over dt at
+  its masses (a uniform B carried as its departure from C0: fd.species_rows).
+- MTPT: the random walk with (1 - eta) D, then every species exchanged with eta D by one transfer
+  matrix (Eq. 19), then every particle reacted over dt at its concentrations m / dV (Benson & Bolster
+  2016; Schmidt, Pankavich & Benson 2017).
+- PT: a reactive run's A, B and C particles of equal mass m_p = 1 / N walk with D on the periodic
+  domain Omega around the source in the frame moving with v (a uniform B is then uniform
+  everywhere, as the reference's) and react by the kind's particle rule; C_A and C_C are each
+  species' kernel reconstruction (models/pt.py) times its mass.
+
+A conservative row holds the paper's measures (each model's ``measure``) and the exact solution's; a
+reactive row the masses of A, B and the product made so far, A + C still held (mass_total) and the
+fraction of B + C lost (mass_lost_BC: FD's window ends let both totals out, particles none), and the
+last row also the errors against the scene's reference: the SSE of C_A and of C_C at the scene's
+points (SSE_points, SSE_points_C) and the product mass's relative error (product_error).
+"""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -18,25 +45,20 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
-def _analytic_columns(cfg: RunConfig, t: float, dV: float) -> dict:
-    ref = cfg.reference(t)
-    return {
-        "H_C_analytic": ref.h_c(dV),
-        "E_analytic": ref.dilution(),
-        "settled": bool(t > M.settling_time(dV, cfg.D)),
-    }
-
-
-def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
-    """Simulate ``cfg`` (defaults resolved and checked) -> (per-step Arrow table, final state or None)."""
+def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False, reference=None):
+    """Simulate ``cfg`` (defaults resolved and checked) -> (per-step Arrow table, final state or None);
+    a reactive run (cfg.reaction) is judged against ``reference`` (experiments/reactive_reference.read)."""
     cfg = cfg.resolved()
+    if cfg.reaction is not None and reference is None:
+        raise ValueError("a reactive run needs its scene's reference to judge its last step")
     grid = "exact" if cfg.method == "fd" else cfg.time_grid
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid)
     runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
     warm_up(cfg)
     size = cfg.n + 1 if cfg.method == "fd" else cfg.n
     rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
-    state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rec)
+    rows = _Conservative(cfg, rec) if cfg.reaction is None else _Reactive(cfg, rec, reference, len(dts))
+    state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rows)
     table = rec.table()
     if not want_state:
         return table, None
@@ -44,9 +66,9 @@ def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, wan
     return table, arrow_table({k: np.asarray(v) for k, v in state.items()}, cfg.case_columns(), length)
 
 
-def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False):
+def run(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False, reference=None):
     """run_arrow as pandas tables: (per-step table, final state or None)."""
-    table, state = run_arrow(cfg, progress, want_state)
+    table, state = run_arrow(cfg, progress, want_state, reference)
     return table.to_pandas(), None if state is None else state.to_pandas()
 
 
@@ -74,66 +96,218 @@ def warm_up(cfg: RunConfig) -> None:
         _WARM.add(("reference", cfg.source.kind))
 
 
-def _row(rec: Recorder, cfg: RunConfig, step: int, t: float, dt: float, meas: dict) -> None:
-    rec.add(step=step, time=t, dt=dt, **meas, **_analytic_columns(cfg, t, meas["dV"]))
+# ------------------------------------------------------------------------------------ the rows
 
 
-def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
-    pt = _model("pt")
-    rng = cfg.rng()
-    x = np.sort(pt.initial_positions(cfg, rng))
-    _row(rec, cfg, 0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
-    for k, dt in enumerate(dts, start=1):
-        t = ts[k]
-        x = np.sort(pt.walk(x, cfg.D, dt, rng, cfg.v))
-        _row(rec, cfg, k, t, dt, pt.measure(cfg, x, t))
-    return pt.final_state(cfg, x, t)
+class _Conservative:
+    """A conservative run's rows: its model's measures (Eqs. 2-14) and the exact solution's."""
+
+    def __init__(self, cfg: RunConfig, rec: Recorder):
+        self.cfg, self.rec = cfg, rec
+
+    def add(self, step: int, t: float, dt: float, meas: dict) -> None:
+        ref = self.cfg.reference(t)
+        analytic = {
+            "H_C_analytic": ref.h_c(meas["dV"]),
+            "E_analytic": ref.dilution(),
+            "settled": bool(t > M.settling_time(meas["dV"], self.cfg.D)),
+        }
+        self.rec.add(step=step, time=t, dt=dt, **meas, **analytic)
 
 
-def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
-    mtpt = _model("mtpt")
-    rng, order_rng = cfg.rng(), cfg.rng(stream=1)
-    x, m, label = mtpt.initial_state(cfg, rng)
-    _row(rec, cfg, 0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
-    for k, dt in enumerate(dts, start=1):
-        t = ts[k]
-        x, m, label, h, beta, sub = mtpt.step(cfg, x, m, label, dt, t, rng, order_rng)
-        _row(rec, cfg, k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
-    dV = cfg.dV
-    return {"x": x, "mass": m, "c": m / dV}
+# a reactive run's columns beside the conservative run's: its errors at t_final (last row only) and
+# no entropy (a reactive scene's reference has none: its measure is rmse of C_A or product)
+_NAN = dict.fromkeys(
+    ("SSE_points", "SSE_points_C", "COMIC_points", "product_error", "H_C", "H_C_analytic", "E", "E_analytic"),
+    math.nan,
+)
 
 
-def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rec: Recorder) -> dict:
+class _Reactive:
+    """A reactive run's rows: the species' masses each step, and the errors against ``ref`` at the last."""
+
+    def __init__(self, cfg: RunConfig, rec: Recorder, ref: dict, last: int):
+        self.cfg, self.rec, self.ref, self.last = cfg, rec, ref, last
+
+    def add(self, k: int, t: float, dt: float, a, b, c, made: float, volume: float, lost_bc: float, extra: dict):
+        mass_a, mass_c = float(a.sum()), float(c.sum())
+        self.rec.add(
+            step=k,
+            time=t,
+            dt=dt,
+            mass_A=mass_a,
+            mass_B=float(b.sum()),
+            mass_C=made,
+            mass_total=mass_a + mass_c,  # A + C still held: 1 but for what left an FD window's ends
+            mass_lost_BC=lost_bc,
+            mass_min=float(min(a.min(), b.min())),
+            dV=volume,
+            **extra,
+        )
+
+    def judged(self, k: int, x, c_a, mass_c: float, x_c=None, c_c=None) -> dict:
+        """At the last step, the errors against the reference: the SSE of C_A and of C_C at the scene's
+        points (the model's concentrations linearly interpolated there, measures.at_points; C_C on
+        ``x_c``, by default A's ``x``) and |M_C / M_C,ref - 1|; before it, NaN."""
+        if k != self.last:
+            return _NAN
+        ref, cfg = self.ref, self.cfg
+        model = M.at_points(ref["points"], x, c_a)
+        err = M.sse(model, ref["a_points"])
+        product = ref["product_mass"]
+        x_c = x if x_c is None else x_c
+        return {
+            **_NAN,
+            "SSE_points": err,
+            "SSE_points_C": M.sse(M.at_points(ref["points"], x_c, c_c), ref["c_points"]),
+            "COMIC_points": M.comic(err, model.size, cfg.fd_dx if cfg.method == "fd" else cfg.dV),
+            "product_error": abs(mass_c / product - 1.0) if product > 0 else math.nan,
+        }
+
+
+# ---------------------------------------------------------------------------------- the models
+
+
+def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """FD: every species row carried by the case's solver (one factorisation per distinct step
+    size), then, in a reactive run, every node reacted (reaction_step.react_masses)."""
     fd = _model("fd")
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
-    extra = {"beta": 0.0, "h": dx, "substeps": 1}
-    _row(rec, cfg, 0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
     solvers: dict = {}
+
+    def solver(dt):
+        if dt not in solvers:
+            solvers[dt] = fd.solver(cfg, dt, dx)
+        return solvers[dt]
+
+    extra = {"beta": 0.0, "h": dx, "substeps": 1}
+    if cfg.reaction is None:
+        state = c[None, :]
+        rows.add(0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
+        for k, dt in enumerate(dts, start=1):
+            fd.transport(solver(dt), state)
+            rows.add(k, ts[k], dt, {**fd.measure(cfg, x, c, dx, ts[k]), **extra})
+        return {"x": x, "c": c}
+    from .reaction_step import react_masses
+
+    reaction = cfg.reaction
+    background = reaction.b_background
+    # B's ends: a plume's are held at zero, as A's; a uniform background's at C0, so that B neither
+    # drains through them nor enters B-free with the flow (fd.species_rows carries its departure)
+    b = reaction.b_masses(x, dx)
+    b[0] = b[-1] = background * dx
+    masses = np.vstack([c * dx, b, np.zeros_like(c)])
+    # B + C lost through the window's ends, as a fraction of B's mass (a uniform B's departure from
+    # C0, which only the reaction makes, in units of A's unit mass)
+    b_total, scale = float((b - background * dx).sum()), reaction.b_mass if reaction.b_source is not None else 1.0
+    rows.add(0, 0.0, 0.0, masses[0], masses[1], masses[2], 0.0, dx, 0.0, _NAN)
+    state, made = fd.species_rows(masses, dx, background), 0.0
     for k, dt in enumerate(dts, start=1):
         t = ts[k]
-        if dt not in solvers:  # one factorisation per distinct step size (one for a fixed dt)
-            solvers[dt] = fd.solver(cfg, dt, dx)
-        c[1:-1] = solvers[dt].solve(c[1:-1])
-        _row(rec, cfg, k, t, dt, {**fd.measure(cfg, x, c, dx, t), **extra})
-    return {"x": x, "c": c}
+        fd.transport(solver(dt), state)
+        masses = fd.species_masses(state, dx, background)
+        made += react_masses(reaction.kinetics, masses, dx, dt, t, "fd")
+        state = fd.species_rows(masses, dx, background)
+        a, b, c = masses
+        lost = reaction.lost_bc(b_total, float((b - background * dx).sum()), float(c.sum()), scale)
+        rows.add(k, t, dt, a, b, c, made, dx, lost, rows.judged(k, x, a / dx, made, c_c=c / dx))
+    return {"x": x, "c": masses[0] / dx}
+
+
+def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """MTPT: every species row walked and exchanged by one step (mtpt.step), then, in a reactive
+    run, every particle reacted (reaction_step.react_masses)."""
+    mtpt = _model("mtpt")
+    rng, order_rng = cfg.rng(), cfg.rng(stream=1)
+    x, m, label = mtpt.initial_state(cfg, rng)
+    dV = cfg.dV
+    if cfg.reaction is None:
+        rows.add(0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
+        for k, dt in enumerate(dts, start=1):
+            t = ts[k]
+            x, m, label, h, beta, sub = mtpt.step(cfg, x, m, label, dt, t, rng, order_rng)
+            rows.add(k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
+        return {"x": x, "mass": m, "c": m / dV}
+    from .reaction_step import A, B, C, react_masses
+
+    kinetics = cfg.reaction.kinetics
+    masses = np.vstack([m, cfg.reaction.b_masses(x, dV), np.zeros_like(m)])
+    rows.add(0, 0.0, 0.0, masses[A], masses[B], masses[C], 0.0, dV, 0.0, {**_NAN, "substeps": 1})
+    for k, dt in enumerate(dts, start=1):
+        t = ts[k]
+        x, masses, label, _, _, sub = mtpt.step(cfg, x, masses, label, dt, t, rng, order_rng)
+        react_masses(kinetics, masses, dV, dt, t, "mtpt")
+        made = float(masses[C].sum())
+        extra = rows.judged(k, x, masses[A] / dV, made, c_c=masses[C] / dV)
+        rows.add(k, t, dt, masses[A], masses[B], masses[C], made, dV, 0.0, {"substeps": sub, **extra})
+    return {"x": x, "mass": masses[A], "c": masses[A] / dV}
+
+
+def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """PT: every species' particles walked (pt.step); a reactive run's A from the source, each of mass
+    m_p = 1 / N, and B's of the same mass from its initial condition, on the periodic domain of width
+    Omega around the source in the frame moving with v, reacted by the kind's particle rule."""
+    pt = _model("pt")
+    rng = cfg.rng()
+    if cfg.reaction is None:
+        x = np.sort(pt.initial_positions(cfg, rng))
+        rows.add(0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
+        for k, dt in enumerate(dts, start=1):
+            t = ts[k]
+            (x,) = pt.step([x], cfg.D, dt, rng, cfg.v)
+            rows.add(k, t, dt, pt.measure(cfg, x, t))
+        return pt.final_state(cfg, x, t)
+    from .reaction_step import react_particles
+
+    reaction = cfg.reaction
+    m_p, length = 1.0 / cfg.n, cfg.omega
+    lo = cfg.source.centre - length / 2.0
+    xa = np.mod(pt.initial_positions(cfg, rng) - lo, length)  # positions in [0, Omega), moving frame
+    xs = [xa, reaction.b_positions(m_p, length, lo, rng), np.empty(0)]
+    one = np.ones(1)
+    rows.add(0, 0.0, 0.0, xs[0].size * m_p * one, xs[1].size * m_p * one, 0.0 * one, 0.0, cfg.dV, 0.0, _NAN)
+    for k, dt in enumerate(dts, start=1):
+        t = ts[k]
+        xs = react_particles(
+            reaction.kinetics, pt.step(xs, cfg.D, dt, rng, period=length), m_p, cfg.D, dt, length, rng, t
+        )
+        made = xs[2].size * m_p
+        extra = _NAN
+        if k == len(dts):  # A's and C's densities in the lab frame: each species' reconstruction times its mass
+            (grid, c_a), (grid_c, c_c) = (_density(cfg, x + lo + cfg.v * t, m_p, t) for x in (xs[0], xs[2]))
+            extra = rows.judged(k, grid, c_a, made, grid_c, c_c)
+        a, b = xs[0].size * m_p * one, xs[1].size * m_p * one
+        rows.add(k, t, dt, a, b, made * one, made, cfg.dV, 0.0, extra)
+    return {"x": np.sort(xs[0] + lo + cfg.v * t), "mass": np.full(xs[0].size, m_p)}
+
+
+def _density(cfg: RunConfig, x: np.ndarray, m_p: float, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """A PT species' concentration from its particles' lab positions ``x``, each of mass m_p: the
+    case's reconstruction (models/pt.reconstruct, a density of unit mass) times their mass; zero if
+    none is left."""
+    pt = _model("pt")
+    if not x.size:
+        return np.zeros(1), np.zeros(1)
+    grid, c, _, _ = pt.reconstruct(cfg, np.sort(x), t)
+    return grid, x.size * m_p * c
 
 
 def run_seeds_arrow(
-    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False
+    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False, reference=None
 ) -> pa.Table:
     """Run ``cfg`` for each seed and concatenate the per-step tables (or final states)."""
     parts = []
     for seed in seeds:
         if progress:
             progress(f"seed {seed}")
-        table, final = run_arrow(replace(cfg, seed=int(seed)), progress=progress, want_state=state)
+        table, final = run_arrow(replace(cfg, seed=int(seed)), progress, state, reference)
         parts.append(final if state else table)
     return pa.concat_tables(parts, promote_options="default")
 
 
 def run_seeds(
-    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False
+    cfg: RunConfig, seeds, progress: Callable[[str], None] | None = None, state: bool = False, reference=None
 ) -> pd.DataFrame:
     """run_seeds_arrow as a pandas table."""
-    return run_seeds_arrow(cfg, seeds, progress, state).to_pandas()
+    return run_seeds_arrow(cfg, seeds, progress, state, reference).to_pandas()

@@ -11,8 +11,8 @@ share one entry point, :func:`gauss_transform`; none builds an N x N matrix:
   boxes 1 to 2.5 sigma wide (``fgt_plan``) carry p Hermite moments, translated to Taylor
   expansions about each target box (one table of Hermite functions per box offset);
   sparse box pairs are summed exactly. p is the fewest terms whose proven error bound
-  (``fgt_error_bound``) is below ``tolerance`` (default ``FGT_TOLERANCE`` = 1e-17 of the
-  summed |weights|, i.e. round-off: the transform stays symmetric and MTPT conserves mass
+  (``fgt_error_bound``) is below ``tolerance`` (default ``registry.FGT_TOLERANCE`` of the
+  summed |weights|, round-off: the transform stays symmetric and MTPT conserves mass
   to round-off).
   O(N p) time plus O(boxes x p^2).
 * ``taylor``: per-target evaluation of each source box's Taylor moments of exp(u v);

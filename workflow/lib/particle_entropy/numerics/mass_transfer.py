@@ -13,6 +13,10 @@ particle i holding mass (empty particles only receive). Where it is not (the SPH
 exceeds 1), the step is split into ``substeps`` equal pieces of beta with the same P, each
 positivity-preserving for every particle (a split step carries mass several kernel widths);
 the count is returned so that callers record it.
+
+Several species (masses of shape (species, N)) move by the same P and the same substeps: the
+species' rows are exchanged together (``_transfer_species``); one species keeps the single row's
+path, which skips the particles out of reach of any mass.
 """
 
 from __future__ import annotations
@@ -52,12 +56,18 @@ def mass_transfer(
     method: str = "auto",
     tolerance: float = FGT_TOLERANCE,
 ) -> TransferResult:
-    """One mass-transfer step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 19); x sorted.
+    """One mass-transfer step m_i <- m_i + beta sum_j P_ij (m_j - m_i) (Eq. 19); x sorted; ``m`` of
+    shape (N,) or (species, N), each row a species moved by the same P (the result has m's shape).
 
     Only particles within the kernel's reach of a mass-holding particle can change, so
     while they are few (early times of a delta initial condition) the step is computed on
     them alone; the result is the same sum.
     """
+    if m.ndim == 2:
+        if m.shape[0] > 1:
+            return _transfer_species(x, m, sigma, beta, truncation, method, tolerance)
+        res = mass_transfer(x, m[0], sigma, beta, truncation, method, tolerance)
+        return TransferResult(res.mass[None, :], res.substeps, res.max_offdiag_beta)
     if x.size < 2 or beta == 0.0:
         return TransferResult(m.copy(), 1, 0.0)
     if method == "auto":  # one choice for all transforms of this step
@@ -125,3 +135,42 @@ def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
             Wm, Wmr = gauss_transform(x, x, np.vstack([m, m * inv_r]), sigma, truncation, method, tolerance=tolerance)
         m = kernels().update(m, offdiag, b, Wm, Wmr, inv_r)
     return TransferResult(m, substeps, c)
+
+
+def _transfer_species(x, masses, sigma, beta, truncation, method, tolerance) -> TransferResult:
+    """Eq. 19 for several species at once: each row of ``masses`` (species, N) exchanged by the same
+    P and the same number of substeps. The kernel's row sums r are computed once and
+    W [1/r, m_1, m_1/r, m_2, m_2/r, ...] in one pass. The substeps are chosen for the particles
+    that hold any species, so that the species see one linear operator (their sum moves as one
+    species would): carrying each row on its own could split the step differently for each."""
+    masses = np.ascontiguousarray(masses, dtype=np.float64)
+    if x.size < 2 or beta == 0.0:
+        return TransferResult(masses.copy(), 1, 0.0)
+    if method == "auto":
+        method = choose_method(x, x, sigma, truncation)
+    r = gauss_transform(x, x, np.ones_like(x), sigma, truncation, method, tolerance=tolerance)
+    inv_r = 1.0 / r
+    ns = masses.shape[0]
+    q = np.empty((1 + 2 * ns, x.size))
+    q[0] = inv_r
+    q[1::2] = masses
+    q[2::2] = masses * inv_r
+    W = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
+    held = np.any(masses != 0.0, axis=0).astype(np.float64)
+    offdiag, c, c_all = kernels().offdiag(W[0], inv_r, held, beta)
+    substeps = _substeps(c)
+    if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
+        c = c_all
+        substeps = _substeps(c)
+    b = beta / substeps
+    out = masses.copy()
+    for k in range(substeps):
+        if k > 0:
+            q = np.empty((2 * ns, x.size))
+            q[0::2] = out
+            q[1::2] = out * inv_r
+            W = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
+            W = np.vstack([W[:1], W])  # rows 1::2 and 2::2 as in the first pass
+        for i in range(ns):
+            out[i] = kernels().update(out[i], offdiag, b, W[1 + 2 * i], W[2 + 2 * i], inv_r)
+    return TransferResult(out, substeps, c)

@@ -2,7 +2,7 @@
 (Benson & Meerschaert 2008, Water Resour. Res. 44, W12201): each A particle tests the B particles
 within reach in turn, in a random order of the A's, and reacts with at most one of them.
 
-Kept apart from models/reactive.py so that what only reads reactive results does not load numba."""
+Kept apart from models/reaction_step.py so that what only reads reactive results does not load numba."""
 
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ RW_entropy_ens_GSM_COMIC.m), checked line by line against that script and implem
 8. Random walk. When eta < 1, the same particles first take a random walk with (1 - eta) D,
    then the transfer.
 9. Time loop. The clock advances by dt before the step, and the loop runs while t < t_final;
-   dt grows by 1.05 after each step. With dt0 = 0.01 and t_final = 1000 it ends after 175
+   dt grows by the factor run_settings.DT_GROWTH after each step. With dt0 = 0.01 and t_final = 1000 it ends after 175
    steps at t = 1021.1 (timegrid.time_steps with grid "authors").
 10. Details kept as the paper has them (each a small difference): the script's SPH constant is
    0.822 where Eq. 26 has 0.82 (0.24 % in h, 0.5 % in beta), and both kernels' lines are in the

@@ -44,7 +44,7 @@ def offdiag(W_inv_r, inv_r, m, beta):
 def update(m, offdiag, b, Wm, Wmr, inv_r):
     """m (1 - b offdiag) + b/2 (sum_{j != i} W_ij m_j / r_i + sum_{j != i} W_ij m_j / r_j)."""
     # Both sums are of non-negative terms. The fast transform leaves them within its
-    # tolerance (1e-17 of the summed mass in reach by default), which can dip below 0 where
+    # tolerance (registry.FGT_TOLERANCE of the summed mass in reach by default), which can dip below 0 where
     # all neighbours are empty; 0 is their bound.
     n = m.shape[0]
     out = np.empty(n)

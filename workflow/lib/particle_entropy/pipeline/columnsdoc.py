@@ -294,7 +294,7 @@ OUTRO = """\
 ## Other files in the results folder (not tables)
 
 - `<name>.parquet.sha256`: the SHA-256 of a table, checked at the start of each run;
-  `<name>.parquet.corrupt`: a table that failed that check, set aside (README, "Interrupted runs").
+  `<name>.parquet.corrupt`: a table that failed that check, set aside (docs/robustness.md).
 - `results/benchmarks/**/*.tsv`: Snakemake's benchmark files, one per simulation job
   (Snakemake's own columns: `s`, `h:m:s`, `max_rss`, `max_vms`, `max_uss`, `max_pss`, `io_in`,
   `io_out`, `mean_load`, `cpu_time`; see the Snakemake documentation).

@@ -4,9 +4,9 @@ result, filled from their one source (as showyourwork's variables are).
 A spot is marked in the Markdown: inline ``<!-- value NAME -->2000<!-- /value -->``, or a block
 (a table) between the lines ``<!-- table NAME -->`` and ``<!-- /table -->``. Code constants
 (``code_values``: the bootstrap's resamples and confidence, the scene search's tolerances, the
-config file caps) are read from the modules that use them. Results (the scene table, the Peclet
-sweep, its crossover) are read from docs/numbers.json, a small committed file that
-``numbers_from_tables`` writes from the scene tables (results/scenes/<name>.parquet): the
+config file caps, the transfer tolerance) are read from the modules that use them. Results (the
+scene table, the Peclet sweep, its crossover) are read from docs/numbers.json, a small committed
+file that ``numbers_from_tables`` writes from the scene tables (results/scenes/<name>.parquet): the
 workflow's rule ``scene_numbers`` writes the same file as results/scenes_numbers.json.
 
     python -m particle_entropy.pipeline.prose --check                  # exit 1 while a spot is stale
@@ -32,7 +32,7 @@ import pandas as pd
 
 from ..analysis import resampling, scene_search
 from ..analysis.optimum import SEARCH_DEFAULTS
-from ..core.registry import MEASUREMENT_POINTS
+from ..core.registry import FGT_TOLERANCE, MEASUREMENT_POINTS
 from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
 from ..core.settings import REACTIVE_COST, SCENE, SCENE_MIN_MARGIN, defaults
 from ..core.timegrid import MAX_STEPS
@@ -122,6 +122,7 @@ def code_values() -> dict[str, str]:
         "scene.MAX_BLOCKS": str(scene.MAX_BLOCKS),
         "settings.SCENE_MIN_MARGIN": f"{SCENE_MIN_MARGIN:.3g}",
         "registry.MEASUREMENT_POINTS": str(MEASUREMENT_POINTS),
+        "registry.FGT_TOLERANCE": power(FGT_TOLERANCE),
         "resampling.N_RESAMPLES": str(resampling.N_RESAMPLES),
         "resampling.CONFIDENCE": percent(resampling.CONFIDENCE),
         "scene_search.NEGATIVE_TOLERANCE": power(scene_search.NEGATIVE_TOLERANCE),
@@ -276,7 +277,7 @@ def _answer(c: Mapping, with_label: bool = True) -> str:
 
 
 def scene_table(numbers: Mapping) -> str:
-    """The README's scene table: per scene its Peclet number, target, the cheapest candidate that
+    """The scene table of docs/scenes.md: per scene its Peclet number, target, the cheapest candidate that
     meets it, every other candidate's answer and the COMIC-best rung."""
     lines = [
         "| scene | Péclet v L / D | target at t_final | cheapest that meets it (interval of n, counted cost a run) "
@@ -298,7 +299,7 @@ def scene_table(numbers: Mapping) -> str:
 
 
 def sweep_table(numbers: Mapping) -> str:
-    """The README's Peclet sweep: per Peclet number the cheapest grid and particle answers."""
+    """The Peclet sweep of docs/scenes.md: per Peclet number the cheapest grid and particle answers."""
     lines = [
         "| Pe | best grid: scheme, n, grid Péclet, Courant, counted cost | best particles: N, counted cost | cheaper |",
         "|---:|---|---|---|",

@@ -35,7 +35,7 @@ FLOW_DEPTH = 3  # mappings nested deeper than this, and every entry of a setting
 
 
 def _yaml(value) -> str:
-    """A value in YAML flow style that PyYAML reads back as the same value (1e-17 as a float:
+    """A value in YAML flow style that PyYAML reads back as the same value (1e-5 as a float:
     YAML 1.1 wants a decimal point)."""
     if isinstance(value, float):
         text = repr(value)

@@ -1,0 +1,83 @@
+"""The one runner (models/simulate.py) against the runs of the three runners before it (issue 51):
+every shipped scene's candidates, conservative and reactive, at their low rungs and short times,
+and their half-step twins, give the same bytes as the code at 5399db0 (measured cost columns left
+out). The digests in tests/data/runs_before_one_runner.json were made by that code."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from particle_entropy.core.records import TIMING_COLUMNS
+from particle_entropy.experiments import reactive
+from particle_entropy.experiments.scene import Scene
+from particle_entropy.models.simulate import run_seeds_arrow
+
+ROOT = Path(__file__).resolve().parents[1]
+BEFORE = json.loads((ROOT / "tests" / "data" / "runs_before_one_runner.json").read_text())["digests"]
+# each shipped scene at a short t_final (its runs' cost, not its physics, is what the test keeps small)
+SHORT = {
+    "paper": 300.0,
+    "carried": 2.0,
+    "spill": 20.0,
+    "narrow": 100.0,
+    "front": 5.0,
+    "well_mixed": 5.0,
+    "carried_reaction": 5.0,
+}
+VARIANTS = {name: (name, {"t_final": t}) for name, t in SHORT.items()}
+VARIANTS["spill_decay"] = (
+    "spill",
+    {"t_final": 20.0, "reaction": {"kind": "decay", "rate": 0.02}, "target": {"measure": "rmse", "value": 0.01}},
+)
+VARIANTS["carried_decay"] = (
+    "carried_reaction",
+    {"t_final": 5.0, "reaction": {"kind": "decay", "rate": 0.05}, "target": {"measure": "product", "value": 0.01}},
+)
+
+
+def _digest(table) -> str:
+    """sha256[:16] of a run table's columns, names and bytes, the measured cost columns left out."""
+    t = table.drop([c for c in TIMING_COLUMNS if c in table.column_names])
+    h = hashlib.sha256()
+    for name in t.column_names:
+        col = t.column(name).to_numpy(zero_copy_only=False)
+        h.update(name.encode())
+        h.update(repr(col.tolist()).encode() if col.dtype == object else np.ascontiguousarray(col).tobytes())
+    return h.hexdigest()[:16]
+
+
+def _stub_reference(scene: Scene) -> dict:
+    """A reference to judge the last step against (its values matter only as numbers to compare)."""
+    pts = reactive.points(scene)
+    return {"points": pts, "a_points": 0.5 + 0.0 * pts, "c_points": 0.25 + 0.0 * pts, "product_mass": 0.1}
+
+
+def _runs():
+    config = yaml.safe_load((ROOT / "config.yaml").read_text())
+    for name, (base, override) in VARIANTS.items():
+        scene = Scene.from_config(name, {**config["scenes"][base], **override}, config.get("case_defaults", {}))
+        for i, cand in enumerate(scene.candidates):
+            n = cand.ladder()[1 if cand.case.method == "fd" else 0]
+            for half in (False, True):
+                yield f"{name}[{i}]{'/2' if half else ''}@{n}", scene, scene.half_step(cand) if half else cand, n
+
+
+RUNS = list(_runs())
+
+
+def test_every_frozen_run_is_listed():
+    assert sorted(key for key, *_ in RUNS) == sorted(BEFORE) and len(BEFORE) == 78
+
+
+@pytest.mark.parametrize("key, scene, cand, n", RUNS, ids=[r[0] for r in RUNS])
+def test_a_run_has_the_bytes_of_the_runners_before(key, scene, cand, n):
+    seeds = [0] if cand.case.method == "fd" else [0, 1]
+    ref = None if scene.reaction is None else _stub_reference(scene)
+    table = run_seeds_arrow(scene.run_config(cand, n), seeds, reference=ref)
+    assert _digest(table) == BEFORE[key]
