@@ -62,7 +62,7 @@ def test_decay_factor_is_the_exponential():
 
 
 def test_reaction_kinds_account_for_every_mass():
-    from particle_entropy.core.reactions import REACTIONS, Bimolecular, Decay
+    from particle_entropy.core.reactions import REACTIONS, Bimolecular, Decay, Production
 
     a, b = np.array([0.0, 0.5, 2.0, 1e-9]), np.array([1.0, 0.5, 0.1, 3.0])
     a1, b1, made = Bimolecular(4.0).react(a, b, 0.3)
@@ -72,7 +72,7 @@ def test_reaction_kinds_account_for_every_mass():
     np.testing.assert_allclose(a1, a * math.exp(-0.6), rtol=1e-15)
     np.testing.assert_allclose(a1 + made, a, rtol=1e-15)
     np.testing.assert_array_equal(b1, b)
-    assert REACTIONS == {"decay": Decay, "bimolecular": Bimolecular}
+    assert REACTIONS == {"decay": Decay, "bimolecular": Bimolecular, "production": Production}
     with pytest.raises(ValueError):
         Decay(-1.0)
 

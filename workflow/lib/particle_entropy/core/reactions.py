@@ -81,7 +81,15 @@ class Decay:
 
     KIND: ClassVar[str] = "decay"
     CONSUMES_B: ClassVar[bool] = False  # conserved: A + C and B
+    PARAMS: ClassVar[dict] = {"rate": "the first-order rate lambda of A -> C [1/T]"}
     rate: float
+
+    def record(self) -> dict:
+        return {"rate": self.rate}
+
+    def closed_form(self, t: float) -> tuple[float, float]:
+        """(A's, C's share of the conservative plume at time t): exp(-lambda t), -expm1(-lambda t)."""
+        return math.exp(-self.rate * t), -math.expm1(-self.rate * t)
 
     def __post_init__(self):
         if not (self.rate >= 0 and math.isfinite(self.rate)):
@@ -120,7 +128,15 @@ class Bimolecular:
 
     KIND: ClassVar[str] = "bimolecular"
     CONSUMES_B: ClassVar[bool] = True  # conserved: A + C and B + C
+    PARAMS: ClassVar[dict] = {"k": "the rate constant k of A + B -> C at rate k C_A C_B [L/(M T)]"}
     k: float
+
+    def record(self) -> dict:
+        return {"k": self.k}
+
+    def closed_form(self, t: float) -> None:
+        """None: A + B -> C has no closed form where A and B are not uniform (a reference solves it)."""
+        return None
 
     def __post_init__(self):
         if not (self.k >= 0 and math.isfinite(self.k)):
@@ -158,8 +174,56 @@ class Bimolecular:
         return {"A + C": a + c, "B + C": b + c}
 
 
+@dataclass(frozen=True)
+class Production:
+    """First-order production A -> A + C, dC/dt = lambda A: A is kept and makes C at ``rate`` lambda
+    [1/T] (a parent that releases a product without being used up); B takes no part."""
+
+    KIND: ClassVar[str] = "production"
+    CONSUMES_B: ClassVar[bool] = False  # conserved: A and B; C grows by lambda dt A a step
+    PARAMS: ClassVar[dict] = {"rate": "the first-order rate lambda of A -> A + C [1/T]"}
+    rate: float
+
+    def __post_init__(self):
+        if not (self.rate >= 0 and math.isfinite(self.rate)):
+            raise ValueError(f"production rate must be >= 0 and finite, got {self.rate!r}")
+
+    def record(self) -> dict:
+        return {"rate": self.rate}
+
+    def closed_form(self, t: float) -> tuple[float, float]:
+        """(A's, C's share of the conservative plume at time t): 1 and lambda t, exactly, because C made at
+        time s is carried by the same linear transport as A from s on."""
+        return 1.0, self.rate * t
+
+    def react(self, a, b, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, the C made) after dt: A and B as they were, lambda dt A made."""
+        a = np.asarray(a, dtype=np.float64)
+        return a, np.asarray(b, dtype=np.float64), a * (self.rate * dt)
+
+    def fastest_rate(self, a, b) -> float:
+        """lambda [1/T]."""
+        return float(self.rate)
+
+    def on_masses(self, ma, mb, dV: float, dt: float):
+        """(m_A, m_B, mass made into C) after dt on each particle or node: m_A and m_B kept, lambda dt m_A made."""
+        ma = np.asarray(ma, dtype=np.float64)
+        return ma, mb, ma * (self.rate * dt)
+
+    def on_particles(self, xa, xb, m_p: float, D: float, dt: float, length: float, rng, pairs):
+        """PT's rule (A kept, B kept, new C positions): each A particle makes a Poisson(lambda dt) number of
+        C particles where it is, lambda dt of them in the mean (exact in expectation at any dt)."""
+        made = rng.poisson(self.rate * dt, xa.size)
+        return np.ones(xa.size, dtype=bool), np.ones(xb.size, dtype=bool), np.repeat(xa, made)
+
+    @staticmethod
+    def conserved(a: float, b: float, c: float) -> dict[str, float]:
+        """The totals production keeps, from the totals of A, B and C: A and B."""
+        return {"A": a, "B": b}
+
+
 # The reaction kinds, each once.
-REACTIONS: dict[str, type] = {cls.KIND: cls for cls in (Decay, Bimolecular)}
+REACTIONS: dict[str, type] = {cls.KIND: cls for cls in (Decay, Bimolecular, Production)}
 
 
 # ------------------------------------------------------------------------------ a scene's reaction
@@ -199,45 +263,55 @@ class Reaction:
 
     def record(self) -> dict:
         """The reaction as a run's settings carry it and its identity digests it."""
-        if self.kind == "decay":
-            return {"kind": "decay", "rate": self.kinetics.rate}
-        if self.b_source is None:
-            b = {"uniform": self.b_uniform}
-        else:
-            b = {"source": self.b_source.record(), "mass": self.b_mass}
-        return {"kind": "bimolecular", "k": self.kinetics.k, "B": b}
+        out = {"kind": self.kind, **self.kinetics.record()}
+        if self.kinetics.CONSUMES_B:
+            out["B"] = (
+                {"uniform": self.b_uniform}
+                if self.b_source is None
+                else {"source": self.b_source.record(), "mass": self.b_mass}
+            )
+        return out
 
     @staticmethod
     def from_spec(spec) -> Reaction:
-        """The reaction a config writes ({kind: decay, rate} or {kind: bimolecular, k, B: {uniform: C0} or
-        {source: <a source>, mass}}), its keys already typed (core/typed.py); ReactionError naming the
-        first bad parameter of B's source."""
+        """The reaction a config writes ({kind, its kind's PARAMS} and, for a kind that consumes B, B:
+        {uniform: C0} or {source: <a source>, mass}), its keys already typed (core/typed.py);
+        ReactionError naming the first bad parameter of B's source."""
         from .sources import Source, SourceError
 
-        if spec["kind"] == "decay":
-            return Reaction(Decay(spec["rate"]))
+        cls = REACTIONS[spec["kind"]]
+        kinetics = cls(**{key: spec[key] for key in cls.PARAMS})
+        if not cls.CONSUMES_B:
+            return Reaction(kinetics)
         b = spec["B"]
         if "uniform" in b:
-            return Reaction(Bimolecular(spec["k"]), b_uniform=b["uniform"])
+            return Reaction(kinetics, b_uniform=b["uniform"])
         try:
             source = Source.from_spec(b["source"])
         except SourceError as e:
             raise ReactionError(f"B.source.{e.param}", e.value, e.allowed) from None
-        return Reaction(Bimolecular(spec["k"]), b_source=source, b_mass=b.get("mass", 1.0))
+        return Reaction(kinetics, b_source=source, b_mass=b.get("mass", 1.0))
 
     @staticmethod
     def of(record: dict | None) -> Reaction | None:
         """The reaction of a run's settings (``record``), or None."""
         if record is None:
             return None
-        if record["kind"] == "decay":
-            return Reaction(Decay(record["rate"]))
+        cls = REACTIONS[record["kind"]]
+        kinetics = cls(**{key: record[key] for key in cls.PARAMS})
+        if not cls.CONSUMES_B:
+            return Reaction(kinetics)
         from .sources import Source
 
         b = record["B"]
         if "uniform" in b:
-            return Reaction(Bimolecular(record["k"]), b_uniform=b["uniform"])
-        return Reaction(Bimolecular(record["k"]), b_source=Source.of(**b["source"]), b_mass=b["mass"])
+            return Reaction(kinetics, b_uniform=b["uniform"])
+        return Reaction(kinetics, b_source=Source.of(**b["source"]), b_mass=b["mass"])
+
+    def closed_form(self, t: float) -> tuple[float, float] | None:
+        """(A's, C's share of the conservative plume at t) where the kinetics have a closed form and B
+        takes no part; None where a reference must be solved."""
+        return None if self.kinetics.CONSUMES_B else self.kinetics.closed_form(t)
 
     @property
     def b_background(self) -> float:
@@ -266,7 +340,7 @@ class Reaction:
         """B's initial mass on particles or nodes at ``x`` with spacing dV [M]: C0 dV each, or the plume's
         mass spread by its density (Source.masses); zero for a decay."""
         x = np.asarray(x, dtype=np.float64)
-        if self.kind == "decay":
+        if not self.kinetics.CONSUMES_B:
             return np.zeros_like(x)
         if self.b_source is None:
             return np.full_like(x, self.b_uniform * dV)
@@ -323,18 +397,58 @@ def reaction_shape(source_shape: dict) -> dict:
         "required": ["kind"],
         "properties": {
             "kind": {"type": "string", "enum": list(REACTIONS), "description": f"one of {', '.join(REACTIONS)}"},
-            "rate": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "description": "decay: the first-order rate lambda of A -> C [1/T]; a number > 0",
-            },
-            "k": {
-                "type": "number",
-                "exclusiveMinimum": 0,
-                "maximum": K_MAX,
-                "description": "bimolecular: the rate constant k of A + B -> C at rate k C_A C_B [L/(M T)]; "
-                f"a number in (0, {K_MAX:g}]",
-            },
-            "B": {**b, "description": "bimolecular: B's initial condition, {uniform: C0} or {source, mass}"},
+            **_param_shapes(),
+            "B": {**b, "description": f"{_kinds_of('B')}: B's initial condition, {{uniform: C0}} or {{source, mass}}"},
         },
     }
+
+
+def _kinds_of(key: str) -> str:
+    """The kinds that take config key ``key`` (B: the kinds that consume B), joined."""
+    if key == "B":
+        return ", ".join(kind for kind, cls in REACTIONS.items() if cls.CONSUMES_B)
+    return ", ".join(kind for kind, cls in REACTIONS.items() if key in cls.PARAMS)
+
+
+# each rate parameter's upper bound (k: K_MAX, below the overflow of k / dV); a first-order rate has none
+_MAXIMA = {"k": K_MAX}
+
+
+def _param_shapes() -> dict:
+    """The schema of every kind's rate parameters (PARAMS), each once, its meaning per kind."""
+    shapes = {}
+    for cls in REACTIONS.values():
+        for key, meaning in cls.PARAMS.items():
+            shape = shapes.setdefault(key, {"type": "number", "exclusiveMinimum": 0, "description": ""})
+            if key in _MAXIMA:
+                shape["maximum"] = _MAXIMA[key]
+            shape["description"] += f"{cls.KIND}: {meaning}; "
+    for key, shape in shapes.items():
+        bound = f"a number in (0, {_MAXIMA[key]:g}]" if key in _MAXIMA else "a number > 0"
+        shape["description"] += bound
+    return shapes
+
+
+def reaction_kinds_text() -> str:
+    """Each kind's keys and meaning, for the config's docs: {kind: decay, rate} (its class's first
+    docstring line), ... (B: {uniform: C0} or {source: <a source>, mass})."""
+    parts = []
+    for kind, cls in REACTIONS.items():
+        keys = ", ".join([*cls.PARAMS, *(["B"] if cls.CONSUMES_B else [])])
+        meaning = cls.__doc__.split(",")[0].strip()
+        parts.append(f"{{kind: {kind}, {keys}}} ({meaning[0].lower()}{meaning[1:]})")
+    return " or ".join(parts) + " (B: {uniform: C0} or {source: <a source>, mass})"
+
+
+def reaction_ranges_text() -> str:
+    """The allowed values of each kind's keys, for the config's docs."""
+    parts = []
+    for kind, cls in REACTIONS.items():
+        keys = ", ".join(
+            [
+                *(f"{k} > 0" for k in cls.PARAMS),
+                *(["B: {uniform: C0 > 0} or {source, mass > 0}"] if cls.CONSUMES_B else []),
+            ]
+        )
+        parts.append(f"{{kind: {kind}, {keys}}}")
+    return " or ".join(parts)

@@ -28,7 +28,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Field, StrictInt
 from pydantic_core import PydanticCustomError
 
-from .reactions import reaction_shape
+from .reactions import reaction_kinds_text, reaction_ranges_text, reaction_shape
 from .registry import (
     ADVECTION_SCHEMES,
     CONVENTION_NAMES,
@@ -572,12 +572,11 @@ SCENE = (
         "reaction",
         "scenes.<name>.reaction",
         NO_DEFAULT,
-        "a reaction of the source's species A (core/reactions.py): {kind: decay, rate} (A -> C, first order) "
-        "or {kind: bimolecular, k, B} (A + B -> C at rate k C_A C_B; B {uniform: C0} or {source: <a source>, "
-        "mass}); absent: a conservative plume",
+        f"a reaction of the source's species A (core/reactions.py): {reaction_kinds_text()}; absent: a "
+        "conservative plume",
         kind="shape",
         shape=reaction_shape(SOURCE_SHAPE),
-        range_text="{kind: decay, rate > 0} or {kind: bimolecular, k > 0, B: {uniform: C0 > 0} or {source, mass > 0}}",
+        range_text=reaction_ranges_text(),
     ),
     Setting(
         "margin",

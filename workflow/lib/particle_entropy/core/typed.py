@@ -573,16 +573,20 @@ class _ScenesPeclet(Section):
 
 
 class _Reaction(OneOf):
-    """A scene's reaction: a decay takes its rate, A + B -> C its k and B."""
+    """A scene's reaction: each kind its PARAMS (core/reactions.py), and B where it consumes B."""
 
     @model_validator(mode="after")
     def _keys_of_kind(self):
+        from .reactions import REACTIONS
+
         given = self.model_fields_set
-        own = {"decay": ("rate",), "bimolecular": ("k", "B")}[self.kind]
+        kinetics = REACTIONS[self.kind]
+        own = (*kinetics.PARAMS, *(("B",) if kinetics.CONSUMES_B else ()))
         for key in own:
             if key not in given:
                 raise refuse(key, f"a required key of a {self.kind} reaction")
-        for key in ("rate", "k", "B"):
+        every = dict.fromkeys(key for cls in REACTIONS.values() for key in cls.PARAMS) | {"B": None}
+        for key in every:
             if key in given and key not in own:
                 raise refuse(key, f"not a key of a {self.kind} reaction (it takes {', '.join(own)})")
         return self

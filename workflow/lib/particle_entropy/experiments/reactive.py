@@ -90,7 +90,7 @@ def plan(physics: dict):
     """What computing the reference of ``physics`` will take, before it runs (a
     reaction_diffusion.Plan: cells, steps, work, estimated seconds), or None for a decay's closed form."""
     reaction, source, D, _, t, _ = _inputs(physics)
-    if reaction.kind == "decay":
+    if reaction.closed_form(t) is not None:
         return None
     from ..numerics.reaction_diffusion import plan as rd_plan
 
@@ -106,14 +106,13 @@ def compute(physics: dict) -> dict:
     times) -> a JSON-ready mapping."""
     reaction, source, D, v, t, pts = _inputs(physics)
     times = t * np.arange(1, SERIES + 1) / SERIES
-    if reaction.kind == "decay":
-        # the product 1 - exp(-lambda t) as -expm1(-lambda t): no cancellation below lambda t ~ eps
-        made = -math.expm1(-reaction.kinetics.rate * t)
-        left = math.exp(-reaction.kinetics.rate * t)
+    form = reaction.closed_form(t)
+    if form is not None:  # the conservative plume times each species' share (a decay's product as -expm1)
+        left, made = form
         plume = source.density(pts, D, v, t)
         zero = [0.0] * pts.size
         return {
-            "method": "closed form: the conservative plume times exp(-lambda t)",
+            "method": f"closed form: the conservative plume times the {reaction.kind}'s shares of A and C",
             "product_mass": made,
             "product_error": 0.0,
             "product_order": math.nan,
@@ -126,7 +125,7 @@ def compute(physics: dict) -> dict:
             "c_error": zero,
             "c_asymptotic": [True] * pts.size,
             "times": times.tolist(),
-            "product_series": (-np.expm1(-reaction.kinetics.rate * times)).tolist(),
+            "product_series": [reaction.closed_form(s)[1] for s in times],
             "seconds": [0.0],
         }
     from ..numerics.reaction_diffusion import reference
