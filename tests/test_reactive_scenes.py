@@ -13,7 +13,7 @@ import pytest
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.experiments import reactive
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.experiments.scene import Scene, scenes
 from particle_entropy.models.simulate import run_arrow as one_runner
 
 
@@ -77,6 +77,40 @@ def test_a_measure_the_reaction_cannot_judge_is_refused():
     no_reaction["target"] = {"measure": "product_rmse", "value": 0.1}
     err = _refused(no_reaction)
     assert err.name == "scenes.r.target.measure" and "makes no product" in err.allowed
+
+
+def test_a_run_too_long_for_its_steps_is_refused_by_its_key_path_before_the_reference_is_planned():
+    """The reference's points are a run's (reactive.points): its plan must wait for the runs' checks,
+    or their refusal escapes unnamed, as `dt0`."""
+    err = _refused(
+        spec(
+            reaction=MIXED,
+            t_final=1e6,
+            D=1e-9,
+            candidates=[{"method": "fd", "kernel": "implicit", "n_range": [64, 1024]}],
+        )
+    )
+    assert err.name == "scenes.r.t_final" and "what fd implicit" in err.allowed
+
+
+def test_a_reference_job_finds_its_physics_and_a_run_its_reference_by_digest():
+    got = scenes(
+        {
+            "scenes": {
+                "plain": {k: v for k, v in spec(target={"value": 0.1}).items() if k != "reaction"},
+                "mixed": spec(reaction=MIXED),
+            }
+        }
+    )
+    mixed = got["mixed"]
+    key = reactive.digest(mixed)
+    physics = got.reference_physics(key)
+    assert physics == reactive.physics(mixed) and physics["reaction"]["kind"] == "bimolecular"
+    physics["D"] = 1.0  # a caller's copy: the index keeps its own
+    assert got.reference_physics(key)["D"] == mixed.D
+    assert got.reference_path(mixed.identity(mixed.candidates[2])) == reactive.path(mixed)
+    with pytest.raises(KeyError, match="no reactive scene has a reference keyed"):
+        got.reference_physics(reactive.digest(replace(mixed, D=2e-3)))
 
 
 def test_a_pt_rung_whose_pair_probability_exceeds_one_is_refused_with_the_least_n():

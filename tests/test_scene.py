@@ -134,6 +134,30 @@ def test_every_scene_of_a_config():
     assert len(scenes({})) == 0
 
 
+def test_a_job_finds_its_settings_in_an_index_digested_once(monkeypatch):
+    """Scenes.settings(identity): each candidate's identity, and each half-step twin's, digested once
+    however many jobs look one up; a lookup builds the scenes only up to its owner's."""
+    got = scenes({"scenes": {"one": spec(), "two": spec(v=0.0), "bad": spec(v=math.nan)}})
+    one = got["one"]
+    own = [one.identity(c) for c in one.candidates]
+    digested = []
+    identity = Scene.identity
+    monkeypatch.setattr(Scene, "identity", lambda self, c: digested.append(self.name) or identity(self, c))
+    for _ in range(3):  # as many jobs of the same runs
+        assert [got.settings(i) for i in own] == [one.settings(c) for c in one.candidates]
+    assert digested == ["one"] * len(one.candidates)  # once each; "two" and "bad" never needed
+
+    good = scenes({"scenes": {"one": spec(), "two": spec(v=0.0)}})
+    two = good["two"]
+    half = two.half_step(two.candidates[1])
+    assert good.settings(identity(two, half)) == two.settings(half) != two.settings(two.candidates[1])
+    digested.clear()
+    for _ in range(2):
+        with pytest.raises(KeyError, match="no scene candidate has runs keyed '000000000000'"):
+            good.settings("000000000000")
+    assert digested == []  # every part already indexed by the half-step lookup: nothing digested again
+
+
 def test_check_config_refuses_a_bad_scene_and_accepts_the_shipped_ones():
     from conftest import ROOT
 

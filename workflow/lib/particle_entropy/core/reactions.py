@@ -346,6 +346,23 @@ class Reaction:
             return np.full_like(x, self.b_uniform * dV)
         return self.b_mass * self.b_source.masses(x, dV)
 
+    def check_b_within(self, centre: float, width: float, beyond: float) -> None:
+        """ReactionError naming B.source unless B's plume and ``beyond`` past it (a scene's REACH
+        sqrt(4 D t_final)) lie within ``width`` around ``centre`` (A's): the narrower of a scene's
+        domains, outside which MTPT would put B's mass on the edge particle, FD on the edge node, PT
+        would wrap it. A uniform B, or none, fits any domain."""
+        b = self.b_source
+        if b is None:
+            return
+        need = 2.0 * (abs(b.centre - centre) + b.half_width + beyond)
+        if width < need * (1.0 - 1e-12):
+            raise ReactionError(
+                "B.source",
+                b.record(),
+                f"a plume within the scene's domains: omega and fd_length ({width:.6g} wide around A's centre) must "
+                f"reach {need:.6g}, B's extent and 3 sqrt(4 D t_final) beyond it; widen them, or leave them to margin",
+            )
+
 
 def reaction_shape(source_shape: dict) -> dict:
     """The JSON schema of a scene's reaction: {kind: decay, rate} or {kind: bimolecular, k, B}, B a

@@ -1,16 +1,18 @@
 """A scene (config `scenes.<name>`, declared by settings.SCENE): a problem of the user's own (D, a
 uniform v, a source, the observation time, the domains) with the candidate models to compare and the
 accuracy they must reach. A scene knows each candidate's runs: their settings, their identity and
-the ladder of resolutions its search may visit (analysis/scene_search.py)."""
+the ladder of resolutions its search may visit (analysis/scene_search.py). Each part checks its own
+values (a candidate here, its source and reaction in core/); the rules between the parts are in
+experiments/scene_checks.py."""
 
 from __future__ import annotations
 
+import copy
 import functools
 import hashlib
 import json
 import math
 import re
-import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
@@ -18,14 +20,14 @@ from ..core.case import CASE_DIR, Case, SettingError
 from ..core.reactions import Reaction, ReactionError
 from ..core.reference import Reference
 from ..core.registry import DEFAULT_ADVECTION
-from ..core.runconfig import RunConfig, check_plume_width
+from ..core.runconfig import RunConfig
 from ..core.runcost import StepWork, Tally
 from ..core.settings import MAX_REALISATIONS, PAPER, REACTIVE_COST, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
 from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
 from ..core.typed import key_path as typed_key_path
-from . import defined
+from . import defined, scene_checks
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -44,9 +46,9 @@ SPEC = shared().Scene  # a scene's model: its keys, their ranges and the rules b
 
 SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
 USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (the schema's pattern)
-# Half the digits of a double: a plume whose centre lies further than its width over this from x = 0
-# has positions (particles', nodes', points') rounded to more than this fraction of the width.
-HALF_DIGITS = math.sqrt(sys.float_info.epsilon)
+# what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
+REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
+_CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
 
 
 def key_path(name: str, key: str) -> str:
@@ -55,9 +57,6 @@ def key_path(name: str, key: str) -> str:
     if name.startswith(SWEEP_PREFIX):
         return f"scenes_peclet.v[{name[len(SWEEP_PREFIX) :]}]" if key == "v" else f"scenes_peclet.base.{key}"
     return f"scenes.{name}.{key}"
-
-
-_key = key_path
 
 
 def _number(x: float) -> str:
@@ -120,6 +119,87 @@ class Candidate:
             if not out or n > out[-1]:
                 out.append(int(n))
         return out
+
+    @classmethod
+    def from_spec(cls, spec, case_defaults: Mapping, key) -> Candidate:
+        """The candidate of its parsed model ``spec`` (its keys' rules held there, core/typed.py): its
+        case built with case_defaults (not their time_grid: a scene's runs end at t_final, where they
+        are judged), else SettingError naming ``key(k)``, the candidate's key k in its scene."""
+        dims = spec.model_dump(exclude_unset=True, exclude={*FD_ONLY, *PARTICLE_ONLY, "n_range", "ladder"})
+        case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
+        try:
+            case = Case.from_spec(dims, None, case_defaults)
+        except SettingError as e:
+            raise SettingError(key(e.name), e.value, e.allowed) from None
+        rungs = tuple(spec.ladder or ())
+        lo, hi = (rungs[0], rungs[-1]) if rungs else spec.n_range
+        advection = spec.advection or DEFAULT_ADVECTION
+        fd_dt = PAPER["fd_dt"] if spec.fd_dt is None else spec.fd_dt
+        return cls(case, lo, hi, advection, fd_dt, rungs, spec.courant, spec.dt0)
+
+    def check_runs(self, scene: Scene, i: int, written) -> None:
+        """SettingError unless this candidate's runs (candidate i of ``scene``) fit their domains and
+        steps at both ends of its ladder, named by the key the user wrote (run_error; ``written``:
+        the keys its config sets)."""
+        for n in dict.fromkeys((self.n_lo, self.ladder()[-1])):
+            try:
+                scene.run_config(self, n)
+            except SettingError as e:
+                raise self.run_error(scene, i, written, e) from None
+
+    def run_error(self, scene: Scene, i: int, written, e: SettingError) -> SettingError:
+        """A SettingError of this candidate's run (candidate i of ``scene``), named by the key the user
+        wrote (``written``): its n_range or ladder for a resolution, its fd_dt or else the scene's
+        t_final for a step count, its own dimension or else case_defaults' for a case dimension, the
+        scene's key for the physics."""
+        where = f"candidates[{i}]"
+        if e.name == "n":
+            key = "ladder" if self.rungs else "n_range"
+            value = list(self.rungs) if self.rungs else [self.n_lo, self.n_hi]
+            return SettingError(scene.key(f"{where}.{key}"), value, e.allowed)
+        if e.name == "courant":
+            return SettingError(scene.key(f"{where}.courant"), e.value, e.allowed)
+        if e.name == "dt0" and self.case.method == "fd" and "fd_dt" in written:
+            return SettingError(scene.key(f"{where}.fd_dt"), e.value, e.allowed)
+        if e.name == "dt0" and self.dt0 is not None:  # a particle step of its own: too many steps to t_final
+            least = max_first_step(scene.t_final, self.case.dt_growth)
+            return SettingError(
+                scene.key(f"{where}.dt0"),
+                self.dt0,
+                f"a number >= {least:.3g} [T]: a first step that reaches t_final = {scene.t_final:g} in at most "
+                f"{MAX_STEPS:,} steps",
+            )
+        if e.name == "dt0":  # a step the scene does not set: the time it must reach is the key
+            g = self.case.dt_growth
+            try:
+                most = e.value * MAX_STEPS if g == 1.0 else e.value * (g**MAX_STEPS - 1.0) / (g - 1.0)
+            except OverflowError:
+                most = math.inf
+            fd = self.case.method == "fd"
+            hint = f"; or give {where} an fd_dt >= {max_first_step(scene.t_final, g):.3g}" if fd else ""
+            return SettingError(
+                scene.key("t_final"),
+                scene.t_final,
+                f"a number in (0, {most:.6g}] [T]: what {self.label} ({where}) reaches in at most {MAX_STEPS:,} "
+                f"steps of its first step {e.value:g}{hint}",
+            )
+        if e.name in _CASE_DIMS:
+            key = scene.key(f"{where}.{e.name}") if e.name in written else f"case_defaults.{e.name}"
+            return SettingError(key, e.value, e.allowed)
+        if e.name in ("kernel", "advection", "fd_dt", "ladder"):
+            return SettingError(scene.key(f"{where}.{e.name}"), e.value, e.allowed)
+        return SettingError(scene.key(e.name), e.value, e.allowed)
+
+    def check_reactive(self, key, i: int) -> None:
+        """SettingError naming candidate i's scheme (``key``: the scene's key path) unless it can carry a
+        reaction: MTPT's symmetric transfer (REACTIVE_SCHEMES), not the authors' loop, which moves one
+        species."""
+        if self.case.method == "mtpt" and self.case.scheme not in REACTIVE_SCHEMES:
+            raise SettingError(
+                key(f"candidates[{i}].scheme"),
+                self.case.scheme,
+                f"{', '.join(REACTIVE_SCHEMES)} in a reactive scene: the transfer moves every species by one matrix",
+            )
 
 
 @dataclass(frozen=True)
@@ -254,19 +334,26 @@ class Scene:
         core/typed.py, as the workflow parses it) or that model parsed; SettingError naming the key
         path of a bad value, also for the rules that need the built scene and its runs."""
         s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, functools.partial(_where, name))
+        key = functools.partial(key_path, name)
         D, v, t_final, r = s.D, s.v, s.t_final, s.realisations
-        source = _source(name, s.source)
-        reaction = _reaction(name, s.reaction)
+        source = _source(key, s.source)
+        reaction = _reaction(key, s.reaction)
         extent = _extent(source, reaction)  # the domains hold a second species' plume too
         span = 2.0 * (extent + s.margin * math.sqrt(2.0 * D * t_final))
         omega = span if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         if s.fd_length is not None:  # from the margin it holds the plume by the margin's range
-            _check_window(name, fd_length, extent, D, t_final)
-        if reaction is not None and reaction.b_source is not None:
-            _check_species_b(name, reaction, source, min(omega, fd_length), D, t_final)
-        cands = tuple(_candidate(name, i, c, case_defaults or {}) for i, c in enumerate(s.candidates))
-        _distinct(name, cands)
+            scene_checks.check_window(key, fd_length, extent, D, t_final)
+        if reaction is not None:  # B's plume, if any, within the domains
+            try:
+                reaction.check_b_within(source.centre, min(omega, fd_length), REACH * math.sqrt(4.0 * D * t_final))
+            except ReactionError as e:
+                raise SettingError(key(f"reaction.{e.param}"), e.value, e.allowed) from None
+        cands = tuple(
+            Candidate.from_spec(c, case_defaults or {}, lambda k, i=i: key(f"candidates[{i}].{k}"))
+            for i, c in enumerate(s.candidates)
+        )
+        scene_checks.check_distinct(key, cands)
         if v == 0:  # nothing to advect: FD's scheme and Courant number are no part of the runs (the step is
             # fd_dt, its own or the default); twins keep their index (same_as)
             cands = tuple(replace(c, advection="none", courant=None) for c in cands)
@@ -275,14 +362,10 @@ class Scene:
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
         scene = replace(scene, budget=budget, max_realisations=most, reaction=reaction)
-        _check_reactive(scene)
-        _check_reach(scene)
+        scene_checks.check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
-            for n in dict.fromkeys((c.n_lo, c.ladder()[-1])):
-                try:
-                    scene.run_config(c, n)
-                except SettingError as e:
-                    raise _candidate_error(scene, i, s.candidates[i].model_fields_set, e) from None
+            c.check_runs(scene, i, s.candidates[i].model_fields_set)
+        scene_checks.check_reactive(scene)  # after the runs: the reference's points are a run's
         defined.check(scene, defined.closed_form(scene))  # a target its closed-form reference can judge
         return scene
 
@@ -290,125 +373,6 @@ class Scene:
 def _where(name: str, path: list) -> str:
     """The config key of the key ``path`` (keys and indexes) within scene ``name`` (key_path)."""
     return key_path(name, typed_key_path(path)) if path else key_path(name, "")[:-1]
-
-
-def _distinct(name: str, cands: tuple[Candidate, ...]) -> None:
-    """SettingError naming the second of two candidates that are the same model (Candidate.model)."""
-    seen: dict[tuple, int] = {}
-    for i, c in enumerate(cands):
-        if c.model in seen:
-            j = seen[c.model]
-            raise SettingError(
-                _key(name, f"candidates[{i}]"), c.label, f"a model other than candidates[{j}] ({c.label}): each once"
-            )
-        seen[c.model] = i
-
-
-def _check_reach(scene: Scene) -> None:
-    """SettingError unless the plume fits a grid at t_final (runconfig.check_plume_width) and its
-    centre then, x0 + v t_final, lies within its spread sqrt(2 D t_final) / HALF_DIGITS of x = 0:
-    further out a double rounds every position (particles, FD nodes, measurement points) by more
-    than HALF_DIGITS of the plume's width, and FD's grid, which spans the path, overflows (v = 1e300)."""
-    try:
-        check_plume_width(scene)
-    except SettingError as e:
-        raise SettingError(scene.key(e.name), e.value, e.allowed) from None
-    name, D, v, t_final, source = scene.name, scene.D, scene.v, scene.t_final, scene.source
-    spread = math.sqrt(2.0 * D * t_final)
-    reach = spread / HALF_DIGITS
-    x0 = source.centre
-    if abs(x0 + v * t_final) <= reach:
-        return
-    why = (
-        f"the plume's centre x0 + v t_final within sqrt(2 D t_final) / sqrt(eps) = {reach:.3g} of x = 0 "
-        f"(D = {D:g}, t_final = {t_final:g}, eps = {sys.float_info.epsilon:.3g}), where a double holds the "
-        "plume's width to half its digits"
-    )
-    if v != 0.0:
-        lo, hi = (-reach - x0) / t_final, (reach - x0) / t_final
-        raise SettingError(_key(name, "v"), v, f"a number in [{lo:.6g}, {hi:.6g}] [L/T]: {why}")
-    key = source.POSITION  # the parameter that places the source
-    raise SettingError(
-        _key(name, f"source.{key}"), getattr(source, key), f"a number in [{-reach:.6g}, {reach:.6g}]: {why}"
-    )
-
-
-_CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
-
-
-def _candidate_error(scene: Scene, i: int, spec, e: SettingError) -> SettingError:
-    """A SettingError of candidate i's run, named by the key the user wrote: its n_range or ladder for
-    a resolution, its fd_dt or else the scene's t_final for a step count, its own dimension or else
-    case_defaults' for a case dimension, the scene's key for the physics."""
-    cand, where = scene.candidates[i], f"candidates[{i}]"
-    if e.name == "n":
-        key = "ladder" if cand.rungs else "n_range"
-        value = list(cand.rungs) if cand.rungs else [cand.n_lo, cand.n_hi]
-        return SettingError(scene.key(f"{where}.{key}"), value, e.allowed)
-    if e.name == "courant":
-        return SettingError(scene.key(f"{where}.courant"), e.value, e.allowed)
-    if e.name == "dt0" and cand.case.method == "fd" and "fd_dt" in spec:
-        return SettingError(scene.key(f"{where}.fd_dt"), e.value, e.allowed)
-    if e.name == "dt0" and cand.dt0 is not None:  # a particle step of its own: too many steps to t_final
-        least = max_first_step(scene.t_final, cand.case.dt_growth)
-        return SettingError(
-            scene.key(f"{where}.dt0"),
-            cand.dt0,
-            f"a number >= {least:.3g} [T]: a first step that reaches t_final = {scene.t_final:g} in at most "
-            f"{MAX_STEPS:,} steps",
-        )
-    if e.name == "dt0":  # a step the scene does not set: the time it must reach is the key
-        g = cand.case.dt_growth
-        try:
-            most = e.value * MAX_STEPS if g == 1.0 else e.value * (g**MAX_STEPS - 1.0) / (g - 1.0)
-        except OverflowError:
-            most = math.inf
-        fd = cand.case.method == "fd"
-        hint = f"; or give {where} an fd_dt >= {max_first_step(scene.t_final, g):.3g}" if fd else ""
-        return SettingError(
-            scene.key("t_final"),
-            scene.t_final,
-            f"a number in (0, {most:.6g}] [T]: what {cand.label} ({where}) reaches in at most {MAX_STEPS:,} steps "
-            f"of its first step {e.value:g}{hint}",
-        )
-    if e.name in _CASE_DIMS:
-        key = scene.key(f"{where}.{e.name}") if e.name in spec else f"case_defaults.{e.name}"
-        return SettingError(key, e.value, e.allowed)
-    if e.name in ("kernel", "advection", "fd_dt", "ladder"):
-        return SettingError(scene.key(f"{where}.{e.name}"), e.value, e.allowed)
-    return SettingError(scene.key(e.name), e.value, e.allowed)
-
-
-def _check_window(name: str, fd_length: float, extent: float, D: float, t_final: float) -> None:
-    """SettingError naming scenes.<name>.fd_length unless the window reaches REACH sqrt(4 D t_final)
-    beyond the sources' extent (``extent``: the half width around A's centre holding A's source and
-    B's plume, _extent) on either side, as the paper's [-6, 6] at t = 1000: its zero ends then absorb
-    at most 2 erfc(3) = 4.4e-5 of each species' mass by t_final (an upper bound: a flow only lowers
-    it); a window of +- 1 sqrt(2 D t_final) lost a third."""
-    need = 2.0 * (extent + REACH * math.sqrt(4.0 * D * t_final))
-    if fd_length < need * (1.0 - 1e-12):  # the paper's own 12 is the bound at its D, t_final
-        extent_text = f"the sources' extent {2.0 * extent:.6g} + " if extent else ""
-        raise SettingError(
-            _key(name, "fd_length"),
-            fd_length,
-            f"a window >= {extent_text}2 x {REACH:g} sqrt(4 D t_final) = {need:.6g} for D = {D:g}, t_final = "
-            f"{t_final:g} (the paper's [-6, 6] at t = 1000, whose zero ends absorb 2 erfc(3) = 4.4e-5 of the mass "
-            "by then): a narrower window loses the plume through its ends",
-        )
-
-
-def _reaction(name: str, spec) -> Reaction | None:
-    """The reaction at scenes.<name>.reaction (Reaction.from_spec), else SettingError naming its key path."""
-    if spec is None:
-        return None
-    try:
-        return Reaction.from_spec(spec.model_dump(exclude_unset=True, warnings=False))
-    except ReactionError as e:
-        raise SettingError(_key(name, f"reaction.{e.param}"), e.value, e.allowed) from None
-
-
-# what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
-REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 
 
 def _extent(source: Source, reaction: Reaction | None) -> float:
@@ -420,102 +384,23 @@ def _extent(source: Source, reaction: Reaction | None) -> float:
     return max(source.half_width, abs(b.centre - source.centre) + b.half_width)
 
 
-def _check_species_b(name: str, reaction: Reaction, source: Source, width: float, D: float, t_final: float) -> None:
-    """SettingError naming scenes.<name>.reaction.B.source unless B's plume and REACH sqrt(4 D t_final)
-    beyond it lie within the narrower of the domains (omega, fd_length) around A's centre: outside
-    them MTPT would put B's mass on the edge particle, FD on the edge node, PT would wrap it."""
-    b = reaction.b_source
-    need = 2.0 * (abs(b.centre - source.centre) + b.half_width + REACH * math.sqrt(4.0 * D * t_final))
-    if width < need * (1.0 - 1e-12):
-        raise SettingError(
-            _key(name, "reaction.B.source"),
-            b.record(),
-            f"a plume within the scene's domains: omega and fd_length ({width:.6g} wide around A's centre) must "
-            f"reach {need:.6g}, B's extent and 3 sqrt(4 D t_final) beyond it; widen them, or leave them to margin",
-        )
-
-
-def _check_pair_probability(scene: Scene, i: int, c: Candidate) -> None:
-    """SettingError naming a PT candidate's resolutions where Benson & Meerschaert's pair probability
-    k m_p dt v(0) (m_p = 1 / N, v(0) = 1 / sqrt(8 pi D dt)) exceeds 1 at its largest step: it holds
-    from N >= k sqrt(dt / (8 pi D)) on (models/reaction_step.max_pair_probability)."""
-    from ..core.timegrid import time_steps
-    from ..models.reaction_step import max_pair_probability
-
-    k = scene.reaction.kinetics.k
-    for n in (c.n_lo, *c.rungs):
-        cfg = scene.run_config(c, n)
-        dt = float(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid).max())  # the runner's grid
-        if max_pair_probability(k, 1.0 / n, scene.D, dt) > 1.0:
-            least = math.ceil(k * math.sqrt(dt / (8.0 * math.pi * scene.D)))
-            key = "ladder" if c.rungs else "n_range"
-            raise SettingError(
-                scene.key(f"candidates[{i}].{key}"),
-                list(c.rungs) if c.rungs else [c.n_lo, c.n_hi],
-                f"particle numbers >= {least:,}: PT's pair probability k dt v(0) / N (Benson & Meerschaert "
-                f"2008) exceeds 1 below that at its largest step dt = {dt:.4g}",
-            )
-
-
-def _check_reference_cost(scene: Scene) -> None:
-    """SettingError naming scenes.<name>.reaction.k where the scene's reference (experiments/reactive.py)
-    would take more than numerics/reaction_diffusion's MAX_WORK: its plan, known before any job, and
-    its estimate in the message. The kinetic rule's steps are capped at that bound; what is refused
-    is a reference whose diffusion rule (r <= 1/4 on the coarsest grid) alone exceeds it."""
-    from ..numerics.reaction_diffusion import MAX_WORK, SECONDS_PER_CELL_STEP
-    from .reactive import physics, plan
-
-    how = plan(physics(scene))
-    if how is None or how.work <= MAX_WORK:
-        return
-    raise SettingError(
-        scene.key("reaction.k"),
-        scene.reaction.kinetics.k,
-        f"a reaction whose reference takes at most {MAX_WORK:.3g} cell-steps (~{MAX_WORK * SECONDS_PER_CELL_STEP:.3g} "
-        f"s); this one's would take {how.describe()}",
-    )
-
-
-def _check_reactive(scene: Scene) -> None:
-    """SettingError naming a candidate that cannot carry the scene's reaction: an MTPT scheme other than
-    the symmetric transfer (the authors' loop moves one species)."""
-    if scene.reaction is None:
-        return
-    _check_reference_cost(scene)
-    for i, c in enumerate(scene.candidates):
-        if c.case.method == "pt" and scene.reaction.kind == "bimolecular":
-            _check_pair_probability(scene, i, c)
-        if c.case.method == "mtpt" and c.case.scheme not in REACTIVE_SCHEMES:
-            raise SettingError(
-                scene.key(f"candidates[{i}].scheme"),
-                c.case.scheme,
-                f"{', '.join(REACTIVE_SCHEMES)} in a reactive scene: the transfer moves every species by one matrix",
-            )
-
-
-def _source(name: str, spec) -> Source:
-    """The source at scenes.<name>.source (Source.from_spec), else SettingError naming its key path."""
+def _source(key, spec) -> Source:
+    """The source at scenes.<name>.source (Source.from_spec), else SettingError naming its key path
+    (``key``: a key's path in the scene)."""
     try:
         return Source.from_spec(spec)
     except SourceError as e:
-        raise SettingError(_key(name, f"source.{e.param}"), e.value, e.allowed) from None
+        raise SettingError(key(f"source.{e.param}"), e.value, e.allowed) from None
 
 
-def _candidate(name: str, i: int, spec, case_defaults: Mapping) -> Candidate:
-    """Candidate i of scene ``name`` from its parsed model (its keys' rules held there, core/typed.py):
-    its case built with case_defaults (not their time_grid: a scene's runs end at t_final, where they
-    are judged), else SettingError naming the candidate's key or case_defaults'."""
-    dims = spec.model_dump(exclude_unset=True, exclude={*FD_ONLY, *PARTICLE_ONLY, "n_range", "ladder"})
-    case_defaults = {k: v for k, v in case_defaults.items() if k != "time_grid"}
+def _reaction(key, spec) -> Reaction | None:
+    """The reaction at scenes.<name>.reaction (Reaction.from_spec), else SettingError naming its key path."""
+    if spec is None:
+        return None
     try:
-        case = Case.from_spec(dims, None, case_defaults)
-    except SettingError as e:
-        raise SettingError(_key(name, f"candidates[{i}].{e.name}"), e.value, e.allowed) from None
-    rungs = tuple(spec.ladder or ())
-    lo, hi = (rungs[0], rungs[-1]) if rungs else spec.n_range
-    advection = spec.advection or DEFAULT_ADVECTION
-    fd_dt = PAPER["fd_dt"] if spec.fd_dt is None else spec.fd_dt
-    return Candidate(case, lo, hi, advection, fd_dt, rungs, spec.courant, spec.dt0)
+        return Reaction.from_spec(spec.model_dump(exclude_unset=True, warnings=False))
+    except ReactionError as e:
+        raise SettingError(key(f"reaction.{e.param}"), e.value, e.allowed) from None
 
 
 class Scenes(Mapping):
@@ -538,6 +423,10 @@ class Scenes(Mapping):
         self._check = check  # a further check of each built scene (the workflow's memory check)
         self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
         self._built: dict[str, Scene] = {}
+        # The jobs' lookups by digest, each filled once, a scene at a time as lookups reach it (_find):
+        self._runs: dict[str, tuple[Scene, Candidate]] = {}  # identity -> the scene and runs it keys
+        self._references: dict[str, dict] = {}  # a reference's key -> its physics
+        self._indexed: set[tuple] = set()  # the parts of scenes already in these
 
     def __getitem__(self, name: str) -> Scene:
         if name not in self._built:
@@ -559,16 +448,36 @@ class Scenes(Mapping):
         """The config of scene ``name`` as written (a Peclet scene: its base with its v)."""
         return self._specs[name]
 
+    def _find(self, index: dict, key: str, parts, add):
+        """``index[key]``, adding the scenes' ``parts`` to ``index`` in their order, each once in the
+        life of this mapping (``add(part)``), until it holds ``key``; None if no part has it. A lookup
+        thus builds the scenes only up to the one it needs (a bad scene after it blocks none of its
+        jobs), and no identity is digested twice however many jobs look one up."""
+        for part in parts:
+            if key in index:
+                break
+            if part not in self._indexed:
+                add(part)
+                self._indexed.add(part)
+        return index.get(key)
+
+    def _add_runs(self, part: tuple) -> None:
+        """The identities of one scene's candidates' runs (their half-step twins' if ``halved``); the
+        first scene and candidate of an identity keep it (equal identities: equal settings)."""
+        _, name, halved = part
+        scene = self[name]
+        for candidate in scene.candidates:
+            runs = scene.half_step(candidate) if halved else candidate
+            self._runs.setdefault(scene.identity(runs), (scene, runs))
+
     def _owner(self, identity: str) -> tuple[Scene, Candidate]:
-        # each candidate's runs first; only then those at half a step (an answer's check), whose
+        # every scene's own runs first; only then those at half a step (an answer's check), whose
         # candidates a particle's resolved first step must be built for
-        for halved in (False, True):
-            for scene in self.values():
-                for candidate in scene.candidates:
-                    runs = scene.half_step(candidate) if halved else candidate
-                    if scene.identity(runs) == identity:
-                        return scene, runs
-        raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+        parts = (("runs", name, halved) for halved in (False, True) for name in self)
+        found = self._find(self._runs, identity, parts, self._add_runs)
+        if found is None:
+            raise KeyError(f"no scene candidate has runs keyed {identity!r}")
+        return found
 
     def settings(self, identity: str) -> dict:
         """The run settings of the candidate runs keyed by ``identity`` (Scene.identity)."""
@@ -586,10 +495,16 @@ class Scenes(Mapping):
         the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
         from . import reactive
 
-        for scene in self.values():
-            if scene.reaction is not None and reactive.key(physics := reactive.physics(scene)) == key:
-                return physics
-        raise KeyError(f"no reactive scene has a reference keyed {key!r}")
+        def add(part: tuple) -> None:
+            scene = self[part[1]]
+            if scene.reaction is not None:
+                physics = reactive.physics(scene)
+                self._references.setdefault(reactive.key(physics), physics)
+
+        found = self._find(self._references, key, (("reference", name) for name in self), add)
+        if found is None:
+            raise KeyError(f"no reactive scene has a reference keyed {key!r}")
+        return copy.deepcopy(found)  # the index's own stays as built
 
 
 def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:

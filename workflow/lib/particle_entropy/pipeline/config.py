@@ -13,7 +13,9 @@ jobs import core/run_settings.py and core/shear_settings.py, and a job's code ha
 imports (pipeline/codeversion.py), so a rewrite would rerun every simulation once and put pydantic
 into every job. schemagen renders the schema and docs/config.md from these models.
 
-``Config`` is what ``configcheck.validate_config`` returns: the merged config, parsed once. A key
+``Config`` is what ``parse`` returns and ``configcheck.validate_config`` returns checked: the merged
+config, parsed once. It sits here, below the checks that read it (pipeline/crosschecks.py, then
+pipeline/configcheck.py), so that no module imports one that imports it back. A key
 the config may leave out and that has no default (a section, a search's ``n``) is None in it; an
 explicit null is refused, as the schema refuses it (such fields are typed ``X`` with default None,
 not ``X | None``).
@@ -23,10 +25,11 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Mapping
 from types import SimpleNamespace
 from typing import Annotated
 
-from pydantic import ConfigDict, Field, create_model, model_validator
+from pydantic import ConfigDict, Field, ValidationError, create_model, model_validator
 from pydantic_core import PydanticCustomError
 
 from ..core.settings import (
@@ -48,6 +51,7 @@ from ..core.typed import (  # noqa: F401  (the model builders, re-exported for s
     Section,
     annotation,
     annotation_of,
+    bounded,
     description,
     field,
     is_model,
@@ -57,6 +61,7 @@ from ..core.typed import (  # noqa: F401  (the model builders, re-exported for s
     refuse,
     required,
     section,
+    setting_error,
     shared,
 )
 from ..figures import PAPER_FIGURES
@@ -180,3 +185,14 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
 
 _MODELS = build()
 Config = _MODELS.Config  # the whole config; its sections' models: build()
+
+
+def parse(config: Mapping):
+    """The config as its typed form (``Config``): each section by its model (types, ranges, required
+    and unknown keys, the rules within a section); SettingError names the key path, the value and the
+    allowed range, as the schema's check did. Only parses: configcheck.validate_config also checks the
+    rules between sections and the runs the config plans (pipeline/crosschecks.py)."""
+    try:
+        return Config.model_validate(dict(config))
+    except ValidationError as e:
+        raise bounded(setting_error(e, config, Config)) from None

@@ -32,6 +32,8 @@ from ..core.typed import (  # noqa: F401  (re-exported: the messages' helpers, w
     setting_error,
     short,
 )
+from .config import parse
+from .crosschecks import check_memory, check_scene, check_search, check_sweeps
 
 SCHEMA_PATH = Path(__file__).resolve().parents[3] / "schemas" / "config.schema.yaml"
 _NUMBER_TEXT = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
@@ -282,28 +284,11 @@ def load_schema(path: str | Path = SCHEMA_PATH) -> Mapping:
         return yaml.load(f, Loader=SAFE_LOADER)
 
 
-def parse(config: Mapping):
-    """The config as its typed form (pipeline.config.Config): each section by its model (types,
-    ranges, required and unknown keys, the rules within a section); SettingError names the key
-    path, the value and the allowed range, as the schema's check did. Only parses:
-    validate_config also checks the rules between sections and the runs the config plans."""
-    from pydantic import ValidationError
-
-    from .config import Config
-
-    try:
-        return Config.model_validate(dict(config))
-    except ValidationError as e:
-        raise bounded(setting_error(e, config, Config)) from None
-
-
 def validate_config(config: Mapping):
     """The merged config validated once and returned typed (pipeline.config.Config): parsed by its
     section models (parse), then the rules between sections and runs (crosschecks.check_sweeps)
     checked on it. SettingError names the key path, the value and the allowed range; its message
     is bounded."""
-    from .crosschecks import check_sweeps
-
     typed = parse(config)
     try:
         check_sweeps(config, typed)
@@ -324,7 +309,6 @@ def check_config(
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
     from ..experiments.scene import scenes
-    from .crosschecks import check_memory, check_scene, check_search
 
     if schema is not None:  # the workflow's, as check_schema takes it
         check_schema(config, schema)
@@ -372,8 +356,6 @@ def check_parsed_config(
     validate); every rule between fields (crosschecks.check_sweeps); and given the ``available``
     bytes of the machine the jobs run on, that each job fits (crosschecks.check_memory). The
     searches and scenes are checked when a target first needs them."""
-    from .crosschecks import check_memory, check_sweeps
-
     retype_overrides(config, overrides)
     typed = parse(config)
     fill_defaults(config, str(schema_path))

@@ -19,8 +19,7 @@ from ..core.labels import case_label
 from ..core.runconfig import FD_MIN_INTERVALS, MAX_SEED, RunConfig, first_step_key
 from ..core.settings import SETTINGS
 from ..core.typed import check_finite
-from .config import Config
-from .configcheck import parse
+from .config import Config, parse
 from .memory import estimate_mb, shear_memory_mb
 from .sweeps import (
     Ensemble,

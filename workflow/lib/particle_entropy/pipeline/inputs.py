@@ -101,7 +101,7 @@ class Inputs:
     (sweeps.run_settings: the simulate jobs' params)."""
 
     def __init__(self, config: Mapping, error: type[Exception] = ValueError, typed=None):
-        from .configcheck import parse
+        from .config import parse
 
         self.config = config
         self.typed = typed if typed is not None else parse(config)
