@@ -41,6 +41,13 @@ class OutputError(ValueError):
     """An output path that must not be written; the message names the path and the reason."""
 
 
+def digest(settings) -> str:
+    """What a file is keyed by: 12 hex digits of the SHA-256 of ``settings`` as canonical JSON (sorted keys,
+    no spaces): a scene run's settings (Scene.identity), a reference's physics (reference_file.key)."""
+    text = json.dumps(settings, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
 def check_output_path(path: str | os.PathLike) -> Path:
     """``path`` as a Path if a table may be written there: a new path or an existing regular
     file, whose ``.sha256`` beside it is new or a regular file too, in a folder that exists or can

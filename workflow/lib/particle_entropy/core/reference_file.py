@@ -12,13 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import TableReadError
+from .io import TableReadError, digest
 
 
 def key(physics: dict) -> str:
-    """A reference's key: a digest of its physics (12 hex digits)."""
-    text = json.dumps(physics, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
+    """A reference's key: a digest of its physics (core/io.digest)."""
+    return digest(physics)
 
 
 def content_sha256(ref: dict) -> str:

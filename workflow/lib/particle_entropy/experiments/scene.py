@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import copy
 import functools
-import hashlib
-import json
 import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..core.case import CASE_DIR, Case, SettingError
+from ..core.io import digest
 from ..core.reactions import Reaction, ReactionError
 from ..core.reference import Reference
 from ..core.registry import DEFAULT_ADVECTION
@@ -307,8 +306,7 @@ class Scene:
     def identity(self, candidate: Candidate) -> str:
         """What a run's file is keyed by besides its case and seeds: a digest of its settings, so that
         two scenes share a run only when their physics (and FD's scheme and step) are equal."""
-        text = json.dumps(self.settings(candidate), sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()[:12]
+        return digest(self.settings(candidate))
 
     def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
         """The checked run of a candidate at resolution n."""

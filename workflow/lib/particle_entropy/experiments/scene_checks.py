@@ -90,7 +90,7 @@ def check_reactive(scene) -> None:
         return
     check_reference_cost(scene)
     for i, c in enumerate(scene.candidates):
-        if c.case.method == "pt" and scene.reaction.kind == "bimolecular":
+        if c.case.method == "pt" and scene.reaction.kinetics.CONSUMES_B:  # PT reacts A with B by pairs
             check_pair_probability(scene, i, c)
         c.check_reactive(scene.key, i)
 
