@@ -90,8 +90,8 @@ def _scene(config: str, name: str, source: str):
     from dataclasses import replace
 
     from particle_entropy.core.sources import Source
-    from particle_entropy.experiments.scene import scenes
     from particle_entropy.pipeline.configcheck import load_yaml
+    from particle_entropy.scenes.scene import scenes
 
     scene = scenes(load_yaml(config))[name]
     if source == "gaussian":  # the twin: a Gaussian of the box's variance

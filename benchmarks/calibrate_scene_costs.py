@@ -24,9 +24,9 @@ import numpy as np
 from scipy.optimize import nnls
 
 from particle_entropy.core.heap import keep_freed_pages
-from particle_entropy.experiments.scene import scenes
 from particle_entropy.models.simulate import run_seeds_arrow
 from particle_entropy.pipeline.configcheck import load_yaml
+from particle_entropy.scenes.scene import scenes
 
 RUNGS = 4  # rungs timed per candidate
 

@@ -22,10 +22,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "workflow" / "lib"))
 from scipy.linalg import lapack  # noqa: E402
 
-from particle_entropy.experiments.scene import Scene  # noqa: E402
 from particle_entropy.models import fd  # noqa: E402
 from particle_entropy.numerics.compiled import kernels  # noqa: E402
 from particle_entropy.numerics.thomas import SMALLEST_NORMAL  # noqa: E402
+from particle_entropy.scenes.scene import Scene  # noqa: E402
 
 
 def best(fn, calls: int = 50, repeats: int = 5) -> float:

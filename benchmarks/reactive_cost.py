@@ -44,10 +44,10 @@ from calibrate_scene_costs import fit, rungs
 from particle_entropy.core import records
 from particle_entropy.core.heap import keep_freed_pages
 from particle_entropy.core.runcost import StepWork
-from particle_entropy.experiments import reactive
-from particle_entropy.experiments.scene import scenes
 from particle_entropy.models import simulate
 from particle_entropy.pipeline.configcheck import load_yaml
+from particle_entropy.scenes import reference as reactive
+from particle_entropy.scenes.scene import scenes
 
 
 def reference(scene) -> dict:

@@ -46,10 +46,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow" / "lib"))
 from particle_entropy.analysis.step_error import mean_interval, observed_order  # noqa: E402
 from particle_entropy.core.timegrid import time_steps  # noqa: E402
-from particle_entropy.experiments import reactive  # noqa: E402
-from particle_entropy.experiments.scene import Candidate, Scene  # noqa: E402
 from particle_entropy.models import simulate  # noqa: E402
 from particle_entropy.pipeline.configcheck import load_yaml  # noqa: E402
+from particle_entropy.scenes import reference as reactive  # noqa: E402
+from particle_entropy.scenes.scene import Candidate, Scene  # noqa: E402
 
 CARRIED = {
     "D": 1.0e-4,

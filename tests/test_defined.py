@@ -1,4 +1,4 @@
-"""A target its reference cannot judge (experiments/defined.py, issue 50): refused before any job where
+"""A target its reference cannot judge (scenes/defined.py, issue 50): refused before any job where
 the reference is a closed form, else every candidate stopped with the reason and nothing recommended."""
 
 import numpy as np
@@ -6,8 +6,8 @@ import pytest
 
 from particle_entropy.analysis import scene_search as S
 from particle_entropy.core.case import SettingError
-from particle_entropy.experiments.defined import undefined
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.scenes.defined import undefined
+from particle_entropy.scenes.scene import Scene
 
 PTS = np.linspace(-1.0, 1.0, 15)
 

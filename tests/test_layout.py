@@ -10,7 +10,7 @@ import pytest
 import particle_entropy
 
 PACKAGE = Path(particle_entropy.__file__).parent
-LAYERS = ["core", "numerics", "models", "experiments", "analysis", "figures", "pipeline"]  # bottom up
+LAYERS = ["core", "numerics", "models", "experiments", "scenes", "analysis", "figures", "pipeline"]  # bottom up
 
 
 def _imported_packages(path: Path) -> set[str]:
@@ -103,7 +103,7 @@ def test_the_import_graph_sees_lazy_imports_and_circles():
     graph = _import_graph()
     assert "particle_entropy.pipeline.crosschecks" in graph["particle_entropy.pipeline.configcheck"]
     # imported inside a function only: the reference cost's plan
-    assert "particle_entropy.experiments.reactive" in graph["particle_entropy.experiments.scene_checks"]
+    assert "particle_entropy.scenes.reference" in graph["particle_entropy.scenes.checks"]
     assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
 
 

@@ -14,9 +14,9 @@ import pytest
 import yaml
 
 from particle_entropy.core.records import TIMING_COLUMNS
-from particle_entropy.experiments import reactive
-from particle_entropy.experiments.scene import Scene
 from particle_entropy.models.simulate import run_seeds_arrow
+from particle_entropy.scenes import reference as reactive
+from particle_entropy.scenes.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 BEFORE = json.loads((ROOT / "tests" / "data" / "runs_before_one_runner.json").read_text())["digests"]

@@ -15,9 +15,9 @@ import pytest
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.core.reactions import REACTIONS, Production, Reaction
-from particle_entropy.experiments import reactive
-from particle_entropy.experiments.scene import Scene
 from particle_entropy.models.simulate import run_arrow
+from particle_entropy.scenes import reference as reactive
+from particle_entropy.scenes.scene import Scene
 
 RATE, T = 0.05, 20.0
 CANDIDATES = [

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from particle_entropy.core.case import SettingError
-from particle_entropy.experiments import reactive
-from particle_entropy.experiments.scene import Scene, scenes
 from particle_entropy.models.simulate import run_arrow as one_runner
+from particle_entropy.scenes import reference as reactive
+from particle_entropy.scenes.scene import Scene, scenes
 
 
 def run_arrow(cfg, reaction, ref):
@@ -521,6 +521,6 @@ def test_the_reference_rule_s_code_hash_covers_the_solver():
     from particle_entropy.pipeline.codeversion import closure, script_imports
 
     script = Path(__file__).parents[1] / "workflow" / "scripts" / "scene_reference.py"
-    assert {"experiments.reactive", "numerics.reaction_diffusion"} <= set(closure(script_imports(script)))
+    assert {"scenes.reference", "numerics.reaction_diffusion"} <= set(closure(script_imports(script)))
     rule = (Path(__file__).parents[1] / "workflow" / "rules" / "scenes.smk").read_text()
     assert 'code=script_code(SCRIPTS / "scene_reference.py")' in rule

@@ -15,8 +15,8 @@ from particle_entropy.analysis.scene_search import SceneSearch
 from particle_entropy.core.case import Case
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.core.runcost import RunCost, StepWork, Tabulated, Tally, run_steps, units_per_step
-from particle_entropy.experiments.scene import Scene
 from particle_entropy.pipeline.jobcost import JOB_COST, PAIR_S, STEP_S, UNIT_S, estimated_seconds
+from particle_entropy.scenes.scene import Scene
 
 
 def _pt(n=10, **kw):

@@ -1,4 +1,4 @@
-"""A scene from config (experiments/scene.py): defaults, domains, identity, ladders and refusals."""
+"""A scene from config (scenes/scene.py): defaults, domains, identity, ladders and refusals."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from particle_entropy.core.case import SettingError
 from particle_entropy.core.timegrid import MAX_STEPS
-from particle_entropy.experiments.scene import Scene, scenes
+from particle_entropy.scenes.scene import Scene, scenes
 
 FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 1000]}
 MTPT = {"method": "mtpt", "kernel": "collision", "n_range": [30, 3000]}

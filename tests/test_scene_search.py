@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from particle_entropy.analysis import scene_search as S
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.scenes.scene import Scene
 
 FD = {"method": "fd", "kernel": "implicit", "n_range": [16, 4096]}
 MTPT = {"method": "mtpt", "kernel": "collision", "n_range": [32, 8192]}
@@ -642,9 +642,9 @@ def test_a_scene_whose_errors_are_nan_is_drawn_saying_so(tmp_path):
     import matplotlib
 
     matplotlib.use("Agg")
-    from particle_entropy.experiments import reactive
     from particle_entropy.figures.scene import scene as draw
     from particle_entropy.figures.style import save_figure
+    from particle_entropy.scenes import reference as reactive
 
     spec = {
         "v": 0.01,

@@ -16,7 +16,7 @@ from particle_entropy.analysis import search as E
 from particle_entropy.analysis.optimum import MAX_ROUNDS, PLAN_COLUMNS, REASONS, Search
 from particle_entropy.core.case import Case
 from particle_entropy.core.io import write_parquet
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.scenes.scene import Scene
 
 MTPT = Case("mtpt", "collision", None)
 

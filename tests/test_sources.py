@@ -12,8 +12,8 @@ from scipy.integrate import quad
 from particle_entropy.core.case import SettingError
 from particle_entropy.core.settings import SOURCE_SHAPE
 from particle_entropy.core.sources import LEGACY_FIELDS, SOURCES, Source, SourceError, TwoGaussians, source_shape
-from particle_entropy.experiments.scene import Scene
 from particle_entropy.models import simulate
+from particle_entropy.scenes.scene import Scene
 
 # one valid spec per kind (a new kind adds one here and every test below covers it)
 EXAMPLES = {

@@ -1115,7 +1115,7 @@ def _scene_overlay(tmp_path, name: str, **changes) -> Path:
 
 def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     from particle_entropy.analysis.scene_search import plan_paths
-    from particle_entropy.experiments.scene import Scene
+    from particle_entropy.scenes.scene import Scene
 
     work = tmp_path / "scenes"
     # from an empty kernel cache: the first job compiles the kernels, and a run exiting 0 has made
@@ -1275,7 +1275,7 @@ def test_a_bad_reference_and_a_corrupt_scene_table_are_rebuilt_by_the_same_scene
     """Issue 50 (10): another scene's valid reference copied over a decay scene's was used (rc 0,
     errors 0.331 where 2.4e-5 was true), and a corrupt scene table was set aside but not rebuilt by
     `snakemake scenes` (rc 0, the table missing). Both are now set aside and rebuilt in one run."""
-    from particle_entropy.experiments import reactive
+    from particle_entropy.scenes import reference as reactive
 
     work, config = tmp_path / "work", tmp_path / "decay.yaml"
     config.write_text(yaml.safe_dump(DECAY_SCENE))

@@ -17,8 +17,8 @@ from particle_entropy.pipeline.codeversion import export_library_path
 export_library_path(LIB)  # jobs import this checkout's library in any software environment
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import SHEAR
-from particle_entropy.experiments.reactive import REFERENCE_PATTERN, path as reactive_reference_path
-from particle_entropy.experiments.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
+from particle_entropy.scenes.reference import REFERENCE_PATTERN, path as reactive_reference_path
+from particle_entropy.scenes.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
 from particle_entropy.figures import BY_NAME as FIGURE, figure_options
 from particle_entropy.pipeline import inputs
 from particle_entropy.pipeline.codeversion import script_code, simulation_code

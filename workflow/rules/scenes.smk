@@ -1,4 +1,4 @@
-# Scenes (config `scenes`, experiments/scene.py): for each, the cheapest candidate model that
+# Scenes (config `scenes`, scenes/scene.py): for each, the cheapest candidate model that
 # reaches the stated accuracy, and the COMIC-best (analysis/scene_search.py). Each round of a scene's
 # search is a checkpoint whose plan names the runs to make next; every run is an ordinary job.
 # Their own target: `snakemake -j2 scenes`.
@@ -27,7 +27,7 @@ rule simulate_scene:
         "../scripts/simulate.py"
 
 
-# A reactive scene's reference (experiments/reactive.py), once per physics: the closed form of a
+# A reactive scene's reference (scenes/reference.py), once per physics: the closed form of a
 # decay, or A + B -> C on three fine grids in the frame moving with v, Richardson-extrapolated.
 rule scene_reference:
     output:

@@ -60,7 +60,7 @@ _scene_round_inputs = search_inputs(scene_kind, "scene_round")
 
 def scene_round_inputs(wildcards):
     """A scene's round reads its last plan and runs, and a reactive scene's its reference too (a target
-    the reference cannot judge stops the search before any run: experiments/defined.py)."""
+    the reference cannot judge stops the search before any run: scenes/defined.py)."""
     out = _scene_round_inputs(wildcards)
     scene = SCENES[wildcards.name]
     if scene.reaction is not None:

@@ -7,7 +7,7 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
 from particle_entropy.analysis.scene_search import SceneSearch
 from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.scenes.scene import Scene
 
 exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
@@ -16,7 +16,7 @@ scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
 plan = read_parquet(inp.plan) if "plan" in inp.keys() else None
 reference = None
 if "reference" in inp.keys():  # a reactive scene's: a target it cannot judge stops the search at once
-    from particle_entropy.experiments.reactive import read
+    from particle_entropy.scenes.reference import read
 
     reference = read(inp.reference)
 plan = SceneSearch(scene, reference).round(

@@ -7,7 +7,7 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
 from particle_entropy.analysis.scene_search import judged, read_runs, result
 from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
-from particle_entropy.experiments.scene import Scene
+from particle_entropy.scenes.scene import Scene
 
 exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
@@ -16,8 +16,8 @@ scene = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults)
 plan = read_parquet(inp.plan)
 reference, why = None, ""
 if scene.reaction is not None:  # judged against its reference, which may leave the target undefined
-    from particle_entropy.experiments.defined import undefined
-    from particle_entropy.experiments.reactive import read
+    from particle_entropy.scenes.defined import undefined
+    from particle_entropy.scenes.reference import read
 
     reference = read(inp.reference)
     why = undefined(scene.measure, scene.value, reference)

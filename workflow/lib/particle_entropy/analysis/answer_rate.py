@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from ..core.registry import MEASUREMENT_POINTS
-from ..experiments.scene import Scene
+from ..scenes.scene import Scene
 from . import scene_search
 from .resampling import CONFIDENCE
 

@@ -1,4 +1,4 @@
-"""The cheapest model of a scene (experiments/scene.py) that reaches its accuracy, and the COMIC-best.
+"""The cheapest model of a scene (scenes/scene.py) that reaches its accuracy, and the COMIC-best.
 
 For each candidate, the smallest rung of its affordable ladder (Candidate.ladder, within the budget)
 whose mean error meets the target: the one-sided upper bound mean + t_q s / sqrt(R) of R
@@ -31,8 +31,8 @@ import pandas as pd
 
 from ..core.io import read_parquet
 from ..core.registry import MEASUREMENT_POINTS
-from ..experiments import defined
-from ..experiments.scene import SCENE_RUN_PATTERN, Candidate, Scene
+from ..scenes import defined
+from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
 from .search import AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
 
@@ -361,7 +361,7 @@ def next_plan(
     """The plan after ``plan`` (None: round 0) given the runs it made: every earlier row, and a row
     per run table each candidate still searching makes next (a rung's seed block: seeds); ``done``
     on every row when no candidate searches on, at once when the target is ``undefined`` (why, from
-    experiments/defined.py: no run can answer it)."""
+    scenes/defined.py: no run can answer it)."""
     k = next_round(plan)
     rows = [] if plan is None else plan.drop(columns="done").to_dict("records")
     if undefined:

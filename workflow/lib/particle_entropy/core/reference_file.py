@@ -1,4 +1,4 @@
-"""A reactive scene's reference file (experiments/reactive.py writes it): its key, its checksum and
+"""A reactive scene's reference file (scenes/reference.py writes it): its key, its checksum and
 its checked reading, which a simulation job needs to judge its runs (so that the job imports no
 experiment). The file carries the SHA-256 of its own canonical content (``sha256``); ``read`` uses it
 only when that holds and its digest is both its file's name and its physics' (``problem``)."""

@@ -242,7 +242,7 @@ SECTION_DOCS = {
     "shear": "Fig. 10 (Appendix B): 2-D shear flow v_x = y - y^2, D = diag(alpha_L v_x, alpha_T v_x).",
     "optimum": "Adaptive searches for the N minimising mean COMIC (its own target: snakemake -j2 optimum; "
     "results/optimum/<name>.parquet, figures/optimum_<name>.png), one per key (letters, digits, _).",
-    "scenes": "Problems of your own (experiments/scene.py, docs/scenes.md; its own target: snakemake -j2 "
+    "scenes": "Problems of your own (scenes/scene.py, docs/scenes.md; its own target: snakemake -j2 "
     "scenes): for each, the cheapest model that reaches an accuracy, and the COMIC-best, one per key.",
     "scenes.<name>": "One scene: D, v, a source, the observation time, the domains, the candidate models and "
     "the accuracy to reach.",
@@ -486,7 +486,7 @@ SEARCH = (  # one entry of `optimum`; Search's fields (analysis/optimum.py)
 )
 
 # ------------------------------------------------------------------------------ scenes
-# One entry of `scenes` (experiments/scene.py): a problem of the user's own, its exact reference
+# One entry of `scenes` (scenes/scene.py): a problem of the user's own, its exact reference
 # (core/reference.py), the candidate models and the accuracy they must reach.
 SCENE_MEASURES = ("rmse", "entropy", "dilution", "product", "product_rmse")
 # a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:

@@ -9,7 +9,7 @@ written, the allowed values (the field's description and jsonschema's wording of
 It sits in core, beside the declarations, so that every owner of a section parses it through the
 same model whoever calls: the workflow (pipeline/config.py assembles the whole ``Config`` from these
 models and validates it once), a job script, a test or a notebook that builds one scene
-(experiments/scene.py: ``Scene.from_config``) or one search (analysis/optimum.py:
+(scenes/scene.py: ``Scene.from_config``) or one search (analysis/optimum.py:
 ``Search.from_config``) from a raw mapping. ``shared`` builds the models such an owner needs: the
 shared definitions (a case, lists of cases and of N), a search, a scene with its target and
 candidates. Rules that need a built object or a run (a source that fits its window, a run that

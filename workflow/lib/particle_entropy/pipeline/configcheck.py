@@ -308,7 +308,7 @@ def check_config(
     ``not_judged``, one that would be refused is not raised but said there, one line each, naming
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
-    from ..experiments.scene import scenes
+    from ..scenes.scene import scenes
 
     if schema is not None:  # the workflow's, as check_schema takes it
         check_schema(config, schema)

@@ -7,7 +7,7 @@ SettingError naming the key path, the value and the allowed range.
 
 Each check takes the config as the workflow holds it (a mapping: a run's settings are read from it
 as written by sweeps.run_config, and the searches and scenes are built from it by
-analysis/optimum.py and experiments/scene.py) and plans the case sections and reads its own values
+analysis/optimum.py and scenes/scene.py) and plans the case sections and reads its own values
 from the typed config, given or parsed here."""
 
 from __future__ import annotations

@@ -31,8 +31,8 @@ from functools import partial
 from pathlib import Path
 
 from ..core.case import Case
-from ..experiments import reactive
 from ..numerics.compiled import kernels_folder
+from ..scenes import reference as reactive
 from .crate import crate_folder_problem
 from .invocation import runs_no_job, snakemake_options
 from .runlock import LockRefused, hold
@@ -101,7 +101,7 @@ def crate_requested(options: Mapping | None) -> bool:
     return any(t == "crate" or Path(t).as_posix().startswith(CRATE_DIR) for t in options.get("targets") or [])
 
 
-# a reactive scene's references (experiments/reactive.py), below results/: checked as tables are
+# a reactive scene's references (scenes/reference.py), below results/: checked as tables are
 REFERENCES = Path(reactive.REFERENCE_PATTERN).parent.relative_to("results")
 
 

@@ -36,8 +36,8 @@ from ..core.registry import FGT_TOLERANCE, MEASUREMENT_POINTS
 from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
 from ..core.settings import REACTIVE_COST, SCENE, SCENE_MIN_MARGIN, defaults
 from ..core.timegrid import MAX_STEPS
-from ..experiments import scene
-from ..experiments.scene import SWEEP_PREFIX
+from ..scenes import scene
+from ..scenes.scene import SWEEP_PREFIX
 from . import configcheck, joblogs
 
 PAGES = ("README.md", "docs/*.md")  # where spots may be marked (globs under the repository root)

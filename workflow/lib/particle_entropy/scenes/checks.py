@@ -1,4 +1,4 @@
-"""The rules between a scene's parts (experiments/scene.py): its FD window against its sources'
+"""The rules between a scene's parts (scenes/scene.py): its FD window against its sources'
 extent, its candidates against each other, its plume's path against the reach of a double, a
 reactive scene's reference against its cost cap and PT's pair probability against its particle
 numbers. Each part checks its own values where it is declared: a section's keys by its model
@@ -118,12 +118,12 @@ def check_pair_probability(scene, i: int, c) -> None:
 
 
 def check_reference_cost(scene) -> None:
-    """SettingError naming scenes.<name>.reaction.k where the scene's reference (experiments/reactive.py)
+    """SettingError naming scenes.<name>.reaction.k where the scene's reference (scenes/reference.py)
     would take more than numerics/reaction_diffusion's MAX_WORK: its plan, known before any job, and
     its estimate in the message. The kinetic rule's steps are capped at that bound; what is refused
     is a reference whose diffusion rule (r <= 1/4 on the coarsest grid) alone exceeds it."""
     from ..numerics.reaction_diffusion import MAX_WORK, SECONDS_PER_CELL_STEP
-    from .reactive import physics, plan
+    from .reference import physics, plan
 
     how = plan(physics(scene))
     if how is None or how.work <= MAX_WORK:

@@ -70,7 +70,7 @@ def closed_form(scene) -> dict | None:
     """A reactive scene's reference when it is a closed form known before any job (a kind without B:
     experiments/reactive.compute), as ``undefined`` reads it; None for A + B -> C, solved by a job,
     and for a conservative scene, whose unit-mass plume the reaction cannot take away."""
-    from . import reactive
+    from . import reference as reactive
 
     if scene.reaction is not None and scene.reaction.closed_form(scene.t_final) is not None:
         return reactive.compute(reactive.physics(scene))

@@ -3,7 +3,7 @@ uniform v, a source, the observation time, the domains) with the candidate model
 accuracy they must reach. A scene knows each candidate's runs: their settings, their identity and
 the ladder of resolutions its search may visit (analysis/scene_search.py). Each part checks its own
 values (a candidate here, its source and reaction in core/); the rules between the parts are in
-experiments/scene_checks.py."""
+scenes/checks.py."""
 
 from __future__ import annotations
 
@@ -26,7 +26,8 @@ from ..core.sources import Source, SourceError
 from ..core.timegrid import MAX_STEPS, max_first_step
 from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
 from ..core.typed import key_path as typed_key_path
-from . import defined, scene_checks
+from . import checks as scene_checks
+from . import defined
 
 SCENE_RUN_PATTERN = "results/scenes/{scene_id}/{kind}/" + CASE_DIR + "/seeds~{first}-{last}.parquet"
 LADDER_RATIO = 2.0  # neighbouring resolutions of a candidate's ladder
@@ -484,14 +485,14 @@ class Scenes(Mapping):
 
     def reference_path(self, identity: str) -> str:
         """The reference file that the reactive runs keyed by ``identity`` are judged against."""
-        from .reactive import path
+        from .reference import path
 
         return path(self._owner(identity)[0])
 
     def reference_physics(self, key: str) -> dict:
         """The physics of the reference keyed ``key`` (reactive.digest): all that its file depends on,
         the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
-        from . import reactive
+        from . import reference as reactive
 
         def add(part: tuple) -> None:
             scene = self[part[1]]
