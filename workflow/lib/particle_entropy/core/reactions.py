@@ -328,12 +328,14 @@ class Reaction:
             return rng.uniform(0.0, length, round(self.b_uniform * length / m_p))
         return np.mod(self.b_source.positions(round(self.b_mass / m_p), rng) - lo, length)
 
-    def lost_bc(self, b_departure0: float, b_departure: float, c_total: float, scale: float) -> float:
+    def lost_bc(self, b_departure0: float, b_departure: float, c_total: float) -> float:
         """The fraction of B + C lost (through an FD window's ends) from B's initial departure from its
-        background ``b_departure0``, its departure now and C's total, over ``scale`` (B's mass, or 1 for a
-        uniform B); 0 where B is no reactant (a decay keeps B, whatever leaves)."""
+        background ``b_departure0``, its departure now and C's total: over B's mass for a plume of B, in
+        units of A's unit mass for a uniform B (whose departure only the reaction makes); 0 where B is no
+        reactant (a kind that keeps B, whatever leaves)."""
         if not self.kinetics.CONSUMES_B:
             return 0.0
+        scale = self.b_mass if self.b_source is not None else 1.0
         return (b_departure0 - (b_departure + c_total)) / scale
 
     def b_masses(self, x: np.ndarray, dV: float) -> np.ndarray:

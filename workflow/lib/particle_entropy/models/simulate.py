@@ -198,9 +198,7 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     b = reaction.b_masses(x, dx)
     b[0] = b[-1] = background * dx
     masses = np.vstack([c * dx, b, np.zeros_like(c)])
-    # B + C lost through the window's ends, as a fraction of B's mass (a uniform B's departure from
-    # C0, which only the reaction makes, in units of A's unit mass)
-    b_total, scale = float((b - background * dx).sum()), reaction.b_mass if reaction.b_source is not None else 1.0
+    b_total = float((b - background * dx).sum())  # B's departure from its background: B + C lost is read from it
     rows.add(0, 0.0, 0.0, masses[0], masses[1], masses[2], 0.0, dx, 0.0, _NAN)
     state, made = fd.species_rows(masses, dx, background), 0.0
     for k, dt in enumerate(dts, start=1):
@@ -210,7 +208,7 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
         made += react_masses(reaction.kinetics, masses, dx, dt, t, "fd")
         state = fd.species_rows(masses, dx, background)
         a, b, c = masses
-        lost = reaction.lost_bc(b_total, float((b - background * dx).sum()), float(c.sum()), scale)
+        lost = reaction.lost_bc(b_total, float((b - background * dx).sum()), float(c.sum()))
         rows.add(k, t, dt, a, b, c, made, dx, lost, rows.judged(k, x, a / dx, made, c_c=c / dx))
     return {"x": x, "c": masses[0] / dx}
 
