@@ -101,6 +101,16 @@ def _substeps(c):
     return max(1, math.ceil(c / (1.0 - 1e-9)))
 
 
+def _split(c: float, c_all: float, beta: float) -> tuple[int, float, float]:
+    """(substeps, the c they guard, beta of each) from c = beta max offdiag over the mass holders and
+    c_all over every particle: a split step carries mass several kernel widths, so it guards all."""
+    substeps = _substeps(c)
+    if substeps > 1:
+        c = c_all
+        substeps = _substeps(c)
+    return substeps, c, beta / substeps
+
+
 def _transfer_near_mass(x, m, active, sigma, beta, truncation, method, tolerance):
     """The step on the particles within reach of mass (targets) with all particles as
     sources of the row sums r; None when it needs substeps (mass then travels further)."""
@@ -124,11 +134,7 @@ def _transfer_all(x, m, sigma, beta, truncation, method, tolerance):
     # one pass gives W (1/r) for the row sums of P and W m, W (m/r) for the first substep
     W3 = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
     offdiag, c, c_all = kernels().offdiag(W3[0], inv_r, m, beta)
-    substeps = _substeps(c)
-    if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
-        c = c_all
-        substeps = _substeps(c)
-    b = beta / substeps
+    substeps, c, b = _split(c, c_all, beta)
     Wm, Wmr = W3[1], W3[2]
     for k in range(substeps):
         if k > 0:
@@ -158,11 +164,7 @@ def _transfer_species(x, masses, sigma, beta, truncation, method, tolerance) -> 
     W = gauss_transform(x, x, q, sigma, truncation, method, tolerance=tolerance)
     held = np.any(masses != 0.0, axis=0).astype(np.float64)
     offdiag, c, c_all = kernels().offdiag(W[0], inv_r, held, beta)
-    substeps = _substeps(c)
-    if substeps > 1:  # split steps carry mass several kernel widths: guard every particle
-        c = c_all
-        substeps = _substeps(c)
-    b = beta / substeps
+    substeps, c, b = _split(c, c_all, beta)
     out = masses.copy()
     for k in range(substeps):
         if k > 0:
