@@ -20,7 +20,7 @@ dt_n = dt0 g^n = dt0 + (g - 1) t at every time. A particle may instead run the g
 change a halving makes is measured paired, seed by seed.
 
 Measured on each run's last row (models/simulate.run_arrow, judged against the scene's
-reference, experiments/reactive.compute): the signed product error mass_C / M_C,ref - 1, the
+reference, scenes/reference.compute): the signed product error mass_C / M_C,ref - 1, the
 product's RMSE at the scene's points sqrt(SSE_points_C / points), and the scene's own measure
 (|product error| or that RMSE). Printed, per step: the step in force at t_final / 2, the mean of
 each over seeds with its 95 % t interval (its half-width is the noise floor of that mean), whether

@@ -28,7 +28,7 @@ def _pulse(n, rng):
     return x, masses
 
 
-def test_species_transfer_moves_each_species_as_mass_transfer_does():
+def test_species_rows_move_each_species_as_one_species_does():
     rng = np.random.default_rng(0)
     x = np.sort(rng.random(300))
     m = rng.random((3, 300))

@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 
 def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, want_state: bool = False, reference=None):
     """Simulate ``cfg`` (defaults resolved and checked) -> (per-step Arrow table, final state or None);
-    a reactive run (cfg.reaction) is judged against ``reference`` (experiments/reactive_reference.read)."""
+    a reactive run (cfg.reaction) is judged against ``reference`` (core/reference_file.read)."""
     cfg = cfg.resolved()
     if cfg.reaction is not None and reference is None:
         raise ValueError("a reactive run needs its scene's reference to judge its last step")

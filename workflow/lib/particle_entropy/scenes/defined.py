@@ -25,7 +25,7 @@ def _rms(values) -> float:
 
 def undefined(measure: str, value: float, ref: dict) -> str:
     """Why the target ``measure`` <= ``value`` cannot be judged against the reference ``ref`` (keys as
-    experiments/reactive.read gives them; a conservative scene's a_points and a_error), '' if it can."""
+    core/reference_file.read gives them; a conservative scene's a_points and a_error), '' if it can."""
     if measure == "product":
         m, err = ref["product_mass"], ref["product_error"]
         if not (m is not None and m > 0.0 and math.isfinite(m)):
@@ -68,10 +68,10 @@ def check(scene, ref: dict | None) -> None:
 
 def closed_form(scene) -> dict | None:
     """A reactive scene's reference when it is a closed form known before any job (a kind without B:
-    experiments/reactive.compute), as ``undefined`` reads it; None for A + B -> C, solved by a job,
+    scenes/reference.compute), as ``undefined`` reads it; None for A + B -> C, solved by a job,
     and for a conservative scene, whose unit-mass plume the reaction cannot take away."""
-    from . import reference as reactive
+    from . import reference
 
     if scene.reaction is not None and scene.reaction.closed_form(scene.t_final) is not None:
-        return reactive.compute(reactive.physics(scene))
+        return reference.compute(reference.physics(scene))
     return None

@@ -490,15 +490,15 @@ class Scenes(Mapping):
         return path(self._owner(identity)[0])
 
     def reference_physics(self, key: str) -> dict:
-        """The physics of the reference keyed ``key`` (reactive.digest): all that its file depends on,
+        """The physics of the reference keyed ``key`` (reference.digest): all that its file depends on,
         the params of rule scene_reference, so that editing a target or a candidate reruns nothing."""
-        from . import reference as reactive
+        from . import reference
 
         def add(part: tuple) -> None:
             scene = self[part[1]]
             if scene.reaction is not None:
-                physics = reactive.physics(scene)
-                self._references.setdefault(reactive.key(physics), physics)
+                physics = reference.physics(scene)
+                self._references.setdefault(reference.key(physics), physics)
 
         found = self._find(self._references, key, (("reference", name) for name in self), add)
         if found is None:
