@@ -279,34 +279,32 @@ class Reaction:
         ReactionError naming the first bad parameter of B's source."""
         from .sources import Source, SourceError
 
-        cls = REACTIONS[spec["kind"]]
-        kinetics = cls(**{key: spec[key] for key in cls.PARAMS})
-        if not cls.CONSUMES_B:
-            return Reaction(kinetics)
-        b = spec["B"]
-        if "uniform" in b:
-            return Reaction(kinetics, b_uniform=b["uniform"])
-        try:
-            source = Source.from_spec(b["source"])
-        except SourceError as e:
-            raise ReactionError(f"B.source.{e.param}", e.value, e.allowed) from None
-        return Reaction(kinetics, b_source=source, b_mass=b.get("mass", 1.0))
+        def source(spec):
+            try:
+                return Source.from_spec(spec)
+            except SourceError as e:
+                raise ReactionError(f"B.source.{e.param}", e.value, e.allowed) from None
+
+        return Reaction._built(spec, source)
 
     @staticmethod
     def of(record: dict | None) -> Reaction | None:
         """The reaction of a run's settings (``record``), or None."""
-        if record is None:
-            return None
-        cls = REACTIONS[record["kind"]]
-        kinetics = cls(**{key: record[key] for key in cls.PARAMS})
-        if not cls.CONSUMES_B:
-            return Reaction(kinetics)
         from .sources import Source
 
-        b = record["B"]
+        return None if record is None else Reaction._built(record, lambda spec: Source.of(**spec))
+
+    @staticmethod
+    def _built(mapping, source) -> Reaction:
+        """The reaction of a config's or a record's ``mapping``, B's plume built by ``source``."""
+        cls = REACTIONS[mapping["kind"]]
+        kinetics = cls(**{key: mapping[key] for key in cls.PARAMS})
+        if not cls.CONSUMES_B:
+            return Reaction(kinetics)
+        b = mapping["B"]
         if "uniform" in b:
             return Reaction(kinetics, b_uniform=b["uniform"])
-        return Reaction(kinetics, b_source=Source.of(**b["source"]), b_mass=b["mass"])
+        return Reaction(kinetics, b_source=source(b["source"]), b_mass=b.get("mass", 1.0))
 
     def closed_form(self, t: float) -> tuple[float, float] | None:
         """(A's, C's share of the conservative plume at t) where the kinetics have a closed form and B
