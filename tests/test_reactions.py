@@ -102,3 +102,36 @@ def test_a_round_off_negative_residue_takes_no_part_in_the_reaction():
     na, nb, made = Bimolecular(100.0).on_masses(a, b, 1.0, 0.1)
     assert na[0] == 1.0 and nb[0] == -1.7e-18 and made[0] == 0.0
     assert made[1] > 0.0 and na[1] + made[1] == pytest.approx(1.0, rel=1e-15)
+
+
+def test_no_caller_branches_on_a_reaction_kind_s_name():
+    """Issue 51: a kind carries its own rules (core/reactions.py), so no other module compares a value with
+    a kind's name (``reaction.kind == "decay"``, a dict keyed by kind names, ``in ("decay", ...)``)."""
+    import ast
+    from pathlib import Path
+
+    from particle_entropy.core.reactions import REACTIONS
+
+    lib = Path(__file__).resolve().parents[1] / "workflow" / "lib" / "particle_entropy"
+    found = []
+    for path in lib.rglob("*.py"):
+        if path.relative_to(lib).as_posix() == "core/reactions.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Compare):
+                values = [node.left, *node.comparators]
+            elif isinstance(node, ast.Dict):
+                values = [k for k in node.keys if k is not None]
+            else:
+                continue
+            names = [v.value for v in values if isinstance(v, ast.Constant) and v.value in REACTIONS]
+            names += [
+                e.value
+                for v in values
+                if isinstance(v, (ast.Tuple, ast.List, ast.Set))
+                for e in v.elts
+                if isinstance(e, ast.Constant) and e.value in REACTIONS
+            ]
+            if names:
+                found.append(f"{path.relative_to(lib)}:{node.lineno} {names}")
+    assert not found, found
