@@ -164,6 +164,20 @@ def test_central_negative_values_are_reported_at_the_step_they_appear():
     assert upwind.first_negative is None and upwind.smallest >= 0.0 and u.min() >= 0.0
 
 
+def test_a_step_on_the_whole_array_holds_the_ring_and_steps_the_interior():
+    grid = fd2d.Grid(0.0, 0.0, 0.05, 0.05, 20, 16)
+    x, y = grid.interior()
+    solver = fd2d.solver(_tensor(1e-3, 2e-4, 0.4), (0.6, 0.2), grid, 0.02, "tvd")
+    whole = np.zeros((21, 17))
+    whole[1:-1, 1:-1] = _gaussian(x, y, (0.5, 0.4), 0.01 * np.eye(2))
+    expected = fd2d.solver(_tensor(1e-3, 2e-4, 0.4), (0.6, 0.2), grid, 0.02, "tvd").solve(whole[1:-1, 1:-1])
+    done = fd2d.step_whole(solver, whole)
+    assert np.array_equal(whole[1:-1, 1:-1], expected)
+    ring = np.ones_like(whole, dtype=bool)
+    ring[1:-1, 1:-1] = False
+    assert not whole[ring].any() and done.outflow > 0.0
+
+
 # --- the Courant limit -----------------------------------------------------------------------------
 
 
