@@ -10,7 +10,7 @@ the square [-5, 5]^2 (area 100, the paper's Omega = 10 in each direction: +- 3.5
 plume's s.d. along its long axis), v = (1e-3, 5e-4) [L/T], eta 0.5 by default (a half of D by
 the walk, a half by the exchange). The masses are a Gaussian of covariance 2 D t at t = 500.
 
-A step: models/walk.walk with (1 - eta) D as (N, 2, 2) tensors and v, then
+A step: models/walk.walk with (1 - eta) D as one (1, 2, 2) tensor and v, then
 numerics/particles2d.mtpt_exchange_2d with eta D; each N runs in its own process (so that its
 peak RSS, ru_maxrss, is its own) after one warm-up step that loads numba's compiled loops.
 Printed per N and cut-off: the median of --repeats steps, the walk's and the exchange's medians,
@@ -69,7 +69,7 @@ def state(n: int, seed: int = 0):
 def step(x, m, rng, eta: float, cutoff_sds: float):
     D = tensor()
     t0 = time.perf_counter()
-    x = walk(x, np.broadcast_to((1.0 - eta) * D, (x.shape[0], 2, 2)), DT, rng, V)
+    x = walk(x, ((1.0 - eta) * D)[None], DT, rng, V)
     t1 = time.perf_counter()
     res = mtpt_exchange_2d(x, m, D, eta, DT, cutoff_sds)
     t2 = time.perf_counter()

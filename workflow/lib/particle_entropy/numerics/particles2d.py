@@ -6,7 +6,7 @@ Nothing here builds an N x N (or N x M) matrix: the exchange works on the pairs 
 (numerics/neighbours.py, one k-d tree) and moves masses by numerics/pair_transfer.py; the
 reconstruction sums over the (point, particle) pairs within a cut-off, a chunk of points at a time.
 The random walk of both models is models/walk.py's (a uniform tensor D is given to it as
-``np.broadcast_to(D, (N, 2, 2))``).
+``D[None]``, one (1, 2, 2) tensor for every particle).
 
 Units: positions [L], tensors [L^2/T], dt [T], masses dimensionless, concentrations [L^-2].
 """
