@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import statistics
 from collections import defaultdict
+from dataclasses import replace
 
 import numpy as np
 from scipy.optimize import nnls
@@ -47,7 +48,8 @@ def timed_points(config: dict, names: list[str], max_s: float) -> dict[str, list
         scene = table_of[name]
         for cand in scene.candidates:
             for n in rungs(scene, cand, max_s):
-                cfg = scene.run_config(cand, n, seed=int(config.get("base_seed", 0)))
+                # the transport's cost: a reactive scene's run without its reaction (reactive_cost.py prices that)
+                cfg = replace(scene.run_config(cand, n, seed=int(config.get("base_seed", 0))), reaction=None)
                 key = (cfg.method, cfg.kernel, n, cfg.t_final, cfg.dt0, cfg.v != 0.0, cand.advection)
                 if key in seen:
                     continue

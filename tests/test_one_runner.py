@@ -81,3 +81,55 @@ def test_a_run_has_the_bytes_of_the_runners_before(key, scene, cand, n):
     ref = None if scene.reaction is None else _stub_reference(scene)
     table = run_seeds_arrow(scene.run_config(cand, n), seeds, reference=ref)
     assert _digest(table) == BEFORE[key]
+
+
+class _Doubling:
+    """A stand-in FD solver whose step doubles the interior it is given (to see which nodes it gets)."""
+
+    def solve(self, interior):
+        return 2.0 * interior
+
+
+@pytest.mark.parametrize("shape", [(2, 7), (3, 5, 6)])
+def test_fd_transport_solves_each_species_interior_and_holds_the_boundary(shape):
+    from particle_entropy.models import fd
+
+    rows = np.arange(np.prod(shape), dtype=float).reshape(shape) + 1.0
+    before = rows.copy()
+    fd.transport(_Doubling(), rows)
+    inner = (slice(None), *(slice(1, -1),) * (len(shape) - 1))
+    np.testing.assert_array_equal(rows[inner], 2.0 * before[inner])
+    edge = np.ones(shape, dtype=bool)
+    edge[inner] = False
+    np.testing.assert_array_equal(rows[edge], before[edge])
+
+
+def test_particle_steps_take_positions_in_two_dimensions():
+    """The PT and MTPT walks move (N, 2) positions by a tensor D: mean v dt, covariance 2 D dt, the order
+    (and each particle's masses) kept; 1-D runs sort."""
+    from particle_entropy.models import mtpt, pt
+
+    n, dt = 200_000, 0.5
+    D = np.array([[2.0, 0.6], [0.6, 0.5]])
+    v = np.array([1.0, -2.0])
+    x0 = np.zeros((n, 2))
+    (x,) = pt.step([x0], D[None], dt, np.random.default_rng(1), v)  # one tensor for all: (1, d, d)
+    assert x.shape == (n, 2)
+    _assert_covariance(x - v * dt, 2.0 * D * dt)
+    assert np.all(np.abs(x.mean(axis=0) - v * dt) < 5.0 * np.sqrt(np.diag(2.0 * D * dt) / n))
+    m = np.vstack([np.arange(n, dtype=float), -np.arange(n, dtype=float)])
+    label = np.arange(n)
+    y, m2, label2 = mtpt.walk(x, m, label, 0.5 * D[None], dt, np.random.default_rng(2))
+    np.testing.assert_array_equal(label2, label)  # no re-sort in 2-D: each particle keeps its masses
+    np.testing.assert_array_equal(m2, m)
+    _assert_covariance(y - x, 2.0 * (0.5 * D) * dt)
+    (z,) = pt.step([np.array([3.0, 1.0, 2.0])], 0.0, dt, np.random.default_rng(0))
+    np.testing.assert_array_equal(z, [1.0, 2.0, 3.0])  # 1-D: sorted for the reconstructions
+
+
+def _assert_covariance(steps: np.ndarray, expected: np.ndarray) -> None:
+    """The sample covariance of ``steps`` (n, d) is ``expected`` within 5 standard errors of each entry,
+    sqrt((S_ii S_jj + S_ij^2) / n) for Gaussian steps."""
+    n = steps.shape[0]
+    se = np.sqrt((np.outer(np.diag(expected), np.diag(expected)) + expected**2) / n)
+    assert np.all(np.abs(np.cov(steps.T) - expected) < 5.0 * se)

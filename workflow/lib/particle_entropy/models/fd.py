@@ -60,11 +60,12 @@ def initial_concentration(cfg: RunConfig) -> np.ndarray:
 
 
 def transport(solve, rows: np.ndarray) -> None:
-    """One transport step of every species row of ``rows`` (species, N + 1), in place: each row's interior
-    by the step's solver ``solve`` (``solver``), its end nodes held (the zero boundary, or a background's
-    departure from itself)."""
+    """One transport step of every species row of ``rows`` (species, N + 1) or, on a d-dimensional grid,
+    (species, N_1 + 1, ..., N_d + 1), in place: each row's interior by the step's solver ``solve``
+    (``solver``), its boundary nodes held (the zero boundary, or a background's departure from itself)."""
+    inner = (slice(1, -1),) * (rows.ndim - 1)
     for row in rows:
-        row[1:-1] = solve.solve(row[1:-1])
+        row[inner] = solve.solve(row[inner])
 
 
 def species_masses(rows: np.ndarray, dx: float, background: float) -> np.ndarray:

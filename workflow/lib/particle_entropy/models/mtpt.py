@@ -36,14 +36,16 @@ def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
 
 def walk(x, m, label, d_walk: float, dt: float, rng: np.random.Generator, domain=None):
     """The random walk with ``d_walk`` = (1 - eta) D of every particle (reflected into ``domain`` (lo, hi)
-    when given), re-sorted -> (x, m, label); ``m`` (N,) or (species, N), its columns moved with x."""
-    if d_walk > 0:
+    when given), in 1-D re-sorted -> (x, m, label); ``m`` (N,) or (species, N), its columns moved with x.
+    Positions may be (N, d), with d_walk a tensor (models/walk.py); they keep their order."""
+    if np.any(np.asarray(d_walk) > 0):
         x = ito_walk(x, d_walk, dt, rng)
         if domain is not None:
             x = reflect(x, *domain)
-        order = np.argsort(x, kind="stable")
-        x, m = x[order], m[..., order]
-        label = None if label is None else label[order]
+        if x.ndim == 1:
+            order = np.argsort(x, kind="stable")
+            x, m = x[order], m[..., order]
+            label = None if label is None else label[order]
     return x, m, label
 
 

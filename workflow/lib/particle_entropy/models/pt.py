@@ -114,13 +114,17 @@ def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
 
 
 def step(xs: list[np.ndarray], D: float, dt: float, rng: np.random.Generator, v: float = 0.0, period=None) -> list:
-    """One step of every species' particles (``xs``, one position array each, walked in order): the
-    walk, then folded into the periodic [0, period) (a reaction's domain, in the frame moving with v),
-    or sorted (the reconstructions need the order)."""
+    """One step of every species' particles (``xs``, one position array each, (N,) or (N, d), walked in
+    order; D a scalar or, in d dimensions, a tensor: models/walk.py): the walk, then folded into the
+    periodic [0, period) (a reaction's domain, in the frame moving with v), or in 1-D sorted (the
+    reconstructions need the order; d-dimensional positions keep theirs)."""
     out = []
     for x in xs:
         x = walk(x, D, dt, rng, v)
-        out.append(np.sort(x) if period is None else np.mod(x, period))
+        if period is not None:
+            out.append(np.mod(x, period))
+        else:
+            out.append(np.sort(x) if x.ndim == 1 else x)
     return out
 
 

@@ -11,7 +11,8 @@ def walk(x, D, dt: float, rng: np.random.Generator, v=0.0, drift=None) -> np.nda
     """X <- ((X + v dt) + B sqrt(2 dt) xi) + a dt for positions ``x`` [L] of shape (N,) (d = 1) or (N, d).
 
     ``D`` [L^2/T]: a scalar (isotropic), per particle (N,) when d = 1; for (N, d) positions a (d,)
-    diagonal, per-particle diagonals (N, d) or per-particle tensors (N, d, d), whose B is the
+    diagonal, per-particle diagonals (N, d), per-particle tensors (N, d, d) or one tensor for all
+    particles (1, d, d), whose B is the
     symmetric square root (eigenvalues below 0 from round-off taken as 0). ``v`` and the drift ``a``
     (e.g. the Ito term div D) [L/T] broadcast against ``x``; v = 0 (a scalar) adds nothing, and
     ``drift=None`` adds nothing. xi is drawn as ``rng.standard_normal((d, N))``, one row per
@@ -37,11 +38,13 @@ def _scaled_noise(D, dt: float, xi: np.ndarray, shape: tuple[int, ...]) -> np.nd
     D = np.asarray(D, dtype=np.float64)
     if D.ndim == 3:
         n, d = shape
-        if D.shape != (n, d, d):
-            raise ValueError(f"tensors must be (N, d, d) = {(n, d, d)}, not {D.shape}")
+        if D.shape not in ((n, d, d), (1, d, d)):
+            raise ValueError(f"tensors must be (N, d, d) = {(n, d, d)}, or (1, d, d) for all, not {D.shape}")
         lam, vec = np.linalg.eigh(D)
         root = np.sqrt(np.maximum(lam, 0.0))
         b = np.einsum("nij,nj,nkj->nik", vec, root, vec)  # B = V diag(sqrt(lambda)) V^T
+        if D.shape[0] == 1 and n != 1:  # one tensor for every particle
+            return math.sqrt(2.0 * dt) * (xi @ b[0].T)
         return math.sqrt(2.0 * dt) * np.einsum("nij,nj->ni", b, xi)
     if np.broadcast_shapes(D.shape, shape) != shape:
         raise ValueError(f"D of shape {D.shape} does not fit positions of shape {shape}")

@@ -3,7 +3,8 @@
 symmetric mass transfer (`mass_transfer`: Eqs. 16-21; several species by one P),
 the authors' sequential pairwise loop (`sequential`), the vectorising exp they share (`fastexp`), the
 pairs within a cut-off in d dimensions (`neighbours`) and the transfer on them with pair-averaged
-tensors (`pair_transfer`, its loops in `pair_kernels`), the particle-killing reaction loop of random-walk
+tensors (`pair_transfer`, its loops in `pair_kernels`), MTPT's exchange with a uniform tensor and the
+2-D kernel estimate of PT in two dimensions (`particles2d`), the particle-killing reaction loop of random-walk
 tracking (`reaction_kernels`) and the reactive scenes' reference (`reaction_diffusion`: A, B and C
 by Strang splitting on a fine grid, Richardson over three grids). The compiled loops of the
 transforms, the transfer and the FD solve are in `gauss_kernels`, `transfer_kernels` and `thomas`,

@@ -1,0 +1,236 @@
+"""Finite differences for 2-D advection-dispersion with a full dispersion tensor (issue 52, point 3):
+the 1-D model of fd.py on a grid of (nx + 1) x (ny + 1) nodes, its boundary ring held at zero and
+its interior, an (nx - 1, ny - 1) array indexed [i, j] with x along axis 0, solved.
+
+Dispersion is backward Euler with the whole tensor D: the 9-point stencil of div(D grad c), whose
+cross term d/dx(Dxy dc/dy) + d/dy(Dxy dc/dx) = 2 Dxy c_xy is taken by central differences on the
+four corner nodes. Advection is implicit upwind or central in the same matrix (as fd.AdvectionSolver),
+or Leonard's explicit ULTIMATE-QUICKEST (tvd), split by direction, x then y, each line by fd.advect_tvd,
+then the dispersion solve (Lie splitting, as fd.TVDSolver; the two directions' shifts commute, so
+splitting them costs no order), at a Courant number max(|vx| dt / dx, |vy| dt / dy) <= 1.
+
+The implicit step is one sparse LU (SuperLU, scipy.sparse.linalg.splu, minimum-degree ordering of
+A^T + A: the matrix's pattern is symmetric, and that ordering fills half what COLAMD does), built once
+per step size and reused every step, not ADI. ADI splits the operator into x and y sweeps; the cross
+term fits neither, so ADI schemes with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer)
+take it explicitly, which bounds the step by the cross term's stability and makes the step no longer
+the backward-Euler step whose mass balance fd.py checks. The LU gives that exact step for any tensor
+and flow, unconditionally stable; its price is memory and time at large n. benchmarks/fd2d_step.py
+measures both; at 1,024 x 1,024 nodes (measured at commit c63f787, one core of an "Intel(R) Xeon(R)
+Processor", others' jobs running) 15-20 s to factorise, 1.8 GB peak and 0.22-0.33 s a step: the
+triangular solves read about 10^8 factor entries, so no direct solve meets the 60 ms target there; an
+O(N) step would (ADI with the cross term explicit, or multigrid-preconditioned Krylov).
+
+Every step balances its mass as in 1-D (fd.check_balance): the interior's mass falls by the flux into
+the zero boundary ring, computed from the stencil's entries that reach the ring (not from the
+sparse matrix), else MassError. Negative concentrations (implicit central, or a cross term larger than
+the diagonal terms allow) are the scheme's own: never clipped, each step's smallest value and the first
+step that went below zero are kept on the solver (Step)."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.runconfig import COURANT_SLACK
+from . import fd
+
+SCHEMES = ("upwind", "central", "tvd")
+
+
+def courant_number(v, dx: float, dy: float, dt: float) -> float:
+    """max(|vx| dt / dx, |vy| dt / dy): the cells the plume crosses in a step along either axis [-]."""
+    return max(abs(float(v[0])) * dt / dx, abs(float(v[1])) * dt / dy)
+
+
+def step_for_courant(courant: float, v, dx: float, dy: float) -> float:
+    """The step dt at which courant_number is ``courant`` [T]."""
+    rate = max(abs(float(v[0])) / dx, abs(float(v[1])) / dy)
+    if not rate > 0.0:
+        raise ValueError("courant needs a flow: v = 0 crosses no cell")
+    return courant / rate
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Nodes (x0 + i dx, y0 + j dy), i = 0..nx, j = 0..ny; the boundary ring held at zero."""
+
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    nx: int
+    ny: int
+
+    @classmethod
+    def over(cls, lo, hi, n: int, path=(0.0, 0.0)) -> Grid:
+        """An n x n grid over the window [lo, hi] (2 corners) lengthened along each axis by the
+        plume's path v t_final, as fd.py's fd_span does in 1-D."""
+        lo, hi, path = (np.asarray(a, dtype=float) for a in (lo, hi, path))
+        start = lo + np.minimum(path, 0.0)
+        length = hi - lo + np.abs(path)
+        return cls(float(start[0]), float(start[1]), float(length[0] / n), float(length[1] / n), n, n)
+
+    def nodes(self) -> tuple[np.ndarray, np.ndarray]:
+        """The node coordinates along x (nx + 1) and along y (ny + 1) [L]."""
+        return self.x0 + self.dx * np.arange(self.nx + 1), self.y0 + self.dy * np.arange(self.ny + 1)
+
+    def interior(self) -> tuple[np.ndarray, np.ndarray]:
+        """The interior nodes' x and y, each of shape (nx - 1, ny - 1) [L]."""
+        x, y = self.nodes()
+        return np.meshgrid(x[1:-1], y[1:-1], indexing="ij")
+
+
+@dataclass(frozen=True)
+class Step:
+    """What one step did: the mass per cell area it sent into the zero ring, and its smallest value."""
+
+    outflow: float
+    smallest: float
+
+
+def _operator(D, v, dx: float, dy: float, dt: float, scheme: str) -> dict[tuple[int, int], float]:
+    """The stencil of dt (v . grad - div D grad) on a node: offset (di, dj) -> weight. Dispersion's
+    5-point part, its cross term 2 Dxy c_xy by central differences on the corners, and the advection
+    term: upwind's one-sided or central's centred difference ("tvd": none, advection is explicit)."""
+    D = np.asarray(D, dtype=float)
+    if D.shape != (2, 2) or not abs(D[0, 1] - D[1, 0]) <= 1e-12 * np.abs(D).max():
+        raise ValueError(f"D must be a symmetric 2 x 2 tensor, got {D.tolist()}")
+    rx, ry = D[0, 0] * dt / dx**2, D[1, 1] * dt / dy**2
+    rxy = 0.5 * (D[0, 1] + D[1, 0]) * dt / (2.0 * dx * dy)  # 2 Dxy dt / (4 dx dy)
+    s = {(0, 0): 2.0 * rx + 2.0 * ry, (-1, 0): -rx, (1, 0): -rx, (0, -1): -ry, (0, 1): -ry}
+    s.update({(1, 1): -rxy, (-1, -1): -rxy, (1, -1): rxy, (-1, 1): rxy})
+    for axis, p in ((0, float(v[0]) * dt / dx), (1, float(v[1]) * dt / dy)):
+        back, ahead = ((-1, 0), (1, 0)) if axis == 0 else ((0, -1), (0, 1))
+        if scheme == "upwind":
+            s[(0, 0)] += abs(p)
+            s[back] -= max(p, 0.0)
+            s[ahead] += min(p, 0.0)
+        elif scheme == "central":
+            s[back] -= 0.5 * p
+            s[ahead] += 0.5 * p
+        elif scheme != "tvd":
+            raise ValueError(f"advection scheme {scheme!r}: one of {', '.join(SCHEMES)}")
+    return s
+
+
+def _matrix(stencil: dict[tuple[int, int], float], mx: int, my: int):
+    """I + the stencil on the mx x my interior (node k = i my + j), the ring's entries dropped."""
+    import scipy.sparse as sp
+
+    def shift(m: int, d: int):
+        return sp.eye(m, k=d, format="csr")
+
+    a = sp.identity(mx * my, format="csr")
+    for (di, dj), w in stencil.items():
+        if w != 0.0:
+            a = a + w * sp.kron(shift(mx, di), shift(my, dj), format="csr")
+    return a.tocsc()
+
+
+def _ring_weights(stencil: dict[tuple[int, int], float], mx: int, my: int) -> np.ndarray:
+    """w (mx, my): the mass per cell area that a unit value at an interior node sends into the ring
+    in one step, by the stencil's entries on the ring's nodes (those the interior matrix drops).
+    Nonzero on the interior's edge nodes only."""
+    i, j = np.meshgrid(np.arange(1, mx + 1), np.arange(1, my + 1), indexing="ij")
+    w = np.zeros((mx, my))
+    for (di, dj), s in stencil.items():
+        # the ring node b = k - (di, dj) sees k through the weight s
+        bi, bj = i - di, j - dj
+        w -= s * ((bi == 0) | (bi == mx + 1) | (bj == 0) | (bj == my + 1))
+    return w
+
+
+def _edge_sum(w: np.ndarray, c: np.ndarray) -> float:
+    """sum(w c) over the edge nodes of the interior, where w lives."""
+    total = float(w[0] @ c[0])
+    if c.shape[0] > 1:
+        total += float(w[-1] @ c[-1])
+        total += float(w[1:-1, 0] @ c[1:-1, 0])
+        if c.shape[1] > 1:
+            total += float(w[1:-1, -1] @ c[1:-1, -1])
+    return total
+
+
+class Solver:
+    """One step dt of 2-D advection-dispersion on the interior (nx - 1, ny - 1), built once per step:
+    backward Euler (I + dt (v . grad_h - div_h D grad_h)) c' = c with upwind or central advection
+    in the matrix, or (tvd) fd.advect_tvd along x then along y, then the dispersion solve."""
+
+    def __init__(self, D, v, dx: float, dy: float, dt: float, shape: tuple[int, int], scheme: str):
+        from scipy.sparse.linalg import splu
+
+        self.D, self.v = np.array(D, dtype=float), np.array(v, dtype=float)
+        self.dx, self.dy, self.dt, self.shape, self.scheme = float(dx), float(dy), float(dt), tuple(shape), scheme
+        self.courant = courant_number(self.v, self.dx, self.dy, self.dt)
+        if scheme == "tvd" and not self.courant <= 1.0 + COURANT_SLACK:
+            raise ValueError(f"tvd advection at courant number {self.courant:.17g}: at most 1")
+        # the Courant number along each axis, within round-off of 1 taken as 1 (fd.TVDSolver's rule)
+        self.p = tuple(max(-1.0, min(1.0, self.v[a] * self.dt / h)) for a, h in ((0, self.dx), (1, self.dy)))
+        stencil = _operator(self.D, self.v, self.dx, self.dy, self.dt, scheme)
+        self.matrix = _matrix(stencil, *self.shape)
+        self._ring = _ring_weights(stencil, *self.shape)
+        self._scale = 1.0 + sum(abs(w) for w in stencil.values())  # the matrix's largest row sum
+        start = time.perf_counter()
+        self._lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A")
+        self.factorisation_seconds = time.perf_counter() - start  # the LU's wall time, for benchmarks
+        self.steps, self.smallest, self.first_negative, self.last = 0, math.inf, None, None
+
+    def outflow(self, c: np.ndarray) -> float:
+        """The mass per cell area the implicit solution ``c`` sent into the zero ring this step."""
+        return _edge_sum(self._ring, c)
+
+    def advect(self, c: np.ndarray) -> tuple[np.ndarray, float]:
+        """tvd's explicit substep: every line along x, then every line along y, by fd.advect_tvd, each
+        sweep's mass balanced against the flux through the ring -> (c*, the mass that left)."""
+        left = 0.0
+        for axis, p in enumerate(self.p):
+            if p == 0.0:
+                continue
+            lines = np.ascontiguousarray(c.T if axis == 0 else c)  # each row one line along the axis
+            out = np.empty_like(lines)
+            flux = 0.0
+            for k, line in enumerate(lines):
+                out[k], through = fd.advect_tvd(line, p)
+                flux += through
+            out = out.T if axis == 0 else out
+            fd.check_balance(c, out, flux, 1.0 + 4.0 * abs(p))
+            c, left = out, left + flux
+        return c, left
+
+    def step(self, c_interior: np.ndarray) -> tuple[np.ndarray, Step]:
+        """One step of the interior -> (the new interior, Step); MassError if the mass does not balance."""
+        c = np.asarray(c_interior, dtype=float)
+        if c.shape != self.shape:
+            raise ValueError(f"interior of shape {c.shape}, the solver's is {self.shape}")
+        left = 0.0
+        if self.scheme == "tvd":
+            c, left = self.advect(c)
+        out = self._lu.solve(c.ravel()).reshape(self.shape)
+        outflow = self.outflow(out)
+        fd.check_balance(c, out, outflow, self._scale)
+        smallest = float(out.min())
+        self.steps += 1
+        self.smallest = min(self.smallest, smallest)
+        if smallest < 0.0 and self.first_negative is None:
+            self.first_negative = self.steps
+        self.last = Step(left + outflow, smallest)
+        return out, self.last
+
+    def solve(self, c_interior: np.ndarray) -> np.ndarray:
+        """The new interior after one step (fd.py's solver interface); the step's Step in ``last``."""
+        return self.step(c_interior)[0]
+
+
+def solver(D, v, grid: Grid, dt: float, scheme: str) -> Solver:
+    """The solver of one step dt on ``grid``'s interior."""
+    return Solver(D, v, grid.dx, grid.dy, dt, (grid.nx - 1, grid.ny - 1), scheme)
+
+
+def step_whole(solve: Solver, c: np.ndarray) -> Step:
+    """One step of the whole node array ``c`` (nx + 1, ny + 1) in place, its ring held."""
+    c[1:-1, 1:-1], done = solve.step(c[1:-1, 1:-1])
+    return done
