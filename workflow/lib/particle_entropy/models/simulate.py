@@ -145,12 +145,10 @@ class _Reactive:
             **extra,
         )
 
-    def judged(self, k: int, x, c_a, mass_c: float, x_c=None, c_c=None) -> dict:
-        """At the last step, the errors against the reference: the SSE of C_A and of C_C at the scene's
-        points (the model's concentrations linearly interpolated there, measures.at_points; C_C on
-        ``x_c``, by default A's ``x``) and |M_C / M_C,ref - 1|; before it, NaN."""
-        if k != self.last:
-            return _NAN
+    def judged(self, x, c_a, mass_c: float, x_c=None, c_c=None) -> dict:
+        """The last step's errors against the reference: the SSE of C_A and of C_C at the scene's points
+        (the model's concentrations linearly interpolated there, measures.at_points; C_C on ``x_c``, by
+        default A's ``x``) and |M_C / M_C,ref - 1|. The runners call it at the last step only (``last``)."""
         ref, cfg = self.ref, self.cfg
         model = M.at_points(ref["points"], x, c_a)
         err = M.sse(model, ref["a_points"])
@@ -209,7 +207,8 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
         state = fd.species_rows(masses, dx, background)
         a, b, c = masses
         lost = reaction.lost_bc(b_total, float((b - background * dx).sum()), float(c.sum()))
-        rows.add(k, t, dt, a, b, c, made, dx, lost, rows.judged(k, x, a / dx, made, c_c=c / dx))
+        extra = rows.judged(x, a / dx, made, c_c=c / dx) if k == rows.last else _NAN
+        rows.add(k, t, dt, a, b, c, made, dx, lost, extra)
     return {"x": x, "c": masses[0] / dx}
 
 
@@ -237,7 +236,7 @@ def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
         x, masses, label, _, _, sub = mtpt.step(cfg, x, masses, label, dt, t, rng, order_rng)
         react_masses(kinetics, masses, dV, dt, t, "mtpt")
         made = float(masses[C].sum())
-        extra = rows.judged(k, x, masses[A] / dV, made, c_c=masses[C] / dV)
+        extra = rows.judged(x, masses[A] / dV, made, c_c=masses[C] / dV) if k == rows.last else _NAN
         rows.add(k, t, dt, masses[A], masses[B], masses[C], made, dV, 0.0, {"substeps": sub, **extra})
     return {"x": x, "mass": masses[A], "c": masses[A] / dV}
 
@@ -272,9 +271,9 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
         )
         made = xs[2].size * m_p
         extra = _NAN
-        if k == len(dts):  # A's and C's densities in the lab frame: each species' reconstruction times its mass
+        if k == rows.last:  # A's and C's densities in the lab frame: each species' reconstruction times its mass
             (grid, c_a), (grid_c, c_c) = (_density(cfg, x + lo + cfg.v * t, m_p, t) for x in (xs[0], xs[2]))
-            extra = rows.judged(k, grid, c_a, made, grid_c, c_c)
+            extra = rows.judged(grid, c_a, made, grid_c, c_c)
         a, b = xs[0].size * m_p * one, xs[1].size * m_p * one
         rows.add(k, t, dt, a, b, made * one, made, cfg.dV, 0.0, extra)
     return {"x": np.sort(xs[0] + lo + cfg.v * t), "mass": np.full(xs[0].size, m_p)}
