@@ -25,7 +25,6 @@ import numpy as np
 
 from ..core.reactions import Bimolecular
 from ..core.timegrid import steps_growing_with_time
-from ..numerics.bandwidths import beta_sph, collision_sigma
 
 METHODS = ("pt", "mtpt")
 
@@ -119,28 +118,21 @@ def mtpt_uniform_labels(n: int, length: float, c0: float, rng: np.random.Generat
     return x, masses
 
 
-def mtpt_kernel(eta: float, D: float, dt: float, h: float | None = None) -> tuple[float, float]:
-    """(sigma, beta) of MTPT's transfer kernel for a step dt: the collision kernel (Eq. 17, beta 1/2), or
-    with ``h`` an SPH kernel of that fixed width (Eqs. 20, 21)."""
-    if h is None:
-        return collision_sigma(eta, D, dt), 0.5
-    if not (h > 0.0 and math.isfinite(h)):
-        raise ValueError(f"SPH width h must be positive and finite, got {h!r}")
-    return h, beta_sph(eta, D, dt, h)
-
-
 def mtpt_step(x, masses, kinetics, dV, D, eta, dt, rng, h=None, domain=None, t: float = 0.0):
     """One reactive MTPT step of the runner's parts -> (x, masses, substeps): the walk with (1 - eta) D
     (models/mtpt.walk, reflected into ``domain``), every species exchanged with eta D (mass_transfer;
-    ``mtpt_kernel``), then every particle reacted (reaction_step.react_masses)."""
-    from ..models.mtpt import walk
+    models/mtpt.kernel: the collision kernel, or ``h`` a fixed SPH width), then every particle reacted
+    (reaction_step.react_masses)."""
+    from ..models.mtpt import kernel, walk
     from ..models.reaction_step import react_masses
     from ..numerics.mass_transfer import mass_transfer
 
+    if h is not None and not (h > 0.0 and math.isfinite(h)):
+        raise ValueError(f"SPH width h must be positive and finite, got {h!r}")
     x, masses, _ = walk(x, masses, None, (1.0 - eta) * D, dt, rng, domain)
     substeps = 1
     if eta * D > 0.0:
-        res = mass_transfer(x, masses, *mtpt_kernel(eta, D, dt, h))
+        res = mass_transfer(x, masses, *kernel(eta, D, dt, h))
         masses, substeps = res.mass, res.substeps
     else:
         masses = masses.copy()

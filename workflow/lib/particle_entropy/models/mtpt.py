@@ -24,14 +24,23 @@ def initial_state(cfg: RunConfig, rng: np.random.Generator):
     return x[order], m[order], order
 
 
+def kernel(eta: float, D: float, dt: float, h: float | None = None) -> tuple[float, float]:
+    """(sigma, beta) of the transfer kernel for a step dt: the collision kernel (Eq. 17, beta 1/2), or
+    with ``h`` an SPH kernel of that width (Eqs. 20, 21)."""
+    if h is None:
+        return collision_sigma(eta, D, dt), 0.5
+    return h, beta_sph(eta, D, dt, h)
+
+
 def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
-    """(sigma, beta) of the transfer kernel for a step of size dt ending at t_end (0, 0: no transfer)."""
+    """(sigma, beta) of the transfer kernel for a step of size dt ending at t_end (0, 0: no transfer);
+    the SPH width is h_SPH of the plume at t_end (Eq. 26)."""
     if cfg.eta * cfg.D == 0.0:
         return 0.0, 0.0
     if cfg.kernel == "collision":
-        return collision_sigma(cfg.eta, cfg.D, dt), 0.5
+        return kernel(cfg.eta, cfg.D, dt)
     h = h_sph(cfg.n, cfg.omega, cfg.reference(t_end).variance, SCHEME_RECORDS[cfg.scheme].sph_constant)
-    return h, beta_sph(cfg.eta, cfg.D, dt, h)
+    return kernel(cfg.eta, cfg.D, dt, h)
 
 
 def walk(x, m, label, d_walk: float, dt: float, rng: np.random.Generator, domain=None):
