@@ -30,6 +30,8 @@ import numpy as np  # noqa: E402
 
 LIB = Path(__file__).resolve().parents[1] / "workflow" / "lib"
 sys.path.insert(0, str(LIB))
+from machine import cpu  # noqa: E402
+
 from particle_entropy.models import fd2d  # noqa: E402
 
 SCHEMES = ("upwind", "central", "tvd")
@@ -72,13 +74,6 @@ def one(nodes: int, scheme: str) -> dict:
         "advect_ms": 1e3 * statistics.median(advects) if advects else float("nan"),
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     }
-
-
-def cpu() -> str:
-    for line in Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown"
 
 
 def main(sizes: list[int]) -> None:

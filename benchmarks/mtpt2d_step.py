@@ -34,6 +34,8 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "workflow" / "lib"))
+from machine import cpu  # noqa: E402
+
 from particle_entropy.models.walk import walk  # noqa: E402
 from particle_entropy.numerics import pair_transfer as pt  # noqa: E402
 from particle_entropy.numerics.neighbours import pairs_within  # noqa: E402
@@ -119,13 +121,6 @@ def one(n: int, eta: float, cutoff_sds: float, repeats: int) -> dict:
         "mass_error": abs(float(m.sum()) - 1.0),
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
     }
-
-
-def cpu() -> str:
-    for line in Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("model name"):
-            return line.split(":", 1)[1].strip()
-    return "unknown"
 
 
 def main() -> None:
