@@ -55,6 +55,8 @@ def _scene(reaction, measure="product", value=0.02, fd=(64, 256), mtpt=(100, 400
             {"method": "mtpt", "kernel": "collision", "eta": 1, "n_range": list(mtpt)},
         ],
     }
+    if reaction is None:  # a conservative scene
+        del spec["reaction"]
     return Scene.from_config("r", spec)
 
 
@@ -86,3 +88,19 @@ def test_a_run_whose_error_is_not_finite_is_unscored_not_failed():
     scene = _scene({"kind": "decay", "rate": 0.01})
     row = {"candidate": 0, "negative_step": -1, "mass_total": 1.0, "mass_lost_BC": 0.0, "product_error": np.nan}
     assert S.unscored(scene, row) == "its product error is not finite"
+
+
+def test_a_conservative_rmse_target_a_field_of_zeros_meets_is_refused_naming_its_plume_s_rms():
+    """A Gaussian plume at rest: sd^2 = 0.05^2 + 2 D t; its 15 points span +- REACH sqrt(2 sd^2)
+    (Scene.points_span), where the exact density's RMS is what a field of zeros scores. A target at
+    or above it is refused by scenes.<name>.target before any job; just below it is accepted."""
+    from particle_entropy.core import measures as M
+    from particle_entropy.core.settings import SCENE_REACH
+
+    sd = np.sqrt(0.05**2 + 2.0 * 1e-4 * 20.0)
+    x = M.measurement_points(2.0 * SCENE_REACH * np.sqrt(2.0) * sd)
+    rms = float(np.sqrt(np.mean((np.exp(-0.5 * (x / sd) ** 2) / (sd * np.sqrt(2.0 * np.pi))) ** 2)))
+    with pytest.raises(SettingError) as err:
+        _scene(None, measure="rmse", value=1.001 * rms)
+    assert err.value.name == "scenes.r.target" and f"{rms:.3g}" in err.value.allowed
+    _scene(None, measure="rmse", value=0.999 * rms)  # a plume still above its target somewhere: accepted

@@ -1,9 +1,10 @@
 """Whether a scene's target asks a question its reference can answer (issue 50): a relative error of
 a zero product is undefined, an RMSE that a field of zeros already meets says nothing about a model,
 and a reference whose own error reaches the target cannot judge one. A scene so posed is refused by
-its key path before any job where its reference is a closed form (a conservative plume, a decay:
-``check``), and otherwise, once the reference is solved, every candidate stops with the reason and
-nothing is recommended (analysis/scene_search.py reads ``undefined``)."""
+its key path before any job where its reference is a closed form (``check``: a conservative plume,
+whose RMSE target must lie below the plume's own RMS at the points; a decay), and otherwise, once the
+reference is solved, every candidate stops with the reason and nothing is recommended
+(analysis/scene_search.py reads ``undefined``)."""
 
 from __future__ import annotations
 
@@ -42,8 +43,8 @@ def undefined(measure: str, value: float, ref: dict) -> str:
     zero = _rms(ref[values])
     if not zero > value:
         return (
-            f"the reference's {field} is ~0 at the points: a field of zeros scores RMSE {zero:.3g} <= {value:g}, "
-            "so meeting the target says nothing about a model"
+            f"a field of zeros scores RMSE {zero:.3g} <= {value:g} against the reference's {field} at the points, "
+            "so meeting the target says nothing about a model (lower it below that)"
         )
     own = _rms(ref[errors])
     if not own < value:
@@ -67,11 +68,15 @@ def check(scene, ref: dict | None) -> None:
 
 
 def closed_form(scene) -> dict | None:
-    """A reactive scene's reference when it is a closed form known before any job (a kind without B:
-    scenes/reference.compute), as ``undefined`` reads it; None for A + B -> C, solved by a job,
-    and for a conservative scene, whose unit-mass plume the reaction cannot take away."""
+    """A scene's reference when it is a closed form known before any job, as ``undefined`` reads it: a
+    conservative plume's exact values at the scene's points (core/reference.py, no error of its own),
+    or a reaction without B (scenes/reference.compute); None for A + B -> C, solved by a job."""
+    if scene.reaction is None:
+        exact = scene.reference
+        values = exact.density(exact.points(scene.points_span))
+        return {"a_points": values.tolist(), "a_error": np.zeros_like(values).tolist()}
     from . import reference
 
-    if scene.reaction is not None and scene.reaction.closed_form(scene.t_final) is not None:
+    if scene.reaction.closed_form(scene.t_final) is not None:
         return reference.compute(reference.physics(scene))
     return None
