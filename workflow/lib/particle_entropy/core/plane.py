@@ -146,6 +146,13 @@ def grid_span(cfg) -> tuple[np.ndarray, np.ndarray]:
     return centre - np.round((centre - lo) / h) * h, h
 
 
+def grid_numbers(cfg, dt: float) -> tuple[float, float]:
+    """(grid Peclet max_i |v_i| dx_i / D_ii, Courant max_i |v_i| dt / dx_i) of a 2-D FD run at step dt."""
+    _, h = grid_span(cfg)
+    v, D = np.abs(np.asarray(cfg.v, dtype=np.float64)), np.diag(np.asarray(cfg.D, dtype=np.float64))
+    return float(np.max(v * h / D)), float(np.max(v * dt / h))
+
+
 def courant_step(cfg) -> float:
     """FD's step at its Courant number: courant / max(|vx| / dx, |vy| / dy) [T]."""
     check_physics(cfg)

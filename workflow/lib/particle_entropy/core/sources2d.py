@@ -16,7 +16,6 @@ from dataclasses import dataclass, fields
 from typing import ClassVar
 
 import numpy as np
-from scipy.special import ndtr
 
 from .sources import SourceError
 
@@ -52,6 +51,8 @@ def dispersion_tensor(v, D: Mapping) -> np.ndarray:
 def normal_mass(lo, hi):
     """Phi(hi) - Phi(lo) for standard-normal bounds lo <= hi, from the nearer tail: no cancellation
     where both bounds lie far out on one side."""
+    from scipy.special import ndtr  # imported when used: a job that runs no 2-D source never loads scipy
+
     lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
     right = lo > 0  # both bounds in the right tail: Phi(-lo) - Phi(-hi)
     return ndtr(np.where(right, -lo, hi)) - ndtr(np.where(right, -hi, lo))

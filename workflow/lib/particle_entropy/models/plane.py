@@ -165,6 +165,7 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
         "H_I": h_c + math.log(dV) if entropy else math.nan,
         "E": M.dilution_index(h_c, dV) if entropy else math.nan,
         "SSE_points": math.nan,
+        "COMIC_points": math.nan,
         "dV": dV,
         "mass_total": total,
         "mass_min": float(masses.min()),
@@ -172,6 +173,7 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
     if at_points is not None and t > 0:
         points = cfg.points(t)
         row["SSE_points"] = M.sse(at_points(points), ref.density(points))
+        row["COMIC_points"] = M.comic(row["SSE_points"], len(points), dV)  # Eq. 43 at the points
     if t > 0 or cfg.source.kind != "point":
         row["H_C_analytic"] = ref.h_i() - math.log(dV) if entropy else math.nan
         row["E_analytic"] = ref.dilution()

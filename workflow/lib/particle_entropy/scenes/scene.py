@@ -420,8 +420,9 @@ class Scene:
                 s.reaction.model_dump(exclude_unset=True),
                 "absent in a 2-D scene: 2-D reactions do not exist yet",
             )
-        v = (0.0, 0.0) if "v" not in s.model_fields_set else tuple(float(u) for u in s.v)
-        source = _source2d(key, s.source if "source" in s.model_fields_set else {"kind": "point", "x0": [0.0, 0.0]})
+        v = tuple(float(u) for u in s.v) if isinstance(s.v, list) else (0.0, 0.0)
+        origin = s.source == _DEFAULTS["source"]  # the default, a point at the origin, in the plane
+        source = _source2d(key, {"kind": "point", "x0": [0.0, 0.0]} if origin else s.source)
         try:
             D = plane.tensor(dispersion_tensor(v, s.D.tensor_spec()))
         except ValueError as e:
@@ -458,15 +459,15 @@ def _plane_keys(s) -> bool:
 
 
 def _check_plane_keys(s, key) -> None:
-    """SettingError naming the first key written in its 1-D form in a scene that writes 2-D ones."""
-    written = s.model_fields_set
-    if not isinstance(s.v, list) and "v" in written:
+    """SettingError naming the first key written in its 1-D form in a scene that writes 2-D ones (v = 0
+    and the default source, a point at the origin, read the same in either form)."""
+    if not isinstance(s.v, list) and s.v != 0.0:
         raise SettingError(
             key("v"), s.v, "a pair [vx, vy] in a 2-D scene (its D or source is 2-D): 1-D and 2-D keys mixed"
         )
     if isinstance(s.D, (int, float)):
         raise SettingError(key("D"), s.D, "{L: D_L, T: D_T} or {x: Dx, y: Dy} in a 2-D scene: 1-D and 2-D keys mixed")
-    if "source" in written and plane.source_of(s.source) is None:
+    if s.source != _DEFAULTS["source"] and plane.source_of(s.source) is None:
         raise SettingError(
             key("source"), s.source, "a 2-D source (x0 a pair, or x and y) in a 2-D scene: 1-D and 2-D keys mixed"
         )
@@ -623,7 +624,7 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     the same measurement points. Their tables are the paper's (``pattern``): the paper scene
     recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
     shared = set()
-    if scene.reaction is not None:  # a reactive scene's runs carry its reaction: none is the paper's
+    if scene.reaction is not None or scene.dim == 2:  # a reactive or 2-D scene's runs: none is the paper's
         return replace(scene, paper_pattern=pattern)
     for ci, cand in enumerate(scene.candidates):
         mine = scene.run_config(cand, cand.n_lo)
