@@ -32,13 +32,22 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..core.runconfig import COURANT_SLACK
+from ..numerics.compiled import kernels
 from . import fd
+from .conservation import MassError
 
 SCHEMES = ("upwind", "central", "tvd")
+METHODS = ("auto", "lu", "krylov")
+# "auto" takes the LU below this many interior unknowns (255 x 255 nodes and fewer: every grid of
+# tests/test_fd2d.py, bit for bit as before), the Krylov solve from it on
+KRYLOV_FROM_UNKNOWNS = 2**16
+RTOL = 1e-13  # the Krylov solve's true relative residual ||c - A c'|| / ||c||
+MAX_ITERATIONS = 40  # BiCGSTAB iterations before the step falls back to the LU
 
 
 def courant_number(v, dx: float, dy: float, dt: float) -> float:
@@ -131,6 +140,24 @@ def _matrix(stencil: dict[tuple[int, int], float], mx: int, my: int):
     return a.tocsc()
 
 
+def _weights(stencil: dict[tuple[int, int], float]) -> np.ndarray:
+    """The step matrix's stencil as a (3, 3) array w[di + 1, dj + 1], the identity included [-]."""
+    w = np.zeros((3, 3))
+    w[1, 1] = 1.0
+    for (di, dj), s in stencil.items():
+        w[di + 1, dj + 1] += s
+    return w
+
+
+def choose_method(method: str, shape: tuple[int, int]) -> str:
+    """ "lu" or "krylov": ``method`` itself, or for "auto" the LU below KRYLOV_FROM_UNKNOWNS unknowns."""
+    if method not in METHODS:
+        raise ValueError(f"solve method {method!r}: one of {', '.join(METHODS)}")
+    if method != "auto":
+        return method
+    return "lu" if shape[0] * shape[1] < KRYLOV_FROM_UNKNOWNS else "krylov"
+
+
 def _ring_weights(stencil: dict[tuple[int, int], float], mx: int, my: int) -> np.ndarray:
     """w (mx, my): the mass per cell area that a unit value at an interior node sends into the ring
     in one step, by the stencil's entries on the ring's nodes (those the interior matrix drops).
@@ -160,9 +187,19 @@ class Solver:
     backward Euler (I + dt (v . grad_h - div_h D grad_h)) c' = c with upwind or central advection
     in the matrix, or (tvd) fd.advect_tvd along x then along y, then the dispersion solve."""
 
-    def __init__(self, D, v, dx: float, dy: float, dt: float, shape: tuple[int, int], scheme: str):
-        from scipy.sparse.linalg import splu
-
+    def __init__(
+        self,
+        D,
+        v,
+        dx: float,
+        dy: float,
+        dt: float,
+        shape: tuple[int, int],
+        scheme: str,
+        method: str = "auto",
+        rtol: float = RTOL,
+        max_iterations: int = MAX_ITERATIONS,
+    ):
         self.D, self.v = np.array(D, dtype=float), np.array(v, dtype=float)
         self.dx, self.dy, self.dt, self.shape, self.scheme = float(dx), float(dy), float(dt), tuple(shape), scheme
         self.courant = courant_number(self.v, self.dx, self.dy, self.dt)
@@ -170,14 +207,63 @@ class Solver:
             raise ValueError(f"tvd advection at courant number {self.courant:.17g}: at most 1")
         # the Courant number along each axis, within round-off of 1 taken as 1 (fd.TVDSolver's rule)
         self.p = tuple(max(-1.0, min(1.0, self.v[a] * self.dt / h)) for a, h in ((0, self.dx), (1, self.dy)))
-        stencil = _operator(self.D, self.v, self.dx, self.dy, self.dt, scheme)
-        self.matrix = _matrix(stencil, *self.shape)
-        self._ring = _ring_weights(stencil, *self.shape)
-        self._scale = 1.0 + sum(abs(w) for w in stencil.values())  # the matrix's largest row sum
+        self._stencil = _operator(self.D, self.v, self.dx, self.dy, self.dt, scheme)
+        self._ring = _ring_weights(self._stencil, *self.shape)
+        self._scale = 1.0 + sum(abs(w) for w in self._stencil.values())  # the matrix's largest row sum
+        self.method = choose_method(method, self.shape)
+        self.rtol, self.max_iterations = float(rtol), int(max_iterations)
+        self.factorisation_seconds, self.setup_seconds = 0.0, 0.0  # wall times, for benchmarks
+        self._lu = None
+        start = time.perf_counter()
+        if self.method == "lu":
+            self._factorise()
+        else:
+            self._w = _weights(self._stencil)
+            self._work = np.empty((8, self.shape[0] * self.shape[1]))  # BiCGSTAB's vectors
+        self.setup_seconds = time.perf_counter() - start
+        self.iterations, self.fallbacks = 0, 0  # the last Krylov solve's; steps that took the LU instead
+        self.steps, self.smallest, self.first_negative, self.last = 0, math.inf, None, None
+
+    @cached_property
+    def matrix(self):
+        """The step matrix I + dt (v . grad_h - div_h D grad_h), sparse (CSC), built when first asked for."""
+        return _matrix(self._stencil, *self.shape)
+
+    def _factorise(self) -> None:
+        """The sparse LU of ``matrix`` (SuperLU, minimum degree on A^T + A), timed."""
+        from scipy.sparse.linalg import splu
+
         start = time.perf_counter()
         self._lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A")
-        self.factorisation_seconds = time.perf_counter() - start  # the LU's wall time, for benchmarks
-        self.steps, self.smallest, self.first_negative, self.last = 0, math.inf, None, None
+        self.factorisation_seconds = time.perf_counter() - start
+
+    def _krylov(self, c: np.ndarray) -> np.ndarray | None:
+        """The matrix's solve by BiCGSTAB (numerics/stencil2d) to ``rtol``, or None where it did not
+        get there in ``max_iterations``."""
+        out, self.iterations, residual = kernels().bicgstab(
+            self._w, np.ascontiguousarray(c), self.rtol, self.max_iterations, self._work
+        )
+        return out if residual <= self.rtol else None
+
+    def implicit(self, c: np.ndarray) -> tuple[np.ndarray, float]:
+        """The backward-Euler solve of ``c`` and its outflow, mass balanced (else MassError): by the
+        Krylov solve, or the LU where that did not converge or balance (from then on, every step)."""
+        if self.method == "krylov":
+            out = self._krylov(c)
+            if out is not None:
+                outflow = self.outflow(out)
+                try:
+                    fd.check_balance(c, out, outflow, self._scale)
+                    return out, outflow
+                except MassError:
+                    pass
+            self.method, self.fallbacks = "lu", self.fallbacks + 1
+        if self._lu is None:
+            self._factorise()
+        out = self._lu.solve(c.ravel()).reshape(self.shape)
+        outflow = self.outflow(out)
+        fd.check_balance(c, out, outflow, self._scale)
+        return out, outflow
 
     def outflow(self, c: np.ndarray) -> float:
         """The mass per cell area the implicit solution ``c`` sent into the zero ring this step."""
@@ -209,9 +295,7 @@ class Solver:
         left = 0.0
         if self.scheme == "tvd":
             c, left = self.advect(c)
-        out = self._lu.solve(c.ravel()).reshape(self.shape)
-        outflow = self.outflow(out)
-        fd.check_balance(c, out, outflow, self._scale)
+        out, outflow = self.implicit(c)
         smallest = float(out.min())
         self.steps += 1
         self.smallest = min(self.smallest, smallest)
@@ -225,9 +309,9 @@ class Solver:
         return self.step(c_interior)[0]
 
 
-def solver(D, v, grid: Grid, dt: float, scheme: str) -> Solver:
-    """The solver of one step dt on ``grid``'s interior."""
-    return Solver(D, v, grid.dx, grid.dy, dt, (grid.nx - 1, grid.ny - 1), scheme)
+def solver(D, v, grid: Grid, dt: float, scheme: str, method: str = "auto", **options) -> Solver:
+    """The solver of one step dt on ``grid``'s interior (``method`` and ``options``: Solver's)."""
+    return Solver(D, v, grid.dx, grid.dy, dt, (grid.nx - 1, grid.ny - 1), scheme, method, **options)
 
 
 def step_whole(solve: Solver, c: np.ndarray) -> Step:
