@@ -164,11 +164,16 @@ def _residual(w, b, x, r, mx, my):
 
 
 @njit(cache=True)
-def _bicgstab_pass(w, b, x, tol, budget, mx, my, work):
+def _bicgstab_pass(w, b, x, tol, budget, mx, my, work, fresh):
     """BiCGSTAB iterations on A x = b from x (updated in place) until ||b - A x|| <= tol by its
-    recurrence, a breakdown, or ``budget`` iterations -> iterations taken. ``work``: 8 vectors."""
+    recurrence, a breakdown, or ``budget`` iterations -> iterations taken. ``work``: 8 vectors;
+    ``fresh``: x is 0."""
     r, rhat, p, v, ph, sh, s, t = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
-    if _residual(w, b, x, r, mx, my) <= tol:
+    if fresh:  # x = 0: the residual is b, no product needed
+        r[:] = b
+        if _dot(r, r) == 0.0:
+            return 0
+    elif _residual(w, b, x, r, mx, my) <= tol:
         return 0
     rhat[:] = r
     p[:] = 0.0
@@ -211,7 +216,7 @@ def bicgstab(w, b, rtol, max_iterations, work):
         return x.reshape(mx, my), 0, 0.0
     tol, done = rtol * scale, 0
     while True:
-        done += _bicgstab_pass(w, flat, x, tol, max_iterations - done, mx, my, work)
+        done += _bicgstab_pass(w, flat, x, tol, max_iterations - done, mx, my, work, done == 0)
         residual = _residual(w, flat, x, work[0], mx, my) / scale
         if residual <= rtol or done >= max_iterations:
             return x.reshape(mx, my), done, residual
