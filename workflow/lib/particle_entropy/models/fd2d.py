@@ -9,17 +9,43 @@ or Leonard's explicit ULTIMATE-QUICKEST (tvd), split by direction, x then y, eac
 then the dispersion solve (Lie splitting, as fd.TVDSolver; the two directions' shifts commute, so
 splitting them costs no order), at a Courant number max(|vx| dt / dx, |vy| dt / dy) <= 1.
 
-The implicit step is one sparse LU (SuperLU, scipy.sparse.linalg.splu, minimum-degree ordering of
-A^T + A: the matrix's pattern is symmetric, and that ordering fills half what COLAMD does), built once
-per step size and reused every step, not ADI. ADI splits the operator into x and y sweeps; the cross
-term fits neither, so ADI schemes with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer)
-take it explicitly, which bounds the step by the cross term's stability and makes the step no longer
-the backward-Euler step whose mass balance fd.py checks. The LU gives that exact step for any tensor
-and flow, unconditionally stable; its price is memory and time at large n. benchmarks/fd2d_step.py
-measures both; at 1,024 x 1,024 nodes (measured at commit c63f787, one core of an "Intel(R) Xeon(R)
-Processor", others' jobs running) 15-20 s to factorise, 1.8 GB peak and 0.22-0.33 s a step: the
-triangular solves read about 10^8 factor entries, so no direct solve meets the 60 ms target there; an
-O(N) step would (ADI with the cross term explicit, or multigrid-preconditioned Krylov).
+The implicit step solves the backward-Euler system A c' = c, A = I + dt (v . grad_h - div_h D grad_h),
+by one of two solves of the same system (Solver's ``method``):
+
+- "lu": one sparse LU (SuperLU, scipy.sparse.linalg.splu, minimum-degree ordering of A^T + A: the
+  matrix's pattern is symmetric, and that ordering fills half what COLAMD does), built once per step
+  size and reused every step. Exact for any tensor and flow; its price is memory and time at large n:
+  the triangular solves read about 10^8 factor entries at 1,024^2 nodes.
+- "krylov": BiCGSTAB (numerics/stencil2d.py, compiled) on the constant 9-point stencil, matrix-free,
+  right-preconditioned by a symmetric Gauss-Seidel sweep, iterated until the true relative residual
+  ||c - A c'|| / ||c|| is at most RTOL = 1e-13: O(N) a step, no factorisation, eight vectors of
+  scratch. A is the identity plus dt times the operator, diagonally dominant at a Courant-limited
+  step's dt D / dx^2, so it takes 2-4 iterations there; more as dt D / dx^2 grows (measured on
+  512^2 nodes at Courant 0.1-1, every scheme: 2-7 at dt D_L / dx^2 = 0.1, 4-5 at 1, 13-15 at 10,
+  52-59 at 100, none within 400 at 1e3). A solve not within RTOL in MAX_ITERATIONS = 40, or whose
+  answer fails the mass balance, is replaced by the LU's (factorised then), for that step and every
+  later one (``fallbacks`` counts them): the step is never other than the LU's to round-off. Measured
+  against the LU (tests): at most 2e-13 of the field's largest value.
+- "auto" (the default): the LU below KRYLOV_FROM_UNKNOWNS = 2^16 interior unknowns, i.e. up to
+  256 x 256 nodes, the Krylov solve from there. The measured crossover is lower (the two equal at
+  64^2 nodes, the Krylov step 2-3x faster from 128^2), but below 2^16 the LU costs under 0.6 s and
+  230 MB, and every grid of tests/test_fd2d.py (and each number measured there) keeps its LU's bits.
+
+Not ADI: ADI splits the operator into x and y sweeps; the cross term fits neither, so ADI schemes
+with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer) take it explicitly, which bounds
+the step by the cross term's stability and makes the step no longer the backward-Euler step whose
+mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves (commit f8c539f, one core of
+an "Intel(R) Xeon(R) Processor" as lscpu names it, others' jobs running: load average 3.3-4.5 on its
+2 CPUs), ms a step (Krylov iterations) for upwind / central / tvd, tvd's explicit advection included:
+
+    nodes      LU: factorise, peak     LU ms a step          Krylov: peak   Krylov ms a step
+    256^2      0.3-0.5 s, 150-230 MB   9.0 / 9.2 / 11.4      170 MB         2.1 (2) / 3.5 (4) / 3.0 (2)
+    512^2      2.3-2.6 s, 455-460 MB   50 / 50 / 56          185-190 MB     9.7 (2) / 13.3 (3) / 15.5 (2)
+    1024^2     15.3-16.6 s, 1.8 GB     218 / 220 / 241       255-290 MB     49 (2) / 62 (3) / 63 (2)
+
+so at 1,024^2 the Krylov step is 3.5-4.5x the LU's speed, needs no 17 s factorisation, and meets
+the 60 ms target for upwind; central and tvd came within 5 % of it on the loaded machine (tvd's
+line-by-line advection is 21 ms of its 63).
 
 Every step balances its mass as in 1-D (fd.check_balance): the interior's mass falls by the flux into
 the zero boundary ring, computed from the stencil's entries that reach the ring (not from the
