@@ -55,21 +55,29 @@ def stencil_apply(w, x):
 
 @njit(cache=True)
 def _recur(z, c, direction):
-    """z[j] -= c z[j - direction] in place along one row, in that direction, two nodes a step
-    (z[j + 1] from z[j - 1] by c^2: the chain of dependent multiply-adds halved)."""
-    my, c2 = z.size, c * c
+    """z[j] -= c z[j - direction] in place along one row, in that direction, four nodes a step:
+    each block's own recurrence q first, then z = q + (-c)^k z_before, so that the chain of
+    dependent multiply-adds from block to block is one long."""
+    my = z.size
+    c2, c3, c4 = c * c, -c * c * c, c * c * c * c
     start = 0 if direction > 0 else my - 1
     prev = 0.0
-    for k in range(my // 2):
-        j0 = start + 2 * k * direction
-        j1 = j0 + direction
-        a0, a1 = z[j0], z[j1]
-        z[j0] = a0 - c * prev
-        prev = (a1 - c * a0) + c2 * prev
-        z[j1] = prev
-    if my % 2:
-        last = start + (my - 1) * direction
-        z[last] -= c * prev
+    for k in range(my // 4):
+        j0 = start + 4 * k * direction
+        j1, j2, j3 = j0 + direction, j0 + 2 * direction, j0 + 3 * direction
+        q0 = z[j0]
+        q1 = z[j1] - c * q0
+        q2 = z[j2] - c * q1
+        q3 = z[j3] - c * q2
+        z[j0] = q0 - c * prev
+        z[j1] = q1 + c2 * prev
+        z[j2] = q2 + c3 * prev
+        prev = q3 + c4 * prev
+        z[j3] = prev
+    for j in range(4 * (my // 4), my):
+        at = start + j * direction
+        prev = z[at] - c * prev
+        z[at] = prev
 
 
 @njit(cache=True)
@@ -167,17 +175,15 @@ def _residual(w, b, x, r, mx, my):
 def _bicgstab_pass(w, b, x, tol, budget, mx, my, work, fresh):
     """BiCGSTAB iterations on A x = b from x (updated in place) until ||b - A x|| <= tol by its
     recurrence, a breakdown, or ``budget`` iterations -> iterations taken. ``work``: 8 vectors;
-    ``fresh``: x is 0."""
+    ``fresh``: x is 0 and b is not."""
     r, rhat, p, v, ph, sh, s, t = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
-    if fresh:  # x = 0: the residual is b, no product needed
+    if fresh:  # x = 0 (b != 0): the residual is b, no product needed, and b is the shadow residual
         r[:] = b
-        if _dot(r, r) == 0.0:
-            return 0
+        rhat = b
     elif _residual(w, b, x, r, mx, my) <= tol:
         return 0
-    rhat[:] = r
-    p[:] = 0.0
-    v[:] = 0.0
+    else:
+        rhat[:] = r
     rho = alpha = omega = 1.0
     rho_new = _dot(rhat, r)
     for it in range(1, budget + 1):
@@ -185,7 +191,10 @@ def _bicgstab_pass(w, b, x, tol, budget, mx, my, work, fresh):
             return it
         beta = (rho_new / rho) * (alpha / omega)
         rho = rho_new
-        _direction(p, r, v, beta, omega)
+        if it == 1:
+            p[:] = r
+        else:
+            _direction(p, r, v, beta, omega)
         _sgs(w, p, ph, mx, my)
         apply(w, ph, v, mx, my)
         alpha = rho / _dot(rhat, v)
