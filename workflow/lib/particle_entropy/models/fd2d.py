@@ -27,25 +27,29 @@ by one of two solves of the same system (Solver's ``method``):
   later one (``fallbacks`` counts them): the step is never other than the LU's to round-off. Measured
   against the LU (tests): at most 2e-13 of the field's largest value.
 - "auto" (the default): the LU below KRYLOV_FROM_UNKNOWNS = 2^16 interior unknowns, i.e. up to
-  256 x 256 nodes, the Krylov solve from there. The measured crossover is lower (the two equal at
-  64^2 nodes, the Krylov step 2-3x faster from 128^2), but below 2^16 the LU costs under 0.6 s and
-  230 MB, and every grid of tests/test_fd2d.py (and each number measured there) keeps its LU's bits.
+  256 x 256 nodes, the Krylov solve from there. The measured crossover is lower (a step of either
+  takes 0.1-0.5 ms at 64^2 nodes, central's the same; from 128^2 the Krylov step is 1.5-3x faster),
+  but below 2^16 the LU costs at most about 0.6 s and 230 MB, and every grid of tests/test_fd2d.py
+  (and each number measured there) keeps its LU's bits.
 
 Not ADI: ADI splits the operator into x and y sweeps; the cross term fits neither, so ADI schemes
 with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer) take it explicitly, which bounds
 the step by the cross term's stability and makes the step no longer the backward-Euler step whose
-mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves (commit f8c539f, one core of
-an "Intel(R) Xeon(R) Processor" as lscpu names it, others' jobs running: load average 3.3-4.5 on its
-2 CPUs), ms a step (Krylov iterations) for upwind / central / tvd, tvd's explicit advection included:
+mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves, at commit f1d6810 on one
+core of an "Intel(R) Xeon(R) Processor" (lscpu's name), with others' jobs running (load average 6-7
+on its 2 CPUs): CPU ms a step (Krylov iterations) for upwind / central / tvd, tvd's explicit
+advection included:
 
-    nodes      LU: factorise, peak     LU ms a step          Krylov: peak   Krylov ms a step
-    256^2      0.3-0.5 s, 150-230 MB   9.0 / 9.2 / 11.4      170 MB         2.1 (2) / 3.5 (4) / 3.0 (2)
-    512^2      2.3-2.6 s, 455-460 MB   50 / 50 / 56          185-190 MB     9.7 (2) / 13.3 (3) / 15.5 (2)
-    1024^2     15.3-16.6 s, 1.8 GB     218 / 220 / 241       255-290 MB     49 (2) / 62 (3) / 63 (2)
+    nodes      LU: factorise, peak     LU ms a step        Krylov: peak   Krylov ms a step
+    256^2      0.5-0.6 s, 154-232 MB   7.5 / 9.0 / 10.8    169-172 MB     1.8 (2) / 3.0 (4) / 2.7 (2)
+    512^2      3.2-3.9 s, 458-465 MB   49 / 49 / 54        188-196 MB     8.2 (2) / 11.6 (3) / 14.6 (2)
+    1024^2     22-25 s, 1.8 GB         222 / 215 / 241     257-286 MB     40 (2) / 57 (3) / 57 (2)
 
-so at 1,024^2 the Krylov step is 3.5-4.5x the LU's speed, needs no 17 s factorisation, and meets
-the 60 ms target for upwind; central and tvd came within 5 % of it on the loaded machine (tvd's
-line-by-line advection is 21 ms of its 63).
+so at 1,024^2 the Krylov step takes a quarter of the LU's time, with no factorisation and a seventh
+of its memory, and its CPU time meets the 60 ms target for each scheme (tvd's line-by-line advection
+took 27-32 ms of wall time of its step). Its wall time there was 66 / 83 / 85 ms (LU: 330-362 ms) at that load, and
+49 / 62 / 63 ms (LU: 218-241 ms) in a run at load 3.3-4.5 (commit f8c539f, before the sweeps took
+four nodes a block).
 
 Every step balances its mass as in 1-D (fd.check_balance): the interior's mass falls by the flux into
 the zero boundary ring, computed from the stencil's entries that reach the ring (not from the
