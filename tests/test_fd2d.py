@@ -332,6 +332,22 @@ def test_the_matrix_free_stencil_is_the_assembled_matrix():
             assert np.abs(product.ravel() - solver.matrix @ c.ravel()).max() <= 1e-15 * solver._scale
 
 
+def test_the_krylov_step_on_narrow_grids_and_a_zero_field():
+    """Grids one or two nodes wide, where the sweeps' rows and blocks are shortest: the Krylov step
+    is the LU's to 1e-13 without a fallback; a field of zeros stays zeros in no iterations."""
+    d, v = _tensor(1e-3, 3e-4, 0.6), (0.7, -0.4)
+    rng = np.random.default_rng(8)
+    for shape in ((1, 1), (1, 7), (6, 1), (2, 3), (5, 4)):
+        for scheme in SCHEMES:
+            fast = fd2d.Solver(d, v, 0.05, 0.04, 0.02, shape, scheme, method="krylov")
+            lu = fd2d.Solver(d, v, 0.05, 0.04, 0.02, shape, scheme, method="lu")
+            c = rng.random(shape)
+            exact = lu.solve(c)
+            assert np.abs(fast.solve(c) - exact).max() <= 1e-13 * np.abs(exact).max(), (shape, scheme)
+            assert fast.fallbacks == 0
+            assert not fast.solve(np.zeros(shape)).any() and fast.iterations == 0
+
+
 @pytest.mark.parametrize("scheme", SCHEMES)
 def test_the_krylov_step_is_the_lu_step_at_45_degrees_with_a_full_tensor(scheme):
     """A Gaussian carried at 45 degrees (D_L = 4 D_T, so Dxy = 1.5 D_T) through the corner, 60 steps
