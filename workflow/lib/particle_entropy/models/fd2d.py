@@ -35,21 +35,21 @@ by one of two solves of the same system (Solver's ``method``):
 Not ADI: ADI splits the operator into x and y sweeps; the cross term fits neither, so ADI schemes
 with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer) take it explicitly, which bounds
 the step by the cross term's stability and makes the step no longer the backward-Euler step whose
-mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves, at commit f1d6810 on one
-core of an "Intel(R) Xeon(R) Processor" (lscpu's name), with others' jobs running (load average 6-7
-on its 2 CPUs): CPU ms a step (Krylov iterations) for upwind / central / tvd, tvd's explicit
-advection included:
+mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves, at commits f1d6810 and
+dbef296 (the same solve) on one core of an "Intel(R) Xeon(R) Processor" (lscpu's name), with others'
+jobs running (load average 3.5-7 on its 2 CPUs): CPU ms a step (Krylov iterations) for upwind /
+central / tvd, tvd's explicit advection included, the range over the two runs:
 
-    nodes      LU: factorise, peak     LU ms a step        Krylov: peak   Krylov ms a step
-    256^2      0.5-0.6 s, 154-232 MB   7.5 / 9.0 / 10.8    169-172 MB     1.8 (2) / 3.0 (4) / 2.7 (2)
-    512^2      3.2-3.9 s, 458-465 MB   49 / 49 / 54        188-196 MB     8.2 (2) / 11.6 (3) / 14.6 (2)
-    1024^2     22-25 s, 1.8 GB         222 / 215 / 241     257-286 MB     40 (2) / 57 (3) / 57 (2)
+    nodes      LU: factorise, peak     LU ms a step          Krylov: peak   Krylov ms a step
+    256^2      0.3-0.6 s, 154-232 MB   7.5-11 / 9 / 11       169-172 MB     1.8 (2) / 3.0-3.2 (4) / 2.7-2.9 (2)
+    512^2      2.2-3.9 s, 458-465 MB   49 / 48-49 / 54-57    188-196 MB     8.2 (2) / 11-12 (3) / 15 (2)
+    1024^2     17-25 s, 1.8 GB         222 / 215-224 / 239-241  257-286 MB     40-43 (2) / 57-62 (3) / 57-59 (2)
 
-so at 1,024^2 the Krylov step takes a quarter of the LU's time, with no factorisation and a seventh
-of its memory, and its CPU time meets the 60 ms target for each scheme (tvd's line-by-line advection
-took 27-32 ms of wall time of its step). Its wall time there was 66 / 83 / 85 ms (LU: 330-362 ms) at that load, and
-49 / 62 / 63 ms (LU: 218-241 ms) in a run at load 3.3-4.5 (commit f8c539f, before the sweeps took
-four nodes a block).
+so at 1,024^2 the Krylov step takes a quarter of the LU's CPU time, with no factorisation and a
+seventh of its memory: upwind meets the 60 ms target, central and tvd are at it (tvd's line-by-line
+advection took 28-32 ms of wall time of its step). Wall times there were longer on the loaded machine:
+Krylov 43-66 / 83-85 / 83-85 ms, LU 303-362 ms; an earlier run at load 3.3-4.5 (commit f8c539f,
+before the sweeps took four nodes a block) gave 49 / 62 / 63 ms against the LU's 218-241 ms.
 
 Every step balances its mass as in 1-D (fd.check_balance): the interior's mass falls by the flux into
 the zero boundary ring, computed from the stencil's entries that reach the ring (not from the
