@@ -30,7 +30,6 @@ import numpy as np
 import pandas as pd
 
 from ..core.io import read_parquet
-from ..core.registry import MEASUREMENT_POINTS
 from ..scenes import defined
 from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
@@ -107,13 +106,13 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
 def error(scene: Scene, row: pd.Series | dict) -> float:
     """The scene's error measure of one run at t_final (its last row)."""
     if scene.measure == "rmse":
-        return math.sqrt(row["SSE_points"] / MEASUREMENT_POINTS)
+        return math.sqrt(row["SSE_points"] / scene.n_points)
     if scene.measure == "entropy":
         return abs(row["H_C"] - row["H_C_analytic"])
     if scene.measure == "product":  # a reactive scene's product mass against its reference
         return row["product_error"]
     if scene.measure == "product_rmse":  # and its product's concentration at the points
-        return math.sqrt(row["SSE_points_C"] / MEASUREMENT_POINTS)
+        return math.sqrt(row["SSE_points_C"] / scene.n_points)
     return abs(row["E"] / row["E_analytic"] - 1.0)
 
 
