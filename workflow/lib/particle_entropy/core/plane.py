@@ -25,6 +25,8 @@ from .sources2d import Source2D
 KERNELS = {"fd": ("implicit",), "mtpt": ("collision",), "pt": ("adaptive",)}
 # The memory an FD rung may take at most [bytes], estimated as FD_BYTES_PER_NODE a node: the sparse LU's
 # factors and the matrix (benchmarks/fd2d_step.py: 1.8 GB at 1,025^2 nodes, about 1,700 bytes a node).
+# Grids of 2^16 unknowns and more take BiCGSTAB instead (about 260 MB there), but fall back to that LU
+# where it does not converge: the bound keeps room for it.
 FD_BYTES_PER_NODE = 1_700
 FD_MAX_BYTES = 4 * 2**30
 # The plume's reach each side of the source that a window must hold, in standard deviations of 2 D t_final

@@ -289,7 +289,8 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
 
 def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     """FD in the plane: the nodes (n + 1, n + 1) carried by fd.transport with the 2-D solver (one
-    sparse factorisation per distinct step size, models/fd2d.py), measured every step (models/plane.py)."""
+    solver per distinct step size: a sparse LU below 2^16 unknowns, BiCGSTAB from there, models/fd2d.py),
+    measured every step (models/plane.py)."""
     from . import plane
     from .fd import transport
 
