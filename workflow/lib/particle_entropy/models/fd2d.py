@@ -3,8 +3,10 @@ the 1-D model of fd.py on a grid of (nx + 1) x (ny + 1) nodes, its boundary ring
 its interior, an (nx - 1, ny - 1) array indexed [i, j] with x along axis 0, solved.
 
 Dispersion is backward Euler with the whole tensor D: the 9-point stencil of div(D grad c), whose
-cross term d/dx(Dxy dc/dy) + d/dy(Dxy dc/dx) = 2 Dxy c_xy is taken by central differences on the
-four corner nodes. Advection is implicit upwind or central in the same matrix (as fd.AdvectionSolver),
+cross term d/dx(Dxy dc/dy) + d/dy(Dxy dc/dx) = 2 Dxy c_xy is taken on the diagonal along Dxy's sign
+by the positive 7-point form wherever |Dxy| dx <= Dxx dy and |Dxy| dy <= Dyy dx (``cross_stencil``: the
+matrix stays an M-matrix and a plume stays non-negative), else by central differences on the four
+corner nodes. Advection is implicit upwind or central in the same matrix (as fd.AdvectionSolver),
 or Leonard's explicit ULTIMATE-QUICKEST (tvd), split by direction, x then y, each line by fd.advect_tvd,
 then the dispersion solve (Lie splitting, as fd.TVDSolver; the two directions' shifts commute, so
 splitting them costs no order), at a Courant number max(|vx| dt / dx, |vy| dt / dy) <= 1.
@@ -133,15 +135,15 @@ class Step:
 
 def _operator(D, v, dx: float, dy: float, dt: float, scheme: str) -> dict[tuple[int, int], float]:
     """The stencil of dt (v . grad - div D grad) on a node: offset (di, dj) -> weight. Dispersion's
-    5-point part, its cross term 2 Dxy c_xy by central differences on the corners, and the advection
-    term: upwind's one-sided or central's centred difference ("tvd": none, advection is explicit)."""
+    5-point part, its cross term 2 Dxy c_xy (``cross_stencil``), and the advection term: upwind's
+    one-sided or central's centred difference ("tvd": none, advection is explicit)."""
     D = np.asarray(D, dtype=float)
     if D.shape != (2, 2) or not abs(D[0, 1] - D[1, 0]) <= 1e-12 * np.abs(D).max():
         raise ValueError(f"D must be a symmetric 2 x 2 tensor, got {D.tolist()}")
     rx, ry = D[0, 0] * dt / dx**2, D[1, 1] * dt / dy**2
-    rxy = 0.5 * (D[0, 1] + D[1, 0]) * dt / (2.0 * dx * dy)  # 2 Dxy dt / (4 dx dy)
     s = {(0, 0): 2.0 * rx + 2.0 * ry, (-1, 0): -rx, (1, 0): -rx, (0, -1): -ry, (0, 1): -ry}
-    s.update({(1, 1): -rxy, (-1, -1): -rxy, (1, -1): rxy, (-1, 1): rxy})
+    for offset, w in cross_stencil(D, dx, dy, dt).items():
+        s[offset] = s.get(offset, 0.0) + w
     for axis, p in ((0, float(v[0]) * dt / dx), (1, float(v[1]) * dt / dy)):
         back, ahead = ((-1, 0), (1, 0)) if axis == 0 else ((0, -1), (0, 1))
         if scheme == "upwind":
@@ -154,6 +156,36 @@ def _operator(D, v, dx: float, dy: float, dt: float, scheme: str) -> dict[tuple[
         elif scheme != "tvd":
             raise ValueError(f"advection scheme {scheme!r}: one of {', '.join(SCHEMES)}")
     return s
+
+
+def positive_cross(D, dx: float, dy: float) -> bool:
+    """Whether the cross term fits the positive 7-point form (``cross_stencil``): |Dxy| dx <= Dxx dy and
+    |Dxy| dy <= Dyy dx, so that every neighbour's weight keeps its sign."""
+    D = np.asarray(D, dtype=float)
+    a = abs(0.5 * (D[0, 1] + D[1, 0]))
+    return a * dx <= D[0, 0] * dy and a * dy <= D[1, 1] * dx
+
+
+def cross_stencil(D, dx: float, dy: float, dt: float) -> dict[tuple[int, int], float]:
+    """The stencil of -dt 2 Dxy c_xy, second order either way. Where ``positive_cross`` holds, the
+    positive 7-point form on the diagonal along Dxy's sign: 2 c_xy h^2 = c(i+1, j+1) + c(i-1, j-1) +
+    2 c - c(i +- 1, j) - c(i, j +- 1) for Dxy > 0 (the anti-diagonal for Dxy < 0), whose neighbour
+    weights keep the signs of the 5-point part's, so that backward Euler keeps an M-matrix and a
+    plume stays non-negative (a point at 45 degrees, D_L = 10 D_T: every scheme went negative at its
+    first step with the corner form). Otherwise the central difference on the four corners, whose
+    two opposite corners carry negative weights (a scheme's negatives are then its own, reported)."""
+    D = np.asarray(D, dtype=float)
+    dxy = 0.5 * (D[0, 1] + D[1, 0])
+    if dxy == 0.0:
+        return {}
+    if not positive_cross(D, dx, dy):
+        r = dxy * dt / (2.0 * dx * dy)  # 2 Dxy dt / (4 dx dy)
+        return {(1, 1): -r, (-1, -1): -r, (1, -1): r, (-1, 1): r}
+    a = abs(dxy) * dt / (dx * dy)
+    diagonal = ((1, 1), (-1, -1)) if dxy > 0 else ((1, -1), (-1, 1))
+    out = {(0, 0): -2.0 * a, (1, 0): a, (-1, 0): a, (0, 1): a, (0, -1): a}
+    out.update({d: -a for d in diagonal})
+    return out
 
 
 def _matrix(stencil: dict[tuple[int, int], float], mx: int, my: int):
