@@ -63,7 +63,7 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "(`measures.sse_points`) [1/L²]",
     "COMIC_points": "2 ln(SSE_points / 15) - ln dV, Eq. 43 at the measurement points, same dV as `COMIC` (-inf for "
     "SSE_points = 0)",
-    "dV": "sampling volume: Ω / N for particles, dx for FD [L]",
+    "dV": "sampling volume: Ω / N for particles, dx for FD; in 2-D an area: Ω² / N, dx dy, PT's estimate's cell [L]",
     "mass_total": "total mass (1 at t = 0; PT always 1)",
     "mass_min": "smallest particle or node mass (PT: 1/N)",
     "beta": "mass-transfer coefficient of the step: 1/2 for the collision kernel, 2 η D dt / h² for SPH (Eq. 20); "
@@ -71,10 +71,13 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "h": "width of the step's kernel: MTPT the transfer kernel's standard deviation (collision sqrt(4 η D dt), "
     "Eq. 17; SPH h_SPH, Eq. 26, of the plume's variance; for `compensated` the widened width); PT the bin width "
     "Ω/N (Eq. 11), the fixed kernel sqrt(2 D t_fix) or h_DE (Eq. 23) of the plume's variance (the source's plus "
-    "2 D t: 0 at t = 0 for a point); FD dx [L]",
+    "2 D t: 0 at t = 0 for a point); FD dx [L]; in 2-D the same along the plume's major axis (MTPT sqrt(4 η D_L "
+    "dt), PT the square root of H's largest eigenvalue)",
+    "neighbours": "2-D MTPT: the step's partners within the exchange's cut-off per particle (2 pairs / N)",
     "substeps": "mass-transfer substeps the step was split into to keep masses non-negative (1: not split; PT and "
     "FD 1)",
-    "settled": "t > dV² / (4 π e D): from here on the analytic H_C is meaningful (Section 3)",
+    "settled": "t > dV² / (4 π e D): from here on the analytic H_C is meaningful (Section 3); in 2-D the exact "
+    "plume's E above dV",
     "work": "particle-steps (FD node-steps, N + 1 nodes) from t = 0 to this step, substeps counted",
     "wall_s": "wall-clock seconds spent in this step (differs between identical runs) [s]",
     "peak_rss_mb": "peak resident memory of the process so far (differs between machines and runs) [MB]",

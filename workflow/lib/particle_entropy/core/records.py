@@ -34,6 +34,7 @@ COLUMNS = (
     "mass_min",
     "beta",
     "h",
+    "neighbours",
     "substeps",
     "settled",
     "work",

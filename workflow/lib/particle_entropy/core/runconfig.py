@@ -10,6 +10,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from . import plane
 from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
 from .reactions import Reaction
@@ -174,8 +175,13 @@ class RunConfig:
     reaction: Reaction | None = None
 
     def __post_init__(self):
-        if isinstance(self.source, Mapping):  # as a job's settings carry it
-            object.__setattr__(self, "source", Source.of(**self.source))
+        if isinstance(self.source, Mapping):  # as a job's settings carry it: a pair x0 (or x and y) is 2-D
+            object.__setattr__(self, "source", plane.source_of(self.source) or Source.of(**self.source))
+        if plane.is_plane(self.source):  # (vx, vy) and the tensor D, hashable (core/plane.py)
+            if isinstance(self.v, (list, tuple, np.ndarray)):
+                object.__setattr__(self, "v", plane.pair(self.v))
+            if isinstance(self.D, (list, tuple, np.ndarray)):
+                object.__setattr__(self, "D", plane.tensor(self.D))
         if isinstance(self.reaction, Mapping):
             object.__setattr__(self, "reaction", Reaction.of(self.reaction))
 
@@ -224,18 +230,29 @@ class RunConfig:
     time_grid = property(lambda self: self.case.time_grid)
 
     @property
+    def dim(self) -> int:
+        """The run's dimensions: 2 with a 2-D source (core/plane.py), else 1."""
+        return 2 if plane.is_plane(self.source) else 1
+
+    @property
     def at_rest(self) -> bool:
         """The paper's scene: a point source at x = 0 and no flow."""
         return self.source == PAPER_SOURCE and self.v == 0.0
 
-    def reference(self, t: float) -> Reference:
-        """The exact solution at time t that this run is measured against."""
+    def reference(self, t: float):
+        """The exact solution at time t that this run is measured against (2-D: core/reference2d.py)."""
+        if self.dim == 2:
+            from .reference2d import Reference2D
+
+            return Reference2D(self.source, self.D, self.v, t)
         return Reference(self.source, self.D, self.v, t)
 
     def points(self, t: float) -> np.ndarray:
         """The measurement points at time t: the paper's 15 (measures.measurement_points), or a
         scene's over the span ``window`` around its plume (Scene.points_span), carried with the
         plume (Reference.points) [L]."""
+        if self.dim == 2:  # a lattice along the plume's principal axes (Reference2D.points)
+            return self.reference(t).points()
         if self.window is not None:  # a scene's: its plume's span, whatever its source, v and window
             return self.reference(t).points(self.window)
         return self.reference(t).points(None if self.at_rest else self.fd_length)
@@ -249,8 +266,9 @@ class RunConfig:
 
     @property
     def dV(self) -> float:
-        """A particle's sampling volume dV = Omega / N (the Delta V of Eqs. 5-9; the bin width of Eq. 11)."""
-        return self.omega / self.n
+        """A particle's sampling volume dV = Omega / N (the Delta V of Eqs. 5-9; the bin width of Eq. 11);
+        in 2-D Omega^2 / N."""
+        return self.omega**self.dim / self.n
 
     @property
     def fd_dx(self) -> float:
@@ -264,7 +282,9 @@ class RunConfig:
 
     def resolved(self) -> RunConfig:
         """Fill the first step (first_step; FD with a courant: courant dx / |v|) and check every setting."""
-        if self.courant is not None:
+        if self.courant is not None and self.dim == 2:
+            cfg = replace(self, dt0=plane.courant_step(self))
+        elif self.courant is not None:
             self._check_courant()
             cfg = replace(self, dt0=self.courant * self.fd_dx / abs(self.v))
         elif self.dt0 is None:
@@ -286,14 +306,15 @@ class RunConfig:
                 f"for fd an even number of intervals >= {FD_MIN_INTERVALS}: a node at x = 0 with an interior node "
                 "either side for the 3-point stencil (with 2 its mass only drains into the zero ends)",
             )
-        for name in ("D", "t_final", "dt0", "omega", "fd_length", "fixed_kernel_time", "transfer_tolerance"):
+        scalars = ("t_final", "dt0", "omega", "fd_length", "fixed_kernel_time", "transfer_tolerance")
+        for name in scalars if self.dim == 2 else ("D", *scalars):
             check_setting(BY_NAME[name], getattr(self, name))
         if not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed <= MAX_SEED:
             raise SettingError(
                 "seed", self.seed, f"an integer in [0, 2^63 - 1 = {MAX_SEED}] (tables store it as int64)"
             )
         steps = step_count(self.t_final, self.dt0, self.dt_growth)
-        if steps > MAX_STEPS and self.courant is not None:
+        if steps > MAX_STEPS and self.courant is not None and self.dim == 1:
             self._check_courant()
             least = max_first_step(self.t_final, 1.0) * abs(self.v) / self.fd_dx
             raise SettingError(
@@ -310,6 +331,9 @@ class RunConfig:
                 f"{self.dt_growth:g}: >= {max_first_step(self.t_final, self.dt_growth):.3g} "
                 f"(this one needs {count_text(steps)})",
             )
+        if self.dim == 2:  # the plane's own checks (core/plane.py) instead of the line's below
+            plane.check(self)
+            return
         check_arithmetic(self)
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
         check_setting(BY_NAME["loop_arithmetic"], self.loop_arithmetic)
@@ -443,4 +467,5 @@ class RunConfig:
 
     def case_columns(self) -> dict:
         """The case parameters written beside every row of a result table."""
-        return {**self.case.columns(), "D": float(self.D), "seed": int(self.seed)}
+        D = float(self.D) if self.dim == 1 else float(np.linalg.eigvalsh(np.asarray(self.D))[-1])  # 2-D: D_L
+        return {**self.case.columns(), "D": D, "seed": int(self.seed)}

@@ -53,9 +53,10 @@ def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, wan
         raise ValueError("a reactive run needs its scene's reference to judge its last step")
     grid = "exact" if cfg.method == "fd" else cfg.time_grid
     dts = time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, grid)
-    runner = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd}[cfg.method]
+    runners = {"pt": _run_pt, "mtpt": _run_mtpt, "fd": _run_fd} if cfg.dim == 1 else _PLANE
+    runner = runners[cfg.method]
     warm_up(cfg)
-    size = cfg.n + 1 if cfg.method == "fd" else cfg.n
+    size = (cfg.n + 1) ** cfg.dim if cfg.method == "fd" else cfg.n
     rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
     rows = _Conservative(cfg, rec) if cfg.reaction is None else _Reactive(cfg, rec, reference, len(dts))
     state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rows)
@@ -86,6 +87,8 @@ def warm_up(cfg: RunConfig) -> None:
     """Load the compiled kernels this case calls (numba's on-disk cache, ~0.05-0.4 s once per
     process) and what its exact solution is computed with before the timed steps, so that step 0's
     and step 1's wall times are the steps' own."""
+    if cfg.dim == 2:  # the plane's steps compile their pair loops (numerics/pair_transfer) when first run
+        return
     advection = cfg.advection if cfg.v != 0.0 else None  # FD in a flow: its scheme's solver
     key = (cfg.method, cfg.kernel, cfg.scheme, cfg.transfer_method, cfg.truncation is None, advection)
     if key not in _WARM:
@@ -106,6 +109,11 @@ class _Conservative:
         self.cfg, self.rec = cfg, rec
 
     def add(self, step: int, t: float, dt: float, meas: dict) -> None:
+        if self.cfg.dim == 2:  # the plane's rows carry the exact solution's (models/plane.py); settled once
+            # the exact plume's E is wider than a cell, as t > dV^2 / (4 pi e D) is on the line
+            settled = bool(meas.get("E_analytic", 0.0) > meas["dV"])
+            self.rec.add(step=step, time=t, dt=dt, **meas, settled=settled)
+            return
         ref = self.cfg.reference(t)
         analytic = {
             "H_C_analytic": ref.h_c(meas["dV"]),
@@ -277,6 +285,60 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
         a, b = xs[0].size * m_p * one, xs[1].size * m_p * one
         rows.add(k, t, dt, a, b, made * one, made, cfg.dV, 0.0, extra)
     return {"x": np.sort(xs[0] + lo + cfg.v * t), "mass": np.full(xs[0].size, m_p)}
+
+
+def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """FD in the plane: the nodes (n + 1, n + 1) carried by fd.transport with the 2-D solver (one
+    sparse factorisation per distinct step size, models/fd2d.py), measured every step (models/plane.py)."""
+    from . import plane
+    from .fd import transport
+
+    g, c = plane.fd_start(cfg)
+    solvers: dict = {}
+    extra = {"beta": 0.0, "h": g.dx, "substeps": 1}
+    rows.add(0, 0.0, 0.0, {**plane.fd_measure(cfg, g, c, 0.0), **extra})
+    state = c[None]
+    for k, dt in enumerate(dts, start=1):
+        if dt not in solvers:
+            solvers[dt] = plane.fd_solver(cfg, g, dt)
+        transport(solvers[dt], state)
+        rows.add(k, ts[k], dt, {**plane.fd_measure(cfg, g, c, ts[k]), **extra})
+    x, y = g.nodes()
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    return {"x": gx.ravel(), "y": gy.ravel(), "c": c.ravel()}
+
+
+def _run_plane_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """MTPT in the plane: carried, walked with (1 - eta) D and exchanged with eta D each step (models/plane.py)."""
+    from . import plane
+
+    rng = cfg.rng()
+    x, m = plane.particles_start(cfg, rng)
+    start = {"beta": 0.0, "h": 0.0, "neighbours": 0.0, "substeps": 1}
+    rows.add(0, 0.0, 0.0, {**plane.mtpt_measure(cfg, x, m, 0.0, False), **start})
+    for k, dt in enumerate(dts, start=1):
+        x, m, neighbours, sub = plane.mtpt_step(cfg, x, m, dt, rng)
+        meas = plane.mtpt_measure(cfg, x, m, ts[k], k == len(dts))
+        h = math.sqrt(4.0 * cfg.eta * plane.major(cfg.D) * dt)  # the kernel's sd along D's major axis
+        rows.add(k, ts[k], dt, {**meas, "beta": 0.5, "h": h, "neighbours": neighbours, "substeps": sub})
+    return {"x": x[:, 0], "y": x[:, 1], "mass": m, "c": m / cfg.dV}
+
+
+def _run_plane_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
+    """PT in the plane: carried and walked with D each step, the kernel estimate at the last (models/plane.py)."""
+    from . import plane
+
+    rng = cfg.rng()
+    x = plane.pt_start(cfg, rng)
+    rows.add(0, 0.0, 0.0, plane.pt_measure(cfg, x, 0.0, False))
+    for k, dt in enumerate(dts, start=1):
+        x = plane.pt_step(cfg, x, dt, rng)
+        rows.add(k, ts[k], dt, plane.pt_measure(cfg, x, ts[k], k == len(dts)))
+    return {"x": x[:, 0], "y": x[:, 1], "mass": np.full(x.shape[0], 1.0 / x.shape[0])}
+
+
+# the runners of a 2-D run (RunConfig.dim): the same steps, the plane's start and measures
+_PLANE = {"fd": _run_plane_fd, "mtpt": _run_plane_mtpt, "pt": _run_plane_pt}
 
 
 def _density(cfg: RunConfig, x: np.ndarray, m_p: float, t: float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,175 @@
+"""The three models' start and measures in the plane (d = 2, issue 52), as fd.py, mtpt.py and pt.py
+give them on the line; their steps are the shared ones (models/simulate.py runs both).
+
+- FD: the n x n grid of core/plane.grid, the source's exact cell masses on it (sources2d.cell_masses),
+  each step fd.transport by models/fd2d.py's solver (backward Euler with the full tensor).
+- MTPT: N particles uniform at random on the square of side Omega around the source, each carrying
+  the source's mass in its sampling volume dV = Omega^2 / N (its density there times dV; a point's on
+  the particle nearest to it), then normalised to one; each step the walk with (1 - eta) D
+  (models/walk.py) and the exchange with eta D (numerics/particles2d.mtpt_exchange_2d).
+- PT: N particles of mass 1 / N drawn from the source, each step the walk with D; the concentration
+  is the kernel estimate with H = N^(-1/3) Sigma, Sigma the exact plume's covariance
+  (particles2d.plume_bandwidth_2d: Eq. 22 at d = 2).
+
+Measures (a row's columns as on the line): H_C = -sum p ln p of the masses (nodes, particles, or PT's
+estimate on MEASURE_GRID^2 cells over the plume), dV the cell or sampling area [L^2], H_I = H_C +
+ln dV, E = exp(H_I) [L^2] (Eq. 8), and the SSE of the concentration at the scene's 15 x 15 points
+(Reference2D.points) against the exact one [L^-4]. MTPT's SSE and PT's H_C and SSE are computed at
+the last step only (a triangulation or a kernel sum each: NaN before); FD's and MTPT's H_C at every
+step. PT's mass is its N particles' of 1 / N, 1 whatever the estimate's cells hold.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..core import measures as M
+from ..core import plane as P
+
+MEASURE_GRID = 128  # PT's estimate is summed on 128 x 128 cells over its plume, +- PT_REACH sd each axis
+PT_REACH = 5.0
+
+
+# -------------------------------------------------------------------------------------------- FD
+def fd_start(cfg):
+    """(grid, nodes (n + 1, n + 1)): the source's exact cell masses over the cell area, the ring zero."""
+    g = P.grid(cfg)
+    x, y = g.nodes()
+    c = np.zeros((g.nx + 1, g.ny + 1))
+    c[1:-1, 1:-1] = cfg.source.cell_masses(x[1:-1], y[1:-1], g.dx, g.dy) / (g.dx * g.dy)
+    return g, c
+
+
+def fd_solver(cfg, g, dt: float):
+    """The solver of one step dt on the grid's interior (models/fd2d.py)."""
+    from .fd2d import solver
+
+    return solver(np.asarray(cfg.D), np.asarray(cfg.v), g, dt, cfg.advection)
+
+
+def bilinear(g, c: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The nodal c (nx + 1, ny + 1) bilinearly interpolated at ``points`` (M, 2); 0 outside the grid."""
+    u = (points[:, 0] - g.x0) / g.dx
+    w = (points[:, 1] - g.y0) / g.dy
+    inside = (u >= 0) & (u <= g.nx) & (w >= 0) & (w <= g.ny)
+    i = np.clip(np.floor(u).astype(int), 0, g.nx - 1)
+    j = np.clip(np.floor(w).astype(int), 0, g.ny - 1)
+    a, b = u - i, w - j
+    out = (1 - a) * (1 - b) * c[i, j] + a * (1 - b) * c[i + 1, j] + (1 - a) * b * c[i, j + 1] + a * b * c[i + 1, j + 1]
+    return np.where(inside, out, 0.0)
+
+
+def fd_measure(cfg, g, c: np.ndarray, t: float) -> dict:
+    """H_C of the node masses c dx dy (Eq. 7 with dV = dx dy), E, and the SSE at the points."""
+    dV = g.dx * g.dy
+    return _row(cfg, c.ravel() * dV, dV, t, lambda points: bilinear(g, c, points))
+
+
+# ------------------------------------------------------------------------------------------ MTPT
+def particles_start(cfg, rng) -> tuple[np.ndarray, np.ndarray]:
+    """MTPT's N positions (N, 2), uniform on the square of side Omega around the source, and their
+    masses: the source's density times dV (a point's mass on the particle nearest it), summing to 1."""
+    centre = cfg.source.centre
+    x = centre + cfg.omega * (rng.random((cfg.n, 2)) - 0.5)
+    if cfg.source.kind == "point":
+        m = np.zeros(cfg.n)
+        m[int(np.argmin(np.sum((x - centre) ** 2, axis=1)))] = 1.0
+        return x, m
+    m = cfg.reference(0.0).density(x) * cfg.dV
+    total = m.sum()
+    if not total > 0:
+        raise ValueError(f"none of the {cfg.n} particles lies on the source: raise n or shrink omega")
+    return x, m / total
+
+
+def mtpt_step(cfg, x, m, dt: float, rng):
+    """Carried by v dt, walked with (1 - eta) D, exchanged with eta D -> (x, m, mean neighbours, substeps)."""
+    from ..numerics.particles2d import mtpt_exchange_2d
+    from .walk import walk
+
+    D = np.asarray(cfg.D)
+    x = x + np.asarray(cfg.v) * dt
+    if cfg.eta < 1.0:
+        x = walk(x, ((1.0 - cfg.eta) * D)[None], dt, rng)
+    done = mtpt_exchange_2d(x, m, D, cfg.eta, dt)
+    return x, done.mass, done.mean_neighbours, done.substeps
+
+
+def mtpt_measure(cfg, x, m, t: float, last: bool) -> dict:
+    """H_C of the masses (dV = Omega^2 / N), E and, at the last step, the SSE at the points (m / dV
+    on the particles' triangles, particles2d.mtpt_concentration_2d)."""
+    from ..numerics.particles2d import mtpt_concentration_2d
+
+    return _row(cfg, m, cfg.dV, t, (lambda points: mtpt_concentration_2d(points, x, m, cfg.dV)) if last else None)
+
+
+# -------------------------------------------------------------------------------------------- PT
+def pt_start(cfg, rng) -> np.ndarray:
+    """PT's N positions (N, 2) drawn from the source."""
+    return cfg.source.positions(cfg.n, rng)
+
+
+def pt_step(cfg, x, dt: float, rng) -> np.ndarray:
+    """Carried by v dt and walked with D (models/walk.py)."""
+    from .walk import walk
+
+    return walk(x + np.asarray(cfg.v) * dt, np.asarray(cfg.D)[None], dt, rng)
+
+
+def pt_bandwidth(cfg, t: float) -> np.ndarray:
+    """H = N^(-1/3) Sigma(t), the exact plume's covariance (particles2d.plume_bandwidth_2d) [L^2]."""
+    from ..numerics.particles2d import plume_bandwidth_2d
+
+    return plume_bandwidth_2d(cfg.n, cfg.reference(t).covariance)
+
+
+def pt_measure(cfg, x, t: float, last: bool) -> dict:
+    """At the last step: the kernel estimate on MEASURE_GRID^2 cells over +- PT_REACH sd of the plume
+    (H_C of its cell masses, dV the cell area) and at the points; before it only the mass."""
+    mass = {"beta": 0.0, "substeps": 1, "mass_total": 1.0, "mass_min": 1.0 / x.shape[0]}  # N particles of 1 / N
+    if not last:
+        return {**_row(cfg, np.ones(1), math.nan, t, None, entropy=False), "h": math.nan, **mass}
+    from ..numerics.particles2d import kde_2d
+
+    H = pt_bandwidth(cfg, t)
+    ref = cfg.reference(t)
+    half = PT_REACH * np.sqrt(np.diag(ref.covariance + H))
+    ticks = [np.linspace(-h, h, MEASURE_GRID) for h in half]
+    dV = float((ticks[0][1] - ticks[0][0]) * (ticks[1][1] - ticks[1][0]))
+    gx, gy = np.meshgrid(*ticks, indexing="ij")
+    cells = ref.centre + np.column_stack([gx.ravel(), gy.ravel()])
+    c = kde_2d(cells, x, H)
+    row = _row(cfg, c * dV, dV, t, lambda points: kde_2d(points, x, H))
+    return {**row, "h": math.sqrt(major(H)), **mass}
+
+
+def major(D) -> float:
+    """The largest eigenvalue of the tensor D: D_L in a flow [L^2/T]."""
+    return float(np.linalg.eigvalsh(np.asarray(D, dtype=np.float64))[-1])
+
+
+# ------------------------------------------------------------------------------------- the row
+def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool = True) -> dict:
+    """A 2-D row: H_C, H_I, E of ``masses`` on cells (or particles) of area dV, the SSE at the points of
+    ``at_points(points)`` (NaN without it), the exact solution's, the total and least mass."""
+    total = float(masses.sum())
+    h_c = M.entropy_discrete(masses / total) if entropy and total > 0 else math.nan
+    ref = cfg.reference(t)
+    row = {
+        "H_C": h_c,
+        "H_I": h_c + math.log(dV) if entropy else math.nan,
+        "E": M.dilution_index(h_c, dV) if entropy else math.nan,
+        "SSE_points": math.nan,
+        "dV": dV,
+        "mass_total": total,
+        "mass_min": float(masses.min()),
+    }
+    if at_points is not None and t > 0:
+        points = cfg.points(t)
+        row["SSE_points"] = M.sse(at_points(points), ref.density(points))
+    if t > 0 or cfg.source.kind != "point":
+        row["H_C_analytic"] = ref.h_i() - math.log(dV) if entropy else math.nan
+        row["E_analytic"] = ref.dilution()
+    return row
