@@ -312,3 +312,136 @@ def test_grid_orientation_error_at_45_degrees_against_0():
     print(f"L2 error at 45 / at 0 degrees, n = 128: {ratios}")
     assert ratios["upwind"] > 1.0, ratios
     assert 0.9 < ratios["central"] < 1.1, ratios
+
+
+# --- the fast path: matrix-free BiCGSTAB against the LU ----------------------------------------------
+
+
+def test_the_matrix_free_stencil_is_the_assembled_matrix():
+    """numerics/stencil2d's product with the interior is the sparse matrix's, to round-off, on
+    rectangular grids and on grids one node wide."""
+    from particle_entropy.numerics.compiled import kernels
+
+    d, v = _tensor(1e-3, 3e-4, 0.6), (0.7, -0.4)
+    rng = np.random.default_rng(5)
+    for shape in ((11, 9), (1, 7), (6, 1), (2, 2)):
+        for scheme in SCHEMES:
+            solver = fd2d.Solver(d, v, 0.05, 0.04, 0.02, shape, scheme, method="krylov")
+            c = rng.random(shape)
+            product = kernels().stencil_apply(fd2d._weights(solver._stencil), c)
+            assert np.abs(product.ravel() - solver.matrix @ c.ravel()).max() <= 1e-15 * solver._scale
+
+
+def test_the_krylov_step_on_narrow_grids_and_a_zero_field():
+    """Grids one or two nodes wide, where the sweeps' rows and blocks are shortest: the Krylov step
+    is the LU's to 1e-13 without a fallback; a field of zeros stays zeros in no iterations."""
+    d, v = _tensor(1e-3, 3e-4, 0.6), (0.7, -0.4)
+    rng = np.random.default_rng(8)
+    for shape in ((1, 1), (1, 7), (6, 1), (2, 3), (5, 4)):
+        for scheme in SCHEMES:
+            fast = fd2d.Solver(d, v, 0.05, 0.04, 0.02, shape, scheme, method="krylov")
+            lu = fd2d.Solver(d, v, 0.05, 0.04, 0.02, shape, scheme, method="lu")
+            c = rng.random(shape)
+            exact = lu.solve(c)
+            assert np.abs(fast.solve(c) - exact).max() <= 1e-13 * np.abs(exact).max(), (shape, scheme)
+            assert fast.fallbacks == 0
+            assert not fast.solve(np.zeros(shape)).any() and fast.iterations == 0
+
+
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_the_krylov_step_is_the_lu_step_at_45_degrees_with_a_full_tensor(scheme):
+    """A Gaussian carried at 45 degrees (D_L = 4 D_T, so Dxy = 1.5 D_T) through the corner, 60 steps
+    by both paths from the same start: each step's Krylov solution is the LU's to 1e-12 of the
+    field's largest value (measured: 1.1e-13 upwind, 2.0e-13 central, 1.7e-13 tvd), without a
+    fallback, and every Krylov step balances its mass (check_balance inside the step, and the
+    summed outflow overall)."""
+    n, dt = 48, 0.01
+    grid = fd2d.Grid(0.0, 0.0, 1.0 / n, 1.0 / n, n, n)
+    x, y = grid.interior()
+    d = _tensor(2e-3, 5e-4, math.pi / 4)
+    v = 0.9 * _rotation(math.pi / 4)[:, 0]
+    fast, lu = fd2d.solver(d, v, grid, dt, scheme, "krylov"), fd2d.solver(d, v, grid, dt, scheme, "lu")
+    c = _gaussian(x, y, (0.6, 0.6), 0.01 * np.eye(2))
+    start, left, worst = c.sum(), 0.0, 0.0
+    for _ in range(60):
+        exact = lu.solve(c)
+        c = fast.solve(c)
+        worst = max(worst, float(np.abs(c - exact).max() / np.abs(exact).max()))
+        assert fast.iterations > 0 and fast.method == "krylov"
+        left += fast.last.outflow
+        c = exact  # both paths step from the same field
+    print(f"{scheme}: largest Krylov - LU difference {worst:.2e} of the field's largest value")
+    assert worst <= 1e-12
+    assert fast.fallbacks == 0 and fast._lu is None  # never factorised
+    assert c.sum() < 0.5 * start
+    fast2 = fd2d.solver(d, v, grid, dt, scheme, "krylov")
+    c2, left2 = _gaussian(x, y, (0.6, 0.6), 0.01 * np.eye(2)), 0.0
+    for _ in range(60):
+        c2 = fast2.solve(c2)
+        left2 += fast2.last.outflow
+    assert start - c2.sum() == pytest.approx(left2, rel=1e-12)
+    assert np.abs(c2 - c).max() <= 1e-11 * np.abs(c).max()  # 60 Krylov steps in a row: the LU's run
+
+
+def test_a_krylov_solve_that_does_not_converge_falls_back_to_the_lu():
+    """A cap of one iteration, below what the 1e-13 residual needs: the step takes the LU instead
+    (its solution bit for bit), and so does every later step; counted in ``fallbacks``."""
+    grid = fd2d.Grid(0.0, 0.0, 0.02, 0.02, 50, 50)
+    x, y = grid.interior()
+    d, v = _tensor(1e-3, 2e-4, 0.5), (0.5, 0.3)
+    capped = fd2d.solver(d, v, grid, 0.01, "central", "krylov", max_iterations=1)
+    lu = fd2d.solver(d, v, grid, 0.01, "central", "lu")
+    c = _gaussian(x, y, (0.5, 0.5), 0.01 * np.eye(2))
+    assert capped._lu is None
+    first = capped.solve(c)
+    assert capped.fallbacks == 1 and capped.method == "lu" and capped._lu is not None
+    assert np.array_equal(first, lu.solve(c))
+    assert np.array_equal(capped.solve(first), lu.solve(first)) and capped.fallbacks == 1
+
+
+def test_a_krylov_solution_that_does_not_balance_falls_back_to_the_lu(monkeypatch):
+    """A Krylov answer off by 1e-6 at one node (1e-7 of the largest value), as if its residual had
+    passed, fails the mass balance: the step takes the LU's, never the wrong answer."""
+    grid = fd2d.Grid(0.0, 0.0, 0.02, 0.02, 50, 50)
+    x, y = grid.interior()
+    d, v = _tensor(1e-3, 2e-4, 0.5), (0.5, 0.3)
+    fast, lu = fd2d.solver(d, v, grid, 0.01, "upwind", "krylov"), fd2d.solver(d, v, grid, 0.01, "upwind", "lu")
+    honest = fast._krylov
+
+    def off(c):
+        out = honest(c)
+        out[24, 24] += 1e-6
+        return out
+
+    monkeypatch.setattr(fast, "_krylov", off)
+    c = _gaussian(x, y, (0.5, 0.5), 0.01 * np.eye(2))
+    assert np.array_equal(fast.solve(c), lu.solve(c)) and fast.fallbacks == 1
+
+
+@pytest.mark.parametrize("r", [0.1, 10.0, 1e3])
+def test_the_krylov_step_at_large_dispersion_numbers_is_the_lu_step_or_falls_back(r):
+    """dt D / dx^2 from 0.1 to 1e3 (Courant 0.5, a full tensor, 80 x 80 nodes): the Krylov step,
+    converged or fallen back to the LU, is the LU's step to 1e-12 of its largest value."""
+    n = 80
+    grid = fd2d.Grid(0.0, 0.0, 1.0 / n, 1.0 / n, n, n)
+    x, y = grid.interior()
+    d0 = 1e-3
+    dt = r * grid.dx**2 / d0
+    speed = 0.5 * grid.dx / dt / math.cos(math.pi / 6)  # Courant 0.5 along x
+    v, d = speed * _rotation(math.pi / 6)[:, 0], _tensor(d0, 0.25 * d0, math.pi / 6)
+    c = _gaussian(x, y, (0.5, 0.5), 0.01 * np.eye(2))
+    for scheme in SCHEMES:
+        fast, lu = fd2d.solver(d, v, grid, dt, scheme, "krylov"), fd2d.solver(d, v, grid, dt, scheme, "lu")
+        out, exact = fast.solve(c), lu.solve(c)
+        print(f"r {r:g} {scheme}: {fast.iterations} iterations, fallbacks {fast.fallbacks}")
+        assert np.abs(out - exact).max() <= 1e-12 * np.abs(exact).max()
+
+
+def test_auto_takes_the_lu_on_small_grids_and_the_krylov_solve_on_large():
+    assert fd2d.choose_method("auto", (255, 255)) == "lu"  # 65,025 unknowns
+    assert fd2d.choose_method("auto", (256, 256)) == "krylov"  # 65,536
+    assert fd2d.choose_method("lu", (1023, 1023)) == "lu" and fd2d.choose_method("krylov", (3, 3)) == "krylov"
+    with pytest.raises(ValueError, match="solve method"):
+        fd2d.choose_method("amg", (9, 9))
+    small = fd2d.Solver(np.eye(2) * 1e-3, (0.5, 0.3), 0.02, 0.02, 0.01, (49, 49), "upwind")
+    assert small.method == "lu" and small._lu is not None

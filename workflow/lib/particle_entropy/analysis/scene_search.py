@@ -29,8 +29,8 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..core import plane
 from ..core.io import read_parquet
-from ..core.registry import MEASUREMENT_POINTS
 from ..scenes import defined
 from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene
 from .resampling import CONFIDENCE
@@ -107,13 +107,13 @@ RESULT_COLUMN_DOCS = {  # result(): one row per visited (candidate, n) of a fini
 def error(scene: Scene, row: pd.Series | dict) -> float:
     """The scene's error measure of one run at t_final (its last row)."""
     if scene.measure == "rmse":
-        return math.sqrt(row["SSE_points"] / MEASUREMENT_POINTS)
+        return math.sqrt(row["SSE_points"] / scene.n_points)
     if scene.measure == "entropy":
         return abs(row["H_C"] - row["H_C_analytic"])
     if scene.measure == "product":  # a reactive scene's product mass against its reference
         return row["product_error"]
     if scene.measure == "product_rmse":  # and its product's concentration at the points
-        return math.sqrt(row["SSE_points_C"] / MEASUREMENT_POINTS)
+        return math.sqrt(row["SSE_points_C"] / scene.n_points)
     return abs(row["E"] / row["E_analytic"] - 1.0)
 
 
@@ -128,9 +128,13 @@ def unscored(scene: Scene, row) -> str:
             f"negative concentrations from step {int(row['negative_step']):,} (t = {row['negative_t']:.4g}): "
             f"minimum {row['mass_min']:.3g} of the total"
         )
-        if scene.candidates[int(row["candidate"])].case.method == "fd" and scene.v != 0.0:
-            dx = row["dV"]
-            peclet, courant = abs(scene.v) * dx / scene.D, abs(scene.v) * row["negative_dt"] / dx
+        if scene.candidates[int(row["candidate"])].case.method == "fd" and scene.speed != 0.0:
+            if scene.dim == 2:
+                cfg = scene.run_config(scene.candidates[int(row["candidate"])], int(row["n"]))
+                peclet, courant = plane.grid_numbers(cfg, row["negative_dt"])
+            else:
+                dx = row["dV"]
+                peclet, courant = abs(scene.v) * dx / scene.D, abs(scene.v) * row["negative_dt"] / dx
             why += f"; grid Peclet {peclet:.3g}{' > 2' if peclet > 2 else ''}, Courant {courant:.3g}"
         return why
     for name, lost in conserved_losses(row).items():
@@ -632,9 +636,11 @@ FAMILIES = {"fd": "grid (best FD)", "pt": "particles (best PT or MTPT)", "mtpt":
 def grid_numbers(scene: Scene, candidate: Candidate, n: int) -> tuple[float, float]:
     """(grid Peclet |v| dx / D, Courant |v| dt / dx) of an FD candidate's rung n in a flow; NaN, NaN for
     particles and at rest."""
-    if candidate.case.method != "fd" or scene.v == 0.0:
+    if candidate.case.method != "fd" or scene.speed == 0.0:
         return math.nan, math.nan
     cfg = scene.run_config(candidate, n)
+    if scene.dim == 2:  # along the axis where each is largest (core/plane.grid_numbers)
+        return plane.grid_numbers(cfg, cfg.dt0)
     return abs(scene.v) * cfg.fd_dx / scene.D, cfg.courant_number()
 
 

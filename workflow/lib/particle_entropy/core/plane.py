@@ -25,11 +25,18 @@ from .sources2d import Source2D
 KERNELS = {"fd": ("implicit",), "mtpt": ("collision",), "pt": ("adaptive",)}
 # The memory an FD rung may take at most [bytes], estimated as FD_BYTES_PER_NODE a node: the sparse LU's
 # factors and the matrix (benchmarks/fd2d_step.py: 1.8 GB at 1,025^2 nodes, about 1,700 bytes a node).
+# Grids of 2^16 unknowns and more take BiCGSTAB instead (about 260 MB there), but fall back to that LU
+# where it does not converge: the bound keeps room for it.
 FD_BYTES_PER_NODE = 1_700
 FD_MAX_BYTES = 4 * 2**30
 # The plume's reach each side of the source that a window must hold, in standard deviations of 2 D t_final
 # along each axis: the 1-D scenes' 3 sqrt(4 D t) = 3 sqrt(2) sd (settings.SCENE_REACH).
 REACH_SDS = 3.0 * math.sqrt(2.0)
+
+
+def major(D) -> float:
+    """The largest eigenvalue of the tensor D: D_L in a flow [L^2/T]."""
+    return float(np.linalg.eigvalsh(np.asarray(D, dtype=np.float64))[-1])
 
 
 def is_plane(source) -> bool:
@@ -129,14 +136,23 @@ def check_fd_memory(n: int, where: str = "n") -> None:
         )
 
 
-def grid(cfg):
-    """The FD grid of a 2-D run (models/fd2d.Grid): n x n over the square window fd_length around the
-    source's centre, lengthened by the path v t_final."""
-    from ..models.fd2d import Grid
+def grid_span(cfg) -> tuple[np.ndarray, np.ndarray]:
+    """(first node (2,), spacing (dx, dy)) of a 2-D run's n x n FD grid: the square window fd_length
+    around the source's centre lengthened along each axis by the path v t_final (as the line's
+    fd_span), then shifted by less than half a cell so that the source's centre is a node, as on the
+    line (a point's mass then sits on one node, whatever n) [L]."""
+    centre = np.asarray(cfg.source.centre, dtype=np.float64)
+    path = np.asarray(cfg.v, dtype=np.float64) * cfg.t_final
+    lo = centre - 0.5 * cfg.fd_length + np.minimum(path, 0.0)
+    h = (cfg.fd_length + np.abs(path)) / cfg.n
+    return centre - np.round((centre - lo) / h) * h, h
 
-    centre = cfg.source.centre
-    half = 0.5 * cfg.fd_length
-    return Grid.over(centre - half, centre + half, cfg.n, np.asarray(cfg.v) * cfg.t_final)
+
+def grid_numbers(cfg, dt: float) -> tuple[float, float]:
+    """(grid Peclet max_i |v_i| dx_i / D_ii, Courant max_i |v_i| dt / dx_i) of a 2-D FD run at step dt."""
+    _, h = grid_span(cfg)
+    v, D = np.abs(np.asarray(cfg.v, dtype=np.float64)), np.diag(np.asarray(cfg.D, dtype=np.float64))
+    return float(np.max(v * h / D)), float(np.max(v * dt / h))
 
 
 def courant_step(cfg) -> float:
@@ -145,8 +161,8 @@ def courant_step(cfg) -> float:
     ok = isinstance(cfg.courant, (int, float)) and not isinstance(cfg.courant, bool)
     if not (ok and 0.0 < cfg.courant < math.inf) or cfg.method != "fd":
         raise SettingError("courant", cfg.courant, "a number > 0 for fd in a flow: the step's Courant number")
-    g = grid(cfg)
-    rate = max(abs(cfg.v[0]) / g.dx, abs(cfg.v[1]) / g.dy)
+    _, (dx, dy) = grid_span(cfg)
+    rate = max(abs(cfg.v[0]) / dx, abs(cfg.v[1]) / dy)
     if not rate > 0:
         raise SettingError("courant", cfg.courant, "no courant at v = 0: fd in a flow only")
     return cfg.courant / rate
@@ -159,8 +175,8 @@ def _check_courant(cfg) -> None:
     limit = COURANT_LIMIT.get(cfg.advection)
     if limit is None or not any(cfg.v):
         return
-    g = grid(cfg)
-    cr = max(abs(cfg.v[0]) * cfg.dt0 / g.dx, abs(cfg.v[1]) * cfg.dt0 / g.dy)
+    _, (dx, dy) = grid_span(cfg)
+    cr = max(abs(cfg.v[0]) * cfg.dt0 / dx, abs(cfg.v[1]) * cfg.dt0 / dy)
     if cr <= limit * (1.0 + 1e-12):
         return
     name, value = ("courant", cfg.courant) if cfg.courant is not None else ("fd_dt", cfg.dt0)

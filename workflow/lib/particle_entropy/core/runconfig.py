@@ -467,5 +467,5 @@ class RunConfig:
 
     def case_columns(self) -> dict:
         """The case parameters written beside every row of a result table."""
-        D = float(self.D) if self.dim == 1 else float(np.linalg.eigvalsh(np.asarray(self.D))[-1])  # 2-D: D_L
+        D = float(self.D) if self.dim == 1 else plane.major(self.D)  # 2-D: D_L
         return {**self.case.columns(), "D": D, "seed": int(self.seed)}

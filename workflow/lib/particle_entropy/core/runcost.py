@@ -60,10 +60,10 @@ def run_steps(cfg: RunConfig) -> np.ndarray:
 
 def units_per_step(cfg: RunConfig, per: str = "work") -> int:
     """The units one step advances: ``per="work"`` as a run table's `work` counts them (N particles,
-    FD's N + 1 nodes); ``per="n"`` the case's N."""
+    FD's (N + 1)^d nodes); ``per="n"`` the case's N."""
     if per not in UNITS:
         raise ValueError(f"per={per!r}: one of {', '.join(UNITS)}")
-    return cfg.n + 1 if per == "work" and cfg.method == "fd" else cfg.n
+    return (cfg.n + 1) ** cfg.dim if per == "work" and cfg.method == "fd" else cfg.n
 
 
 PairCount = Callable[[RunConfig, np.ndarray, np.ndarray], np.ndarray]  # (cfg, dt, step end times) -> pairs a step

@@ -48,6 +48,7 @@ from .run_settings import (  # noqa: F401  (re-exported: the run settings, decla
 )
 from .shear_settings import SHEAR, SHEAR_MAX_N  # noqa: F401  (re-exported)
 from .sources import source_forms, source_ranges, source_shape
+from .sources2d import pair_shape, source_forms_2d, with_pairs
 
 MAX_REALISATIONS = 10_000  # realisations of one case or N: more is a typo, not an ensemble
 MAX_N = 10**9  # particles of one 1-D run: 2,500 x the paper's largest, ~400 GB for mass transfer; more is a typo
@@ -492,7 +493,15 @@ SCENE_MEASURES = ("rmse", "entropy", "dilution", "product", "product_rmse")
 # a scene is judged at t_final, so its runs take the exact time grid, whose last step ends there:
 # the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
-SOURCE_SHAPE = source_shape()  # the kinds of core/sources.py
+SOURCE_SHAPE = with_pairs(source_shape())  # the kinds of core/sources.py and core/sources2d.py
+# a 2-D scene's dispersion (core/sources2d.dispersion_tensor): along and across the flow, or along the axes
+DISPERSION_2D_SHAPE = {
+    "type": "object",
+    "x-model": "Dispersion",  # core/typed.py's, with the rule: both of L, T or both of x, y
+    "additionalProperties": False,
+    "properties": {k: {"type": "number", "exclusiveMinimum": 0} for k in ("L", "T", "x", "y")},
+    "oneOf": [{"required": ["L", "T"]}, {"required": ["x", "y"]}],
+}
 CANDIDATE_SHAPE = {
     "type": "array",
     "minItems": 1,
@@ -556,14 +565,33 @@ CANDIDATE_SHAPE = {
 SCENE_REACH = 3.0
 SCENE_MIN_MARGIN = SCENE_REACH * math.sqrt(2.0)  # the same in the margin's unit sqrt(2 D t_final): 4.24
 SCENE = (
-    Setting("D", "scenes.<name>.D", 1e-3, "dispersion coefficient", "L^2/T", 0.0, open_low=True),
-    Setting("v", "scenes.<name>.v", 0.0, "uniform velocity", "L/T", -math.inf, range_text="a finite number"),
+    Setting(
+        "D",
+        "scenes.<name>.D",
+        1e-3,
+        "dispersion coefficient; in 2-D the tensor {L: D_L, T: D_T} along and across the flow (D = D_T I + "
+        "(D_L - D_T) v v^T / |v|^2), or {x: Dx, y: Dy} along the axes (at v = 0 this one)",
+        "L^2/T",
+        kind="shape",
+        shape={"oneOf": [{"type": "number", "exclusiveMinimum": 0}, DISPERSION_2D_SHAPE]},
+        range_text="a number > 0 (1-D), or {L, T} or {x, y}, each a number > 0 (2-D)",
+    ),
+    Setting(
+        "v",
+        "scenes.<name>.v",
+        0.0,
+        "uniform velocity; [vx, vy] in 2-D",
+        "L/T",
+        kind="shape",
+        shape={"oneOf": [{"type": "number"}, pair_shape()]},
+        range_text="a finite number (1-D) or a pair [vx, vy] of finite numbers (2-D)",
+    ),
     Setting("t_final", "scenes.<name>.t_final", 1000.0, "observation time", "T", 0.0, open_low=True),
     Setting(
         "source",
         "scenes.<name>.source",
         {"kind": "point", "x0": 0.0},
-        f"the initial plume, unit mass: {source_forms()}",
+        f"the initial plume, unit mass: {source_forms()}; in 2-D the same with pairs: {source_forms_2d()}",
         kind="shape",
         shape=SOURCE_SHAPE,
         range_text=source_ranges(),
@@ -693,6 +721,10 @@ SCENE = (
 # run beside its conservative run, CPU seconds, AMD EPYC, 2 vCPU, 2026-12-04, at 9049350: `python
 # benchmarks/reactive_cost.py`. Factors, not seconds, so a scene's own `cost` carries over.
 REACTIVE_COST = {"fd": (1.08, 1.45), "mtpt": (0.902, 1.58), "pt": (0.474, 2.64)}
+# A 2-D scene's default cost model, per method [seconds a step, seconds a unit of work]: work is FD's
+# (n + 1)^2 node-steps and the particles' N particle-steps (core/runcost.units_per_step). Fitted by
+# benchmarks/plane_cost.py to 2-D runs (the machine and commit in its output).
+PLANE_COST = {"fd": (1.0e-3, 2.0e-7), "mtpt": (1.0e-3, 2.0e-5), "pt": (1.0e-3, 2.0e-7)}
 
 
 SCENES_PECLET = (

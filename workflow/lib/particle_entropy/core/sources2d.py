@@ -16,7 +16,6 @@ from dataclasses import dataclass, fields
 from typing import ClassVar
 
 import numpy as np
-from scipy.special import ndtr
 
 from .sources import SourceError
 
@@ -52,6 +51,8 @@ def dispersion_tensor(v, D: Mapping) -> np.ndarray:
 def normal_mass(lo, hi):
     """Phi(hi) - Phi(lo) for standard-normal bounds lo <= hi, from the nearer tail: no cancellation
     where both bounds lie far out on one side."""
+    from scipy.special import ndtr  # imported when used: a job that runs no 2-D source never loads scipy
+
     lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
     right = lo > 0  # both bounds in the right tail: Phi(-lo) - Phi(-hi)
     return ndtr(np.where(right, -lo, hi)) - ndtr(np.where(right, -hi, lo))
@@ -236,3 +237,35 @@ class Box2D(Source2D):
 
 # The kinds, each once.
 SOURCES2D: dict[str, type[Source2D]] = {cls.KIND: cls for cls in (Point2D, Gaussian2D, Box2D)}
+
+
+def pair_shape(**bounds) -> dict:
+    """The JSON schema of a pair [u, w] of numbers (``bounds`` on each: exclusiveMinimum, ...)."""
+    return {"type": "array", "items": {"type": "number", **bounds}, "minItems": 2, "maxItems": 2}
+
+
+def with_pairs(shape: dict) -> dict:
+    """A source's JSON schema (core/sources.source_shape) that also takes the 2-D kinds: their pair
+    keys, a key both take being a number or a pair."""
+    properties = {k: dict(v) for k, v in shape["properties"].items()}
+    properties["kind"] = {"type": "string", "enum": list(dict.fromkeys([*properties["kind"]["enum"], *SOURCES2D]))}
+    for cls in SOURCES2D.values():
+        for f in fields(cls):
+            pair = pair_shape(**({"exclusiveMinimum": 0} if f.name == "sd" else {}))
+            one = properties.get(f.name)
+            if one is None:
+                properties[f.name] = pair
+            elif "oneOf" not in one:
+                properties[f.name] = {"oneOf": [one, pair]}
+    return {**shape, "properties": properties}
+
+
+_PAIR_WORDS = {"x0": "x0, y0", "sd": "sx, sy", "x": "a, b", "y": "c, d"}  # how the docs write each pair
+
+
+def source_forms_2d() -> str:
+    """'{kind: point, x0: [x0, y0]}, ...': what a 2-D scene's config writes for each kind."""
+    return ", ".join(
+        f"{{kind: {k}, {', '.join(f'{f.name}: [{_PAIR_WORDS[f.name]}]' for f in fields(cls))}}}"
+        for k, cls in SOURCES2D.items()
+    )

@@ -22,6 +22,7 @@ from __future__ import annotations
 import difflib
 import functools
 import math
+import operator
 import re
 import types
 import typing
@@ -116,6 +117,8 @@ def annotation(fragment: dict, defs: dict | None = None):
     if "$ref" in fragment:
         return (defs or shared().defs)[fragment["$ref"].rsplit("/", 1)[1]]
     kind = fragment.get("type")
+    if kind is None and "oneOf" in fragment:  # one of several shapes (a number or a pair: 1-D or 2-D)
+        return functools.reduce(operator.or_, (annotation(f, defs) for f in fragment["oneOf"]))
     if "enum" in fragment:
         return Literal[tuple(fragment["enum"])]
     if kind in ("number", "integer"):
@@ -381,6 +384,14 @@ def setting_error(error: ValidationError, config: Mapping, model) -> SettingErro
     first = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a typo before its missing key
     kind, ctx = first["type"], first.get("ctx", {})
     path, value, info, _ = _located(first["loc"], config, model, missing=kind == "missing")
+    deeper = [
+        e for e in errors if len(p := _located(e["loc"], config, model)[0]) > len(path) and p[: len(path)] == path
+    ]
+    if deeper and kind.endswith("_type"):  # a union's value of another member's type (a pair, a mapping where
+        # a number is one member): that member's refusal names the key or item within it
+        first = max(deeper, key=lambda e: len(_located(e["loc"], config, model)[0]))
+        kind, ctx = first["type"], first.get("ctx", {})
+        path, value, info, _ = _located(first["loc"], config, model, missing=kind == "missing")
     same = [e for e in errors if _located(e["loc"], config, model)[0] == path]
     if len(same) > 1 and kind not in ("missing", "extra_forbidden"):  # each member of a union refused it:
         # a member of its type names the bound it breaks, else none is of its type
@@ -605,8 +616,33 @@ class _SpeciesB(OneOf):
         return self
 
 
+class _Dispersion(OneOf):
+    """A 2-D scene's dispersion: {L, T} along and across the flow, or {x, y} along the axes."""
+
+    # the schema's spelling of the rule below
+    model_config = ConfigDict(json_schema_extra={"oneOf": [{"required": ["L", "T"]}, {"required": ["x", "y"]}]})
+
+    @model_validator(mode="after")
+    def _exactly_one(self):
+        given = self.model_fields_set
+        for pair in (("L", "T"), ("x", "y")):
+            other = [k for k in ("L", "T", "x", "y") if k not in pair and k in given]
+            if any(k in given for k in pair):
+                if other:
+                    raise refuse(other[0], f"absent with {pair[0]}: D is {{L, T}} or {{x, y}}, not both")
+                for k in pair:
+                    if k not in given:
+                        raise refuse(k, f"a number > 0 with {pair[0] if k == pair[1] else pair[1]} [L^2/T]")
+                return self
+        raise PydanticCustomError("one_of", "exactly one of {keys}", {"keys": "{L, T}, {x, y}"})
+
+    def tensor_spec(self) -> dict:
+        """The keys written: {L, T} or {x, y} (core/sources2d.dispersion_tensor reads them)."""
+        return self.model_dump(exclude_unset=True)
+
+
 # the models of structured values whose rules their owner states
-_OWNED = {"Candidate": _Candidate, "Reaction": _Reaction, "SpeciesB": _SpeciesB}
+_OWNED = {"Candidate": _Candidate, "Reaction": _Reaction, "SpeciesB": _SpeciesB, "Dispersion": _Dispersion}
 
 
 def keys_in(prefix: str, settings) -> tuple:

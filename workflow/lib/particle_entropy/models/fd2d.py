@@ -9,17 +9,47 @@ or Leonard's explicit ULTIMATE-QUICKEST (tvd), split by direction, x then y, eac
 then the dispersion solve (Lie splitting, as fd.TVDSolver; the two directions' shifts commute, so
 splitting them costs no order), at a Courant number max(|vx| dt / dx, |vy| dt / dy) <= 1.
 
-The implicit step is one sparse LU (SuperLU, scipy.sparse.linalg.splu, minimum-degree ordering of
-A^T + A: the matrix's pattern is symmetric, and that ordering fills half what COLAMD does), built once
-per step size and reused every step, not ADI. ADI splits the operator into x and y sweeps; the cross
-term fits neither, so ADI schemes with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer)
-take it explicitly, which bounds the step by the cross term's stability and makes the step no longer
-the backward-Euler step whose mass balance fd.py checks. The LU gives that exact step for any tensor
-and flow, unconditionally stable; its price is memory and time at large n. benchmarks/fd2d_step.py
-measures both; at 1,024 x 1,024 nodes (measured at commit c63f787, one core of an "Intel(R) Xeon(R)
-Processor", others' jobs running) 15-20 s to factorise, 1.8 GB peak and 0.22-0.33 s a step: the
-triangular solves read about 10^8 factor entries, so no direct solve meets the 60 ms target there; an
-O(N) step would (ADI with the cross term explicit, or multigrid-preconditioned Krylov).
+The implicit step solves the backward-Euler system A c' = c, A = I + dt (v . grad_h - div_h D grad_h),
+by one of two solves of the same system (Solver's ``method``):
+
+- "lu": one sparse LU (SuperLU, scipy.sparse.linalg.splu, minimum-degree ordering of A^T + A: the
+  matrix's pattern is symmetric, and that ordering fills half what COLAMD does), built once per step
+  size and reused every step. Exact for any tensor and flow; its price is memory and time at large n:
+  the triangular solves read about 10^8 factor entries at 1,024^2 nodes.
+- "krylov": BiCGSTAB (numerics/stencil2d.py, compiled) on the constant 9-point stencil, matrix-free,
+  right-preconditioned by a symmetric Gauss-Seidel sweep, iterated until the true relative residual
+  ||c - A c'|| / ||c|| is at most RTOL = 1e-13: O(N) a step, no factorisation, eight vectors of
+  scratch. A is the identity plus dt times the operator, diagonally dominant at a Courant-limited
+  step's dt D / dx^2, so it takes 2-4 iterations there; more as dt D / dx^2 grows (measured on
+  512^2 nodes at Courant 0.1-1, every scheme: 2-7 at dt D_L / dx^2 = 0.1, 4-5 at 1, 13-15 at 10,
+  52-59 at 100, none within 400 at 1e3). A solve not within RTOL in MAX_ITERATIONS = 40, or whose
+  answer fails the mass balance, is replaced by the LU's (factorised then), for that step and every
+  later one (``fallbacks`` counts them): the step is never other than the LU's to round-off. Measured
+  against the LU (tests): at most 2e-13 of the field's largest value.
+- "auto" (the default): the LU below KRYLOV_FROM_UNKNOWNS = 2^16 interior unknowns, i.e. up to
+  256 x 256 nodes, the Krylov solve from there. The measured crossover is lower (a step of either
+  takes 0.1-0.5 ms at 64^2 nodes, central's the same; from 128^2 the Krylov step is 1.5-3x faster),
+  but below 2^16 the LU costs at most about 0.6 s and 230 MB, and every grid of tests/test_fd2d.py
+  (and each number measured there) keeps its LU's bits.
+
+Not ADI: ADI splits the operator into x and y sweeps; the cross term fits neither, so ADI schemes
+with a mixed derivative (Douglas, Craig-Sneyd, Hundsdorfer-Verwer) take it explicitly, which bounds
+the step by the cross term's stability and makes the step no longer the backward-Euler step whose
+mass balance fd.py checks. benchmarks/fd2d_step.py measures both solves, at commits f1d6810 and
+dbef296 (the same solve) on one core of an "Intel(R) Xeon(R) Processor" (lscpu's name), with others'
+jobs running (load average 3.5-7 on its 2 CPUs): CPU ms a step (Krylov iterations) for upwind /
+central / tvd, tvd's explicit advection included, the range over the two runs:
+
+    nodes      LU: factorise, peak     LU ms a step          Krylov: peak   Krylov ms a step
+    256^2      0.3-0.6 s, 154-232 MB   7.5-11 / 9 / 11       169-172 MB     1.8 (2) / 3.0-3.2 (4) / 2.7-2.9 (2)
+    512^2      2.2-3.9 s, 458-465 MB   49 / 48-49 / 54-57    188-196 MB     8.2 (2) / 11-12 (3) / 15 (2)
+    1024^2     17-25 s, 1.8 GB         222 / 215-224 / 239-241  257-286 MB     40-43 (2) / 57-62 (3) / 57-59 (2)
+
+so at 1,024^2 the Krylov step takes a quarter of the LU's CPU time, with no factorisation and a
+seventh of its memory: upwind meets the 60 ms target, central and tvd are at it (tvd's line-by-line
+advection took 28-32 ms of wall time of its step). Wall times there were longer on the loaded machine:
+Krylov 43-66 / 83-85 / 83-85 ms, LU 303-362 ms; an earlier run at load 3.3-4.5 (commit f8c539f,
+before the sweeps took four nodes a block) gave 49 / 62 / 63 ms against the LU's 218-241 ms.
 
 Every step balances its mass as in 1-D (fd.check_balance): the interior's mass falls by the flux into
 the zero boundary ring, computed from the stencil's entries that reach the ring (not from the
@@ -32,13 +62,22 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..core.runconfig import COURANT_SLACK
+from ..numerics.compiled import kernels
 from . import fd
+from .conservation import MassError
 
 SCHEMES = ("upwind", "central", "tvd")
+METHODS = ("auto", "lu", "krylov")
+# "auto" takes the LU below this many interior unknowns (255 x 255 nodes and fewer: every grid of
+# tests/test_fd2d.py, bit for bit as before), the Krylov solve from it on
+KRYLOV_FROM_UNKNOWNS = 2**16
+RTOL = 1e-13  # the Krylov solve's true relative residual ||c - A c'|| / ||c||
+MAX_ITERATIONS = 40  # BiCGSTAB iterations before the step falls back to the LU
 
 
 def courant_number(v, dx: float, dy: float, dt: float) -> float:
@@ -131,6 +170,24 @@ def _matrix(stencil: dict[tuple[int, int], float], mx: int, my: int):
     return a.tocsc()
 
 
+def _weights(stencil: dict[tuple[int, int], float]) -> np.ndarray:
+    """The step matrix's stencil as a (3, 3) array w[di + 1, dj + 1], the identity included [-]."""
+    w = np.zeros((3, 3))
+    w[1, 1] = 1.0
+    for (di, dj), s in stencil.items():
+        w[di + 1, dj + 1] += s
+    return w
+
+
+def choose_method(method: str, shape: tuple[int, int]) -> str:
+    """ "lu" or "krylov": ``method`` itself, or for "auto" the LU below KRYLOV_FROM_UNKNOWNS unknowns."""
+    if method not in METHODS:
+        raise ValueError(f"solve method {method!r}: one of {', '.join(METHODS)}")
+    if method != "auto":
+        return method
+    return "lu" if shape[0] * shape[1] < KRYLOV_FROM_UNKNOWNS else "krylov"
+
+
 def _ring_weights(stencil: dict[tuple[int, int], float], mx: int, my: int) -> np.ndarray:
     """w (mx, my): the mass per cell area that a unit value at an interior node sends into the ring
     in one step, by the stencil's entries on the ring's nodes (those the interior matrix drops).
@@ -160,9 +217,19 @@ class Solver:
     backward Euler (I + dt (v . grad_h - div_h D grad_h)) c' = c with upwind or central advection
     in the matrix, or (tvd) fd.advect_tvd along x then along y, then the dispersion solve."""
 
-    def __init__(self, D, v, dx: float, dy: float, dt: float, shape: tuple[int, int], scheme: str):
-        from scipy.sparse.linalg import splu
-
+    def __init__(
+        self,
+        D,
+        v,
+        dx: float,
+        dy: float,
+        dt: float,
+        shape: tuple[int, int],
+        scheme: str,
+        method: str = "auto",
+        rtol: float = RTOL,
+        max_iterations: int = MAX_ITERATIONS,
+    ):
         self.D, self.v = np.array(D, dtype=float), np.array(v, dtype=float)
         self.dx, self.dy, self.dt, self.shape, self.scheme = float(dx), float(dy), float(dt), tuple(shape), scheme
         self.courant = courant_number(self.v, self.dx, self.dy, self.dt)
@@ -170,14 +237,63 @@ class Solver:
             raise ValueError(f"tvd advection at courant number {self.courant:.17g}: at most 1")
         # the Courant number along each axis, within round-off of 1 taken as 1 (fd.TVDSolver's rule)
         self.p = tuple(max(-1.0, min(1.0, self.v[a] * self.dt / h)) for a, h in ((0, self.dx), (1, self.dy)))
-        stencil = _operator(self.D, self.v, self.dx, self.dy, self.dt, scheme)
-        self.matrix = _matrix(stencil, *self.shape)
-        self._ring = _ring_weights(stencil, *self.shape)
-        self._scale = 1.0 + sum(abs(w) for w in stencil.values())  # the matrix's largest row sum
+        self._stencil = _operator(self.D, self.v, self.dx, self.dy, self.dt, scheme)
+        self._ring = _ring_weights(self._stencil, *self.shape)
+        self._scale = 1.0 + sum(abs(w) for w in self._stencil.values())  # the matrix's largest row sum
+        self.method = choose_method(method, self.shape)
+        self.rtol, self.max_iterations = float(rtol), int(max_iterations)
+        self.factorisation_seconds, self.setup_seconds = 0.0, 0.0  # wall times, for benchmarks
+        self._lu = None
+        start = time.perf_counter()
+        if self.method == "lu":
+            self._factorise()
+        else:
+            self._w = _weights(self._stencil)
+            self._work = np.empty((8, self.shape[0] * self.shape[1]))  # BiCGSTAB's vectors
+        self.setup_seconds = time.perf_counter() - start
+        self.iterations, self.fallbacks = 0, 0  # the last Krylov solve's; steps that took the LU instead
+        self.steps, self.smallest, self.first_negative, self.last = 0, math.inf, None, None
+
+    @cached_property
+    def matrix(self):
+        """The step matrix I + dt (v . grad_h - div_h D grad_h), sparse (CSC), built when first asked for."""
+        return _matrix(self._stencil, *self.shape)
+
+    def _factorise(self) -> None:
+        """The sparse LU of ``matrix`` (SuperLU, minimum degree on A^T + A), timed."""
+        from scipy.sparse.linalg import splu
+
         start = time.perf_counter()
         self._lu = splu(self.matrix, permc_spec="MMD_AT_PLUS_A")
-        self.factorisation_seconds = time.perf_counter() - start  # the LU's wall time, for benchmarks
-        self.steps, self.smallest, self.first_negative, self.last = 0, math.inf, None, None
+        self.factorisation_seconds = time.perf_counter() - start
+
+    def _krylov(self, c: np.ndarray) -> np.ndarray | None:
+        """The matrix's solve by BiCGSTAB (numerics/stencil2d) to ``rtol``, or None where it did not
+        get there in ``max_iterations``."""
+        out, self.iterations, residual = kernels().bicgstab(
+            self._w, np.ascontiguousarray(c), self.rtol, self.max_iterations, self._work
+        )
+        return out if residual <= self.rtol else None
+
+    def implicit(self, c: np.ndarray) -> tuple[np.ndarray, float]:
+        """The backward-Euler solve of ``c`` and its outflow, mass balanced (else MassError): by the
+        Krylov solve, or the LU where that did not converge or balance (from then on, every step)."""
+        if self.method == "krylov":
+            out = self._krylov(c)
+            if out is not None:
+                outflow = self.outflow(out)
+                try:
+                    fd.check_balance(c, out, outflow, self._scale)
+                    return out, outflow
+                except MassError:
+                    pass
+            self.method, self.fallbacks = "lu", self.fallbacks + 1
+        if self._lu is None:
+            self._factorise()
+        out = self._lu.solve(c.ravel()).reshape(self.shape)
+        outflow = self.outflow(out)
+        fd.check_balance(c, out, outflow, self._scale)
+        return out, outflow
 
     def outflow(self, c: np.ndarray) -> float:
         """The mass per cell area the implicit solution ``c`` sent into the zero ring this step."""
@@ -209,9 +325,7 @@ class Solver:
         left = 0.0
         if self.scheme == "tvd":
             c, left = self.advect(c)
-        out = self._lu.solve(c.ravel()).reshape(self.shape)
-        outflow = self.outflow(out)
-        fd.check_balance(c, out, outflow, self._scale)
+        out, outflow = self.implicit(c)
         smallest = float(out.min())
         self.steps += 1
         self.smallest = min(self.smallest, smallest)
@@ -225,9 +339,9 @@ class Solver:
         return self.step(c_interior)[0]
 
 
-def solver(D, v, grid: Grid, dt: float, scheme: str) -> Solver:
-    """The solver of one step dt on ``grid``'s interior."""
-    return Solver(D, v, grid.dx, grid.dy, dt, (grid.nx - 1, grid.ny - 1), scheme)
+def solver(D, v, grid: Grid, dt: float, scheme: str, method: str = "auto", **options) -> Solver:
+    """The solver of one step dt on ``grid``'s interior (``method`` and ``options``: Solver's)."""
+    return Solver(D, v, grid.dx, grid.dy, dt, (grid.nx - 1, grid.ny - 1), scheme, method, **options)
 
 
 def step_whole(solve: Solver, c: np.ndarray) -> Step:

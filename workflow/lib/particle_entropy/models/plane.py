@@ -1,7 +1,7 @@
 """The three models' start and measures in the plane (d = 2, issue 52), as fd.py, mtpt.py and pt.py
 give them on the line; their steps are the shared ones (models/simulate.py runs both).
 
-- FD: the n x n grid of core/plane.grid, the source's exact cell masses on it (sources2d.cell_masses),
+- FD: the n x n grid of core/plane.grid_span, the source's exact cell masses on it (sources2d.cell_masses),
   each step fd.transport by models/fd2d.py's solver (backward Euler with the full tensor).
 - MTPT: N particles uniform at random on the square of side Omega around the source, each carrying
   the source's mass in its sampling volume dV = Omega^2 / N (its density there times dV; a point's on
@@ -33,9 +33,17 @@ PT_REACH = 5.0
 
 
 # -------------------------------------------------------------------------------------------- FD
+def fd_grid(cfg):
+    """The run's n x n grid (core/plane.grid_span: the window and path, a node on the source's centre)."""
+    from .fd2d import Grid
+
+    (x0, y0), (dx, dy) = P.grid_span(cfg)
+    return Grid(float(x0), float(y0), float(dx), float(dy), cfg.n, cfg.n)
+
+
 def fd_start(cfg):
     """(grid, nodes (n + 1, n + 1)): the source's exact cell masses over the cell area, the ring zero."""
-    g = P.grid(cfg)
+    g = fd_grid(cfg)
     x, y = g.nodes()
     c = np.zeros((g.nx + 1, g.ny + 1))
     c[1:-1, 1:-1] = cfg.source.cell_masses(x[1:-1], y[1:-1], g.dx, g.dy) / (g.dx * g.dy)
@@ -142,12 +150,7 @@ def pt_measure(cfg, x, t: float, last: bool) -> dict:
     cells = ref.centre + np.column_stack([gx.ravel(), gy.ravel()])
     c = kde_2d(cells, x, H)
     row = _row(cfg, c * dV, dV, t, lambda points: kde_2d(points, x, H))
-    return {**row, "h": math.sqrt(major(H)), **mass}
-
-
-def major(D) -> float:
-    """The largest eigenvalue of the tensor D: D_L in a flow [L^2/T]."""
-    return float(np.linalg.eigvalsh(np.asarray(D, dtype=np.float64))[-1])
+    return {**row, "h": math.sqrt(P.major(H)), **mass}
 
 
 # ------------------------------------------------------------------------------------- the row
@@ -162,6 +165,7 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
         "H_I": h_c + math.log(dV) if entropy else math.nan,
         "E": M.dilution_index(h_c, dV) if entropy else math.nan,
         "SSE_points": math.nan,
+        "COMIC_points": math.nan,
         "dV": dV,
         "mass_total": total,
         "mass_min": float(masses.min()),
@@ -169,6 +173,7 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
     if at_points is not None and t > 0:
         points = cfg.points(t)
         row["SSE_points"] = M.sse(at_points(points), ref.density(points))
+        row["COMIC_points"] = M.comic(row["SSE_points"], len(points), dV)  # Eq. 43 at the points
     if t > 0 or cfg.source.kind != "point":
         row["H_C_analytic"] = ref.h_i() - math.log(dV) if entropy else math.nan
         row["E_analytic"] = ref.dilution()

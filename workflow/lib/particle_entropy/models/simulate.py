@@ -289,7 +289,8 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
 
 def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     """FD in the plane: the nodes (n + 1, n + 1) carried by fd.transport with the 2-D solver (one
-    sparse factorisation per distinct step size, models/fd2d.py), measured every step (models/plane.py)."""
+    solver per distinct step size: a sparse LU below 2^16 unknowns, BiCGSTAB from there, models/fd2d.py),
+    measured every step (models/plane.py)."""
     from . import plane
     from .fd import transport
 
@@ -310,6 +311,7 @@ def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict
 
 def _run_plane_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     """MTPT in the plane: carried, walked with (1 - eta) D and exchanged with eta D each step (models/plane.py)."""
+    from ..core.plane import major
     from . import plane
 
     rng = cfg.rng()
@@ -319,7 +321,7 @@ def _run_plane_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> di
     for k, dt in enumerate(dts, start=1):
         x, m, neighbours, sub = plane.mtpt_step(cfg, x, m, dt, rng)
         meas = plane.mtpt_measure(cfg, x, m, ts[k], k == len(dts))
-        h = math.sqrt(4.0 * cfg.eta * plane.major(cfg.D) * dt)  # the kernel's sd along D's major axis
+        h = math.sqrt(4.0 * cfg.eta * major(cfg.D) * dt)  # the kernel's sd along D's major axis
         rows.add(k, ts[k], dt, {**meas, "beta": 0.5, "h": h, "neighbours": neighbours, "substeps": sub})
     return {"x": x[:, 0], "y": x[:, 1], "mass": m, "c": m / cfg.dV}
 

@@ -46,6 +46,8 @@ EXPORTS = {
     "thomas_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8, f8[::1])"),
     "gt_solve": ("thomas", "f8[::1](f8[::1], f8[::1], f8[::1], f8[::1], i4[::1], f8[::1])"),
     "tvd_advect": ("thomas", "Tuple((f8[::1], f8))(f8[::1], f8)"),
+    "stencil_apply": ("stencil2d", "f8[:, ::1](f8[:, ::1], f8[:, ::1])"),
+    "bicgstab": ("stencil2d", "Tuple((f8[:, ::1], i8, f8))(f8[:, ::1], f8[:, ::1], f8, i8, f8[:, ::1])"),
     # the authors' loop: (x, m, label, sigma, radius, beta, seed, symnorm, clip) -> m
     "_sweep": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),
     "_sweep_fma": ("sequential_kernels", "f8[::1](f8[::1], f8[::1], i8[::1], f8, f8, f8, u8, b1, b1)"),
@@ -69,10 +71,11 @@ def _jit() -> types.SimpleNamespace:
 
 def _kernel_modules() -> dict[str, types.ModuleType]:
     """The modules of EXPORTS' kernels by name (importing them imports numba)."""
-    from . import gauss_kernels, sequential_kernels, thomas, transfer_kernels
+    from . import gauss_kernels, sequential_kernels, stencil2d, thomas, transfer_kernels
 
     return {
         "gauss_kernels": gauss_kernels,
+        "stencil2d": stencil2d,
         "transfer_kernels": transfer_kernels,
         "thomas": thomas,
         "sequential_kernels": sequential_kernels,
@@ -82,7 +85,7 @@ def _kernel_modules() -> dict[str, types.ModuleType]:
 def code_key() -> str:
     """SHA-256 of the kernels' code: this module, the kernel modules and what they import."""
     digest = hashlib.sha256()
-    kernel_files = ("gauss_kernels.py", "transfer_kernels.py", "thomas.py", "sequential_kernels.py")
+    kernel_files = ("gauss_kernels.py", "transfer_kernels.py", "thomas.py", "stencil2d.py", "sequential_kernels.py")
     for name in ("compiled.py", *kernel_files, "fastexp.py"):
         digest.update((Path(__file__).with_name(name)).read_bytes())
     return digest.hexdigest()

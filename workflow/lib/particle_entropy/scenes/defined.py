@@ -72,8 +72,7 @@ def closed_form(scene) -> dict | None:
     conservative plume's exact values at the scene's points (core/reference.py, no error of its own),
     or a reaction without B (scenes/reference.compute); None for A + B -> C, solved by a job."""
     if scene.reaction is None:
-        exact = scene.reference
-        values = exact.density(exact.points(scene.points_span))
+        values = scene.reference.density(scene.points)
         return {"a_points": values.tolist(), "a_error": np.zeros_like(values).tolist()}
     from . import reference
 

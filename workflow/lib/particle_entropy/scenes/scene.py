@@ -14,15 +14,20 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
+import numpy as np
+
+from ..core import plane
 from ..core.case import CASE_DIR, Case, SettingError
 from ..core.io import digest
 from ..core.reactions import Reaction, ReactionError
 from ..core.reference import Reference
-from ..core.registry import DEFAULT_ADVECTION
+from ..core.reference2d import Reference2D
+from ..core.registry import DEFAULT_ADVECTION, MEASUREMENT_POINTS
 from ..core.runconfig import RunConfig
 from ..core.runcost import StepWork, Tally
-from ..core.settings import MAX_REALISATIONS, PAPER, REACTIVE_COST, SCENE, SCENE_REACH, defaults
+from ..core.settings import MAX_REALISATIONS, PAPER, PLANE_COST, REACTIVE_COST, SCENE, SCENE_REACH, defaults
 from ..core.sources import Source, SourceError
+from ..core.sources2d import Source2D, dispersion_tensor
 from ..core.timegrid import MAX_STEPS, max_first_step
 from ..core.typed import FD_ONLY, PARTICLE_ONLY, shared, validate
 from ..core.typed import key_path as typed_key_path
@@ -261,9 +266,39 @@ class Scene:
         return self.candidates.index(self.candidates[i])
 
     @property
-    def reference(self) -> Reference:
-        """The exact solution at the observation time."""
+    def dim(self) -> int:
+        """The scene's dimensions: 2 with a 2-D source (core/plane.py), else 1."""
+        return 2 if plane.is_plane(self.source) else 1
+
+    @property
+    def n_points(self) -> int:
+        """The measurement points a run's SSE_points sums over: 15 on the line, a 15 x 15 lattice in 2-D."""
+        return MEASUREMENT_POINTS**self.dim
+
+    @property
+    def reference(self):
+        """The exact solution at the observation time (2-D: core/reference2d.Reference2D)."""
+        if self.dim == 2:
+            return Reference2D(self.source, self.D, self.v, self.t_final)
         return Reference(self.source, self.D, self.v, self.t_final)
+
+    @property
+    def points(self):
+        """The measurement points at t_final, as a run's (RunConfig.points): a span on the line, the
+        plume's 15 x 15 lattice in 2-D [L]."""
+        exact = self.reference
+        return exact.points() if self.dim == 2 else exact.points(self.points_span)
+
+    @property
+    def speed(self) -> float:
+        """|v| [L/T]."""
+        return math.hypot(*self.v) if self.dim == 2 else abs(self.v)
+
+    @property
+    def d_along(self) -> float:
+        """The dispersion the grid Peclet number divides by: D, or in 2-D the tensor's largest
+        eigenvalue (D_L in a flow) [L^2/T]."""
+        return plane.major(self.D) if self.dim == 2 else self.D
 
     @property
     def points_span(self) -> float:
@@ -278,7 +313,7 @@ class Scene:
     @property
     def peclet(self) -> float:
         """v L / D with L the FD window: how far advection outruns dispersion over the scene [-]."""
-        return abs(self.v) * self.fd_length / self.D
+        return self.speed * self.fd_length / self.d_along
 
     def settings(self, candidate: Candidate) -> dict:
         """The run settings of a candidate's runs (RunConfig's fields besides case and seed)."""
@@ -289,8 +324,11 @@ class Scene:
             "fd_length": self.fd_length,
             "source": self.source.record(),
             "v": self.v,
-            "window": self.points_span,  # the measurement points span the plume, at rest too
         }
+        if self.dim == 2:  # the tensor and v as lists; the points are the plume's lattice, not a span
+            out.update(D=[list(row) for row in self.D], v=list(self.v))
+        else:
+            out["window"] = self.points_span  # the measurement points span the plume, at rest too
         if self.reaction is not None:  # only then: a conservative scene's runs keep their identity
             out["reaction"] = self.reaction.record()
         if candidate.case.method == "fd":
@@ -334,6 +372,8 @@ class Scene:
         path of a bad value, also for the rules that need the built scene and its runs."""
         s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, functools.partial(_where, name))
         key = functools.partial(key_path, name)
+        if _plane_keys(s):
+            return cls._in_plane(name, s, key, case_defaults)
         D, v, t_final, r = s.D, s.v, s.t_final, s.realisations
         source = _source(key, s.source)
         reaction = _reaction(key, s.reaction)
@@ -367,6 +407,78 @@ class Scene:
         scene_checks.check_reactive(scene)  # after the runs: the reference's points are a run's
         defined.check(scene, defined.closed_form(scene))  # a target its closed-form reference can judge
         return scene
+
+    @classmethod
+    def _in_plane(cls, name: str, s, key, case_defaults: Mapping | None) -> Scene:
+        """A 2-D scene (issue 52): v [vx, vy], D {L, T} or {x, y}, a 2-D source; its domains the source's
+        extent plus ``margin`` sd of 2 D t_final along each axis (core/plane.sd_reach), every candidate's
+        runs checked at both ends of its ladder (core/plane.check)."""
+        _check_plane_keys(s, key)
+        if s.reaction is not None:
+            raise SettingError(
+                key("reaction"),
+                s.reaction.model_dump(exclude_unset=True),
+                "absent in a 2-D scene: 2-D reactions do not exist yet",
+            )
+        v = tuple(float(u) for u in s.v) if isinstance(s.v, list) else (0.0, 0.0)
+        origin = s.source == _DEFAULTS["source"]  # the default, a point at the origin, in the plane
+        source = _source2d(key, {"kind": "point", "x0": [0.0, 0.0]} if origin else s.source)
+        try:
+            D = plane.tensor(dispersion_tensor(v, s.D.tensor_spec()))
+        except ValueError as e:
+            where = str(e).split(":", 1)[0]
+            raise SettingError(key(where if where.startswith("D") else "D"), s.D.tensor_spec(), str(e)) from None
+        t_final, r = s.t_final, s.realisations
+        probe = RunConfig.of("fd", "implicit", 4, source=source, D=D, v=v, t_final=t_final)
+        own = plane.sd_reach(probe, np.asarray(D)) - plane.REACH_SDS * np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))
+        span = 2.0 * float(np.max(own + s.margin * np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))))
+        omega = span if s.omega is None else s.omega
+        fd_length = span if s.fd_length is None else s.fd_length
+        cands = tuple(
+            Candidate.from_spec(c, case_defaults or {}, lambda k, i=i: key(f"candidates[{i}].{k}"))
+            for i, c in enumerate(s.candidates)
+        )
+        scene_checks.check_distinct(key, cands)
+        if not any(v):  # nothing to advect: as on the line, FD's scheme and Courant number are no part of the runs
+            cands = tuple(replace(c, advection="none", courant=None) for c in cands)
+        cost = tuple((m, tuple(pair)) for m, pair in sorted({**dict(PLANE_COST), **s.cost}.items()))
+        budget = math.inf if s.budget is None else s.budget
+        most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
+        scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
+        scene = replace(scene, budget=budget, max_realisations=most)
+        for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
+            c.check_runs(scene, i, s.candidates[i].model_fields_set)
+        defined.check(scene, defined.closed_form(scene))
+        return scene
+
+
+def _plane_keys(s) -> bool:
+    """Whether the parsed scene ``s`` writes any 2-D key: v a pair, D a mapping, a source with pairs."""
+    source = s.source if isinstance(s.source, Mapping) else {}
+    return isinstance(s.v, list) or not isinstance(s.D, (int, float)) or plane.source_of(source) is not None
+
+
+def _check_plane_keys(s, key) -> None:
+    """SettingError naming the first key written in its 1-D form in a scene that writes 2-D ones (v = 0
+    and the default source, a point at the origin, read the same in either form)."""
+    if not isinstance(s.v, list) and s.v != 0.0:
+        raise SettingError(
+            key("v"), s.v, "a pair [vx, vy] in a 2-D scene (its D or source is 2-D): 1-D and 2-D keys mixed"
+        )
+    if isinstance(s.D, (int, float)):
+        raise SettingError(key("D"), s.D, "{L: D_L, T: D_T} or {x: Dx, y: Dy} in a 2-D scene: 1-D and 2-D keys mixed")
+    if s.source != _DEFAULTS["source"] and plane.source_of(s.source) is None:
+        raise SettingError(
+            key("source"), s.source, "a 2-D source (x0 a pair, or x and y) in a 2-D scene: 1-D and 2-D keys mixed"
+        )
+
+
+def _source2d(key, spec):
+    """The 2-D source at scenes.<name>.source, else SettingError naming its key path."""
+    try:
+        return Source2D.of(**spec)
+    except SourceError as e:
+        raise SettingError(key(f"source.{e.param}"), e.value, e.allowed) from None
 
 
 def _where(name: str, path: list) -> str:
@@ -512,7 +624,7 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     the same measurement points. Their tables are the paper's (``pattern``): the paper scene
     recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
     shared = set()
-    if scene.reaction is not None:  # a reactive scene's runs carry its reaction: none is the paper's
+    if scene.reaction is not None or scene.dim == 2:  # a reactive or 2-D scene's runs: none is the paper's
         return replace(scene, paper_pattern=pattern)
     for ci, cand in enumerate(scene.candidates):
         mine = scene.run_config(cand, cand.n_lo)
