@@ -69,8 +69,7 @@ def rmse_over_peak(c, exact) -> float:
 def mtpt_run(n: int, seed: int, theta: float, cutoff_sds: float | None = None, D=None, score: bool = True):
     """MTPT of the scene at ``theta`` with N particles -> (error, or nan without ``score``; H_C = -sum
     p ln p; masses; initial total). ``D`` replaces the scene's tensor in the exchange only (a
-    deliberately wrong model). ``score=False`` skips the interpolation (its Delaunay transforms are
-    LAPACK calls that a multi-threaded OpenBLAS slows 10-300 times on a loaded machine)."""
+    deliberately wrong model). ``score=False`` skips the interpolation where only H_C is wanted."""
     v, D_true = scene(theta)
     D_model = D_true if D is None else D
     rng = np.random.default_rng([seed, n])
@@ -136,7 +135,7 @@ def test_mtpt_error_falls_with_n_at_the_measured_rate():
     ~0.08, so the band [-0.75, -0.2] lies 3 of those around -0.45 and excludes 0 (no convergence).
     The fit is asserted stable: no mean more than 0.3 (in log) off the fitted line, the error at
     16,000 below half that at 1,000, and the two orientations' slopes (same layouts) within 0.2.
-    ~15 s with a single-threaded OpenBLAS (see mtpt_run on a loaded machine)."""
+    ~15 s on an idle two-core Xeon, 34 s at load 4 under pytest's two workers."""
     seeds = {1000: 8, 2000: 8, 4000: 8, 8000: 6, 16000: 4}
     slopes = []
     for theta in (0.0, 30.0):
