@@ -78,11 +78,12 @@ def test_exchange_equals_a_dense_reference_with_an_oblique_tensor():
     x = rng.uniform(-1.0, 1.0, (300, 2)) * [1.0, 0.5]
     m = rng.uniform(0.0, 1.0, (3, 300))
     eta, dt = 0.7, 2.0e-3  # kernel sd along the major axis sqrt(4 eta dt) = 0.075, ~1.5 spacings
-    got, substeps, neighbours = mtpt_exchange_2d(x, m, D_OBLIQUE, eta, dt)
+    # 9 s.d., the untruncated reach: the default 6 drops weights up to 1.5e-8 of the self weight
+    got, substeps, neighbours = mtpt_exchange_2d(x, m, D_OBLIQUE, eta, dt, cutoff_sds=9.0)
     want = dense_exchange(x, m, D_OBLIQUE, eta, dt, substeps)
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
     assert np.abs(got - m).max() > 1e-3  # the exchange did move mass
-    single, substeps_1, _ = mtpt_exchange_2d(x, m[1], D_OBLIQUE, eta, dt)
+    single, substeps_1, _ = mtpt_exchange_2d(x, m[1], D_OBLIQUE, eta, dt, cutoff_sds=9.0)
     assert substeps_1 == substeps
     np.testing.assert_array_equal(single, got[1])  # each species by the same P
     assert 0.0 < neighbours < 299.0

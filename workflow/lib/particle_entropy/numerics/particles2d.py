@@ -22,6 +22,13 @@ from .bandwidths import CUTOFF_SIGMAS, collision_sigma
 from .neighbours import pairs_within
 
 COLLISION_BETA = 0.5  # Eq. 16's factor 1/2: with P of covariance 4 eta D dt, the masses spread by 2 eta D dt
+# The exchange's cut-off in kernel standard deviations. Not bandwidths.CUTOFF_SIGMAS (9, shared
+# with the 1-D code, where it means "untruncated"): in 2-D the pairs grow as the cut-off squared and
+# at 9 s.d. an exchange step at N = 100,000 takes 0.78 s against issue 52's 0.5 s; 6 s.d. takes 0.41 s
+# (Intel Xeon, benchmarks/mtpt2d_step.py) and drops exp(-18) = 1.5e-8 of the kernel's mass and 2.9e-7
+# of its variance, far below the 1 / (1 + n_K) under-dispersion of the exchange itself, and changes
+# the RMSE at N = 16,000 of tests/test_particles2d_rates.py by less than 1e-4 of its 0.02.
+EXCHANGE_CUTOFF_SIGMAS = 6.0
 KDE_CHUNK_PAIRS = 4_000_000  # (point, particle) pairs held at once by kde_2d: about 100 MB (24 B each)
 
 
@@ -54,13 +61,13 @@ def whiten(x, A) -> np.ndarray:
     return x @ inv.T
 
 
-def exchange_cutoff(dt: float, cutoff_sds: float = CUTOFF_SIGMAS) -> float:
+def exchange_cutoff(dt: float, cutoff_sds: float = EXCHANGE_CUTOFF_SIGMAS) -> float:
     """Cut-off radius in the coordinates whitened by eta D (``whiten``): ``cutoff_sds`` standard
     deviations sqrt(4 dt) of the collision kernel there (collision_sigma with eta D = 1)."""
     return cutoff_sds * collision_sigma(1.0, 1.0, dt)
 
 
-def mtpt_exchange_2d(x, m, D, eta: float, dt: float, cutoff_sds: float = CUTOFF_SIGMAS) -> Exchange:
+def mtpt_exchange_2d(x, m, D, eta: float, dt: float, cutoff_sds: float = EXCHANGE_CUTOFF_SIGMAS) -> Exchange:
     """One mass exchange m_i <- m_i + (1/2) sum_j P_ij (m_j - m_i) (Eq. 16) with Eq. 17's collision
     kernel of the uniform tensor eta D: W_ij = exp(-r^T (eta D)^-1 r / (8 dt)), a Gaussian of
     covariance 4 eta D dt (in 1-D the variance of bandwidths.collision_sigma), P the average of the
@@ -82,9 +89,10 @@ def mtpt_exchange_2d(x, m, D, eta: float, dt: float, cutoff_sds: float = CUTOFF_
     (r^T (4 eta D dt)^-1 r > cutoff_sds^2) are dropped. A dropped weight is below
     exp(-cutoff_sds^2 / 2) of the self weight; of a 2-D Gaussian kernel the mass beyond is
     exp(-k^2/2) and the share of its variance (k^2 + 2) exp(-k^2/2) / 2, k = cutoff_sds. The
-    default, CUTOFF_SIGMAS = 9 (the reach of the untruncated 1-D kernels), drops 2.6e-18 of the
-    kernel (round-off of the self term) and 2.2e-16 of its variance; 6 drops 1.5e-8 and 2.9e-7 for
-    (6/9)^2 = 0.44 of the pairs. Mass is conserved to round-off whatever the cut-off (P is symmetric).
+    default, EXCHANGE_CUTOFF_SIGMAS = 6, drops 1.5e-8 of the kernel and 2.9e-7 of its variance for
+    (6/9)^2 = 0.44 of the pairs of CUTOFF_SIGMAS = 9 (the reach of the untruncated 1-D kernels),
+    which drops 2.6e-18 (round-off of the self term) and 1.1e-16; 7 drops 2.3e-11 and 5.8e-10, 8
+    1.3e-14 and 4.2e-13. Mass is conserved to round-off whatever the cut-off (P is symmetric).
     """
     from . import pair_transfer as pt  # numba: loaded by the jobs that step
 
