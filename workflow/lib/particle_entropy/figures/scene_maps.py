@@ -152,10 +152,10 @@ def draw_maps(axes, cax, scene, run: ModelRun | None, nodes: int = MAP_NODES) ->
         ax.set_ylim(y[0], y[-1])
         ax.set_xlabel("x [L]")
     axes[0].set_ylabel("y [L]")
-    axes[0].set_title(f"(c) exact concentration at t = {scene.t_final:g}", loc="left", fontsize=10)
+    axes[0].set_title(f"(c) the exact concentration\nat t_final = {scene.t_final:g}", loc="left", fontsize=10)
     axes[1].set_title(_model_title(run, rmse), loc="left", fontsize=10)
     if run is None:
-        axes[1].text(0.5, 0.5, "no rung has an error: nothing to draw", transform=axes[1].transAxes, ha="center")
+        axes[1].text(0.5, 0.5, "no model to draw", transform=axes[1].transAxes, ha="center", color="0.3")
     else:
         key = [Line2D([], [], color=BLACK, lw=0.7), Patch(facecolor=style["cmap"](0.75), edgecolor="none")]
         axes[1].legend(key, ["exact", "model"], loc="upper right", fontsize=8, framealpha=0.9)
@@ -168,17 +168,15 @@ def _colours(bands: int) -> dict:
     """contourf's colours for ``bands`` bands: white below the first level above 0, then CMAP's from
     light to dark; a value below 0 (a model's undershoot) in VERMILLION."""
     shades = matplotlib.colormaps[CMAP](np.linspace(0.12, 1.0, max(bands - 1, 1)))
-    cmap = ListedColormap(np.vstack([[1.0, 1.0, 1.0, 1.0], shades])[:bands])
-    cmap.set_under(VERMILLION)
-    return {"cmap": cmap}
+    return {"cmap": ListedColormap(np.vstack([[1.0, 1.0, 1.0, 1.0], shades])[:bands]).with_extremes(under=VERMILLION)}
 
 
 def _model_title(run: ModelRun | None, rmse: float | None) -> str:
     """The model panel's title: its label, n and RMSE at the points; says when it is not recommended."""
     if run is None:
-        return "(d) no candidate recommended, none run"
+        return "(d) none recommended\nand no rung has an error"
     r = run.row
-    what = f"{r['label']}, n = {int(r['n']):,}: RMSE {rmse:.3g}"
+    what = f"{r['label']}\nn = {int(r['n']):,}, RMSE at the points {rmse:.3g}"
     if run.recommended:
-        return f"(d) recommended {what}"
-    return f"(d) none recommended; cheapest best rung:\n{what}"
+        return f"(d) recommended: {what}"
+    return f"(d) none recommended; the cheapest best rung: {what}"
