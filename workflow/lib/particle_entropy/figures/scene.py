@@ -7,7 +7,9 @@ every candidate, the COMIC-best ringed; for a reactive scene instead the product
 time: the reference, the recommended model and each candidate's finest visited rung (mean over
 seeds). Unscored runs (negative concentrations) are drawn hollow and named below. A rung without
 an error (NaN: not run, as when the reference cannot judge the target) or at error 0 has no place
-on the log axis: it is not drawn, and panel (a) says how many are missing.
+on the log axis: it is not drawn, and panel (a) says how many are missing. A 2-D scene's figure adds
+(c) the exact concentration at t_final and (d) the recommended model's, one grid and one set of levels
+(figures/scene_maps.py); a 1-D scene's is drawn as before.
 """
 
 from __future__ import annotations
