@@ -330,3 +330,19 @@ def test_mtpt_concentration_is_masses_over_dV_and_zero_outside():
     got = mtpt_concentration_2d(p, x, m, 0.25)
     np.testing.assert_allclose(got[0], [4.0, 10.0, 0.0])  # centre: the mean of the corners (either diagonal)
     np.testing.assert_allclose(got[1, [0, 2]], [0.0, 0.0])
+
+
+def test_the_concentration_at_points_equals_scipy_s_linear_interpolation_on_the_same_triangles():
+    """Our closed-form point location against scipy's LinearNDInterpolator (its own find_simplex):
+    random points inside, outside and on particles, one species and two."""
+    from scipy.interpolate import LinearNDInterpolator
+
+    rng = np.random.default_rng(52)
+    x = rng.random((3000, 2)) * 2.0 - 1.0
+    m = rng.random(3000)
+    p = np.vstack([rng.random((400, 2)) * 2.4 - 1.2, x[:20]])  # some outside the hull, some on vertices
+    want = LinearNDInterpolator(x, m / 0.5, fill_value=0.0)(p)
+    assert np.any(want == 0.0) and np.any(want > 0.0)
+    assert np.allclose(mtpt_concentration_2d(p, x, m, 0.5), want, rtol=0, atol=1e-12)
+    both = mtpt_concentration_2d(p, x, np.vstack([m, 3.0 * m]), 0.5)
+    assert both.shape == (2, p.shape[0]) and np.allclose(both[1], 3.0 * want, rtol=0, atol=1e-12)

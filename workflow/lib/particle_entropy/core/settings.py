@@ -678,7 +678,8 @@ SCENE = (
         {"fd": [3.85e-5, 1.72e-8], "pt": [7.99e-5, 3.71e-8], "mtpt": [8.37e-5, 2.02e-7]},
         "the cost model of a run, by method: [seconds a time step, seconds a unit of work] (work = node- or "
         "particle-steps); counted, never timed, so the answer is the same on every machine (fitted by "
-        "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03); a reactive "
+        "benchmarks/calibrate_scene_costs.py to 88 runs of the shipped scenes, Intel Xeon, 2026-12-03; a 2-D scene's "
+        "default is settings.PLANE_COST, fitted to 2-D runs); a reactive "
         "scene's run: its steps' part and its work's part times its method's factor (settings.REACTIVE_COST)",
         "s",
         kind="shape",
@@ -723,8 +724,9 @@ SCENE = (
 REACTIVE_COST = {"fd": (1.08, 1.45), "mtpt": (0.902, 1.58), "pt": (0.474, 2.64)}
 # A 2-D scene's default cost model, per method [seconds a step, seconds a unit of work]: work is FD's
 # (n + 1)^2 node-steps and the particles' N particle-steps (core/runcost.units_per_step). Fitted by
-# benchmarks/plane_cost.py to 2-D runs (the machine and commit in its output).
-PLANE_COST = {"fd": (1.0e-3, 2.0e-7), "mtpt": (1.0e-3, 2.0e-5), "pt": (1.0e-3, 2.0e-7)}
+# `python benchmarks/calibrate_scene_costs.py --max-s 5 plume2d oblique` (24 runs; Intel Xeon, 2 vCPU,
+# shared with other jobs; measured / fitted median 0.98-1.08 per method).
+PLANE_COST = {"fd": (1.02e-3, 1.11e-7), "mtpt": (0.0, 1.73e-6), "pt": (2.11e-3, 1.74e-6)}
 
 
 SCENES_PECLET = (

@@ -169,11 +169,67 @@ def mtpt_concentration_2d(points, x, m, dV: float) -> np.ndarray:
     outside the cloud), so the two dimensions score alike; it adds no smoothing, whereas a kernel
     sum of the masses would add its bandwidth's covariance to a plume that the exchange has already
     spread (a second, numerical dispersion). ``m`` (N,) or (species, N) -> (M,) or (species, M).
+
+    The triangles are Qhull's (scipy.spatial.Delaunay); each point's triangle and barycentric
+    weights come from ``_locate``, in closed form. scipy's own find_simplex first computes every
+    triangle's transform by LAPACK, which took 2-11 s for 8,000 particles where two jobs shared
+    two cores (OpenBLAS threads contending), against 0.02 s on one thread.
     """
-    from scipy.interpolate import LinearNDInterpolator
+    from scipy.spatial import Delaunay
 
     x = np.asarray(x, dtype=np.float64)
     c = np.asarray(m, dtype=np.float64) / dV
-    values = c.T if c.ndim == 2 else c
-    got = LinearNDInterpolator(x, values, fill_value=0.0)(np.asarray(points, dtype=np.float64))
-    return got.T if c.ndim == 2 else got
+    p = np.asarray(points, dtype=np.float64)
+    tri = Delaunay(x)
+    simplex, weights = _locate(x, tri.simplices, p)
+    rows = c[None, :] if c.ndim == 1 else c
+    inside = simplex >= 0
+    out = np.zeros((rows.shape[0], p.shape[0]))
+    corners = tri.simplices[simplex[inside]]  # (K, 3)
+    out[:, inside] = np.einsum("skj,kj->sk", rows[:, corners], weights[inside])
+    return out[0] if c.ndim == 1 else out
+
+
+LOCATE_NEAREST = 12  # triangles tried first for each point: those of the nearest centroids
+
+
+def _locate(x: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(triangle index, barycentric weights (M, 3)) of each point of ``p`` (M, 2) in the triangulation
+    ``triangles`` (K, 3) of ``x``; -1 outside every triangle. Each point tries the LOCATE_NEAREST
+    triangles of nearest centroid (a k-d tree), then, if none holds it, every triangle, a chunk of
+    points at a time; weights from the closed-form inverse of each triangle's 2 x 2 edge matrix,
+    a point on an edge (weight >= -1e-12 of its triangle's scale) counted in."""
+    from scipy.spatial import cKDTree
+
+    a, b, c = (x[triangles[:, k]] for k in range(3))
+    e1, e2 = b - a, c - a
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+
+    def weights(k: np.ndarray, q: np.ndarray) -> np.ndarray:
+        r = q - a[k]
+        w1 = (r[..., 0] * e2[k, 1] - r[..., 1] * e2[k, 0]) / det[k]
+        w2 = (e1[k, 0] * r[..., 1] - e1[k, 1] * r[..., 0]) / det[k]
+        return np.stack([1.0 - w1 - w2, w1, w2], axis=-1)
+
+    simplex = np.full(p.shape[0], -1)
+    found = np.zeros((p.shape[0], 3))
+    if not triangles.shape[0]:
+        return simplex, found
+    tol = -1e-12
+    k = min(LOCATE_NEAREST, triangles.shape[0])
+    _, near = cKDTree((a + b + c) / 3.0).query(p, k=k)
+    near = near.reshape(p.shape[0], k)
+    w = weights(near, p[:, None, :])  # (M, k, 3)
+    ok = np.all(w >= tol, axis=-1)
+    hit = ok.any(axis=1)
+    first = np.argmax(ok, axis=1)
+    rows = np.flatnonzero(hit)
+    simplex[rows] = near[rows, first[rows]]
+    found[rows] = w[rows, first[rows]]
+    every = np.arange(triangles.shape[0])
+    for i in np.flatnonzero(~hit):  # far from the cloud's middle or outside it: every triangle
+        wi = weights(every, p[i][None, :])
+        inside = np.flatnonzero(np.all(wi >= tol, axis=-1))
+        if inside.size:
+            simplex[i], found[i] = inside[0], wi[inside[0]]
+    return simplex, found
