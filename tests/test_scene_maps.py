@@ -26,18 +26,19 @@ FD = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75,
 PT = {"method": "pt", "kernel": "adaptive", "n_range": [200, 800]}
 
 
+_SPEC = {
+    "v": [0.5, 0.0],
+    "D": {"L": 1.0e-2, "T": 1.0e-3},
+    "t_final": 4.0,
+    "source": {"kind": "point", "x0": [0.0, 0.0]},
+    "target": {"measure": "rmse", "value": 0.05},
+}
+
+
 @pytest.fixture(scope="module")
 def plane():
     """A small 2-D scene: a point carried along x, D_T = D_L / 10."""
-    spec = {
-        "v": [0.5, 0.0],
-        "D": {"L": 1.0e-2, "T": 1.0e-3},
-        "t_final": 4.0,
-        "source": {"kind": "point", "x0": [0.0, 0.0]},
-        "target": {"measure": "rmse", "value": 0.05},
-        "candidates": [FD, PT],
-    }
-    return Scene.from_config("plane", spec)
+    return Scene.from_config("plane", {**_SPEC, "candidates": [FD, PT]})
 
 
 def _fd_state(scene, n: int = 16):
@@ -130,6 +131,20 @@ def test_a_particle_state_is_drawn_as_its_run_scores_it(plane):
     points = np.array([[2.0, 0.0], [2.1, 0.05]])
     got = SM.concentration(cfg, state, points)
     np.testing.assert_array_equal(got, kde_2d(points, x, pt_bandwidth(cfg, plane.t_final)))
+
+
+def test_an_mtpt_state_is_its_masses_over_dv_on_its_triangles(plane):
+    from particle_entropy.numerics.particles2d import mtpt_concentration_2d
+
+    mtpt = Scene.from_config(
+        "m", {**_SPEC, "candidates": [{"method": "mtpt", "kernel": "collision", "eta": 1, "n_range": [1000, 2000]}]}
+    )
+    cfg = mtpt.run_config(mtpt.candidates[0], 1000)
+    x = np.random.default_rng(2).uniform(-1.0, 3.0, (1000, 2))
+    m = np.random.default_rng(3).random(1000) / 1000
+    state = pd.DataFrame({"x": x[:, 0], "y": x[:, 1], "mass": m, "c": m / cfg.dV})
+    points = np.array([[2.0, 0.0], [0.5, 0.5]])
+    np.testing.assert_array_equal(SM.concentration(cfg, state, points), mtpt_concentration_2d(points, x, m, cfg.dV))
 
 
 def test_a_table_with_no_recommended_rung_still_draws_the_cheapest_best_rung(plane, tmp_path):
