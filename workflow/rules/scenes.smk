@@ -110,6 +110,9 @@ rule plot_scene:
     resources:
         mem_mb=1000,
     params:
+        spec=lambda w: SCENES.spec(w.name),  # a 2-D scene's maps run its model once (figures/scene_maps.py)
+        case_defaults=config.get("case_defaults", {}),
+        base_seed=config["base_seed"],
         code=script_code(SCRIPTS / "plot_scene.py"),
     script:
         "../scripts/plot_scene.py"

@@ -7,7 +7,9 @@ every candidate, the COMIC-best ringed; for a reactive scene instead the product
 time: the reference, the recommended model and each candidate's finest visited rung (mean over
 seeds). Unscored runs (negative concentrations) are drawn hollow and named below. A rung without
 an error (NaN: not run, as when the reference cannot judge the target) or at error 0 has no place
-on the log axis: it is not drawn, and panel (a) says how many are missing.
+on the log axis: it is not drawn, and panel (a) says how many are missing. A 2-D scene's figure adds
+(c) the exact concentration at t_final and (d) the recommended model's, one grid and one set of levels
+(figures/scene_maps.py); a 1-D scene's is drawn as before.
 """
 
 from __future__ import annotations
@@ -26,9 +28,13 @@ MEASURE_LABEL = {
 }
 
 
-def scene(table: pd.DataFrame):
-    """The figure of one scene's table."""
-    fig, (ax, bx) = new_figure(2, width=5.4, height=5.6)
+def scene(table: pd.DataFrame, maps=None):
+    """The figure of one scene's table; of a 2-D scene with ``maps``, (scene, its ModelRun or None),
+    panels a and b above the exact and the model's maps (figures/scene_maps.py)."""
+    if maps is None:
+        fig, (ax, bx) = new_figure(2, width=5.4, height=5.6)
+    else:
+        fig, (ax, bx) = _with_maps(*maps)
     name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
     labels = list(dict.fromkeys(table["label"]))
     reactive = "product_series" in table
@@ -147,6 +153,24 @@ def scene(table: pd.DataFrame):
         bottom = 0.045 * (1 + text.count("\n"))  # room for the notes; rect is (left, bottom, width, height)
         fig.get_layout_engine().set(rect=(0, bottom, 1, 1 - bottom))
     return fig
+
+
+def _with_maps(scene, run):
+    """A figure whose top holds panels a and b as in 1-D and whose bottom the two maps, as wide as
+    the plume over the map grid is (equal aspect), with one colour bar -> (figure, (a, b))."""
+    from matplotlib.figure import Figure
+
+    from .scene_maps import draw_maps, map_grid
+
+    x, y = map_grid(scene.reference)
+    aspect = float(np.clip((y[-1] - y[0]) / (x[-1] - x[0]), 0.25, 1.2))
+    low = 4.6 * aspect + 1.1  # a map 4.6 in wide, its title and labels
+    fig = Figure(figsize=(10.8, 5.6 + low), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=[5.6, low])
+    ax, bx = top.subplots(1, 2)
+    cx, dx, cax = bottom.subplots(1, 3, width_ratios=[1, 1, 0.04])
+    draw_maps((cx, dx), cax, scene, run)
+    return fig, (ax, bx)
 
 
 def _on_log_axes(table: pd.DataFrame) -> pd.Series:

@@ -268,9 +268,12 @@ FIGURE_CONTENTS = (
     (
         "scene",
         "`results/scenes/<name>.parquet` (drawn as `figures/scene_<name>.png`)",
-        "a, b",
+        "a, b (2-D: c, d)",
         "a: `cost_s` → `error_mean` with `error_lo`, `error_hi` per candidate, the `target`, the `recommended` row "
-        "starred; b: `n` → `COMIC_points` per candidate, the `comic_best` row ringed",
+        "starred; b: `n` → `COMIC_points` per candidate, the `comic_best` row ringed; 2-D: c the exact concentration "
+        "at t_final on 200 × 200 points over ±4 sd of the plume, d the `recommended` row's (else the cheapest "
+        "candidate's least-error rung) on the same grid and levels, its final state run once in the plot job on the "
+        "first seed",
     ),
     (
         "scenes_peclet",
