@@ -29,10 +29,19 @@ def test_every_kind_has_an_example():
 
 
 def test_the_schema_lists_the_registrys_kinds_and_every_parameter():
-    assert SOURCE_SHAPE == source_shape()
-    assert SOURCE_SHAPE["properties"]["kind"]["enum"] == list(SOURCES)
+    from dataclasses import fields
+
+    from particle_entropy.core.sources2d import SOURCES2D, with_pairs
+
+    assert SOURCE_SHAPE == with_pairs(source_shape())  # the line's kinds, and the plane's pairs
+    assert SOURCE_SHAPE["properties"]["kind"]["enum"] == list(dict.fromkeys([*SOURCES, *SOURCES2D]))
     for cls in SOURCES.values():
         assert {p.name for p in cls.PARAMS} <= set(SOURCE_SHAPE["properties"])
+    for cls in SOURCES2D.values():  # a key of both a number or a pair; the plane's own a pair
+        for f in fields(cls):
+            entry = SOURCE_SHAPE["properties"][f.name]
+            pairs = [e for e in entry.get("oneOf", [entry]) if e.get("type") == "array"]
+            assert len(pairs) == 1 and pairs[0]["minItems"] == pairs[0]["maxItems"] == 2
 
 
 @pytest.mark.parametrize("kind", list(EXAMPLES))
