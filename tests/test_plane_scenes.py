@@ -70,3 +70,14 @@ def test_the_shipped_2d_scenes_are_a_flow_along_and_at_45_degrees_to_the_grid():
     assert along.v[1] == 0.0 and math.isclose(oblique.v[0], oblique.v[1], rel_tol=1e-15)
     assert math.isclose(along.speed, oblique.speed, rel_tol=1e-15)
     assert np.allclose(np.linalg.eigvalsh(np.asarray(along.D)), np.linalg.eigvalsh(np.asarray(oblique.D)))
+
+
+def test_a_2d_scene_is_priced_by_the_plane_s_cost_model_unless_it_writes_its_own():
+    """The workflow's schema fills in the 1-D default `cost`; a 2-D scene reads that as unset and takes
+    settings.PLANE_COST (MTPT's 2-D step costs ~20 times the 1-D default's), but keeps one written."""
+    from particle_entropy.core.settings import PLANE_COST, SCENE, defaults
+
+    filled = Scene.from_config("s", {**BASE, "cost": defaults(SCENE)["cost"]})
+    assert dict(filled.cost) == {m: tuple(p) for m, p in PLANE_COST.items()}
+    own = {"fd": [1.0, 2.0], "pt": [3.0, 4.0], "mtpt": [5.0, 6.0]}
+    assert dict(Scene.from_config("s", {**BASE, "cost": own}).cost) == {m: tuple(p) for m, p in own.items()}

@@ -441,7 +441,9 @@ class Scene:
         scene_checks.check_distinct(key, cands)
         if not any(v):  # nothing to advect: as on the line, FD's scheme and Courant number are no part of the runs
             cands = tuple(replace(c, advection="none", courant=None) for c in cands)
-        cost = tuple((m, tuple(pair)) for m, pair in sorted({**dict(PLANE_COST), **s.cost}.items()))
+        # the 1-D default (as the workflow's schema fills it in) is no cost a user wrote: the plane's is
+        written = {} if _same_cost(s.cost, _DEFAULTS["cost"]) else s.cost
+        cost = tuple((m, tuple(pair)) for m, pair in sorted({**dict(PLANE_COST), **written}.items()))
         budget = math.inf if s.budget is None else s.budget
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
@@ -450,6 +452,11 @@ class Scene:
             c.check_runs(scene, i, s.candidates[i].model_fields_set)
         defined.check(scene, defined.closed_form(scene))
         return scene
+
+
+def _same_cost(a: Mapping, b: Mapping) -> bool:
+    """Whether two cost models give every method the same two unit costs."""
+    return {m: tuple(map(float, p)) for m, p in a.items()} == {m: tuple(map(float, p)) for m, p in b.items()}
 
 
 def _plane_keys(s) -> bool:
