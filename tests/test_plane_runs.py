@@ -102,3 +102,32 @@ def test_an_fd_rung_over_the_memory_bound_names_its_grid_and_bytes():
     with pytest.raises(SettingError) as err:
         _cfg("fd", n=4096).resolved()
     assert "4,096 x 4,096" in err.value.allowed and "bytes" in err.value.allowed
+
+
+@pytest.mark.parametrize("method, n", [("fd", 256), ("mtpt", 8000), ("pt", 32000)])
+def test_a_plane_run_s_memory_estimate_bounds_its_peak(method, n):
+    """memory.estimate_bytes of a 2-D run (the job's mem_mb) against the peak resident memory the run
+    itself records (its table's peak_rss_mb), run alone in a fresh process: above it, and not more
+    than 4 times it."""
+    import json
+    import subprocess
+    import sys
+
+    from particle_entropy.pipeline.memory import estimate_bytes
+
+    cfg = _cfg(method, n=n).resolved()
+    code = (
+        "import json, sys\n"
+        "from particle_entropy.core.runconfig import RunConfig\n"
+        "from particle_entropy.models.simulate import run\n"
+        f"cfg = RunConfig.of({method!r}, **json.loads(sys.argv[1]))\n"
+        "print(float(run(cfg)[0]['peak_rss_mb'].max()))\n"
+    )
+    case = {"fd": {"kernel": "implicit", "courant": 0.5, "advection": "tvd"}}.get(
+        method, {"kernel": "collision" if method == "mtpt" else "adaptive", "dt_growth": 1.0, "dt0": 0.1}
+    )
+    settings = {**case, **PHYSICS, "D": np.asarray(D).tolist(), "n": n}
+    out = subprocess.run([sys.executable, "-c", code, json.dumps(settings)], capture_output=True, text=True, check=True)
+    peak = float(out.stdout.strip().splitlines()[-1]) * 2**20
+    estimate = estimate_bytes(cfg)
+    assert peak < estimate < 4.0 * peak, (peak / 2**20, estimate / 2**20)

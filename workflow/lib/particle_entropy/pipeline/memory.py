@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
+
 from ..core.runconfig import RunConfig
 from ..core.timegrid import step_count
 
@@ -25,7 +27,37 @@ UNIT_BYTES = {"fd": 150.0, "pt": 100.0, "mtpt": 400.0}
 def estimate_bytes(cfg: RunConfig) -> float:
     """Estimated peak memory of one run of a resolved ``cfg``, in bytes (an upper estimate)."""
     steps = step_count(cfg.t_final, cfg.dt0, cfg.dt_growth)
+    if cfg.dim == 2:
+        return BASE_BYTES + STEP_BYTES * steps + plane_bytes(cfg)
     return BASE_BYTES + STEP_BYTES * steps + UNIT_BYTES[cfg.method] * cfg.n
+
+
+# 2-D runs (core/plane.py): FD holds its LU (core/plane.FD_BYTES_PER_NODE a node, which the Krylov
+# solve falls back to); MTPT its pairs within the cut-off (numbers as the shear flow's, SHEAR_*);
+# PT its kernel estimate's chunk of (point, particle) pairs (particles2d.KDE_CHUNK_PAIRS)
+PLANE_PARTICLE_BYTES = 400.0
+KDE_PAIR_BYTES = 64.0  # measured: 32,000 particles on 128 x 128 points peaked at 367 MB
+
+
+def plane_bytes(cfg: RunConfig) -> float:
+    """What a 2-D run adds to the base and its steps [bytes]: FD's grid and LU; MTPT's pairs at its
+    largest step, N^2 / 2 x the share of the square omega^2 its cut-off ellipse covers; PT's chunk."""
+    from ..core.plane import fd_bytes
+    from ..numerics.particles2d import EXCHANGE_CUTOFF_SIGMAS, KDE_CHUNK_PAIRS
+
+    if cfg.method == "fd":
+        return fd_bytes(cfg.n)
+    n = float(cfg.n)
+    if cfg.method == "pt":
+        return PLANE_PARTICLE_BYTES * n + KDE_PAIR_BYTES * KDE_CHUNK_PAIRS
+    from ..core.timegrid import time_steps
+
+    dt = float(max(time_steps(cfg.t_final, cfg.dt0, cfg.dt_growth, cfg.time_grid)))
+    det = float(np.linalg.det(cfg.eta * np.asarray(cfg.D, dtype=np.float64)))
+    # the cut-off k sd of the kernel of covariance 4 eta D dt: an ellipse of area pi k^2 4 dt sqrt(det)
+    area = math.pi * EXCHANGE_CUTOFF_SIGMAS**2 * 4.0 * dt * math.sqrt(det)
+    pairs = 0.5 * n * n * min(1.0, area / cfg.omega**2)
+    return PLANE_PARTICLE_BYTES * n + SHEAR_PAIR_BYTES * pairs
 
 
 def estimate_mb(cfg: RunConfig, runs: int = 1) -> int:

@@ -330,7 +330,24 @@ def result_values(numbers: Mapping) -> dict[str, str]:
     sweep = numbers.get("sweep") or []
     if sweep:
         out["scenes.sweep_target"] = target(sweep[0]["measure"], sweep[0]["target"])
+    ratio = orientation_cost(numbers)
+    if ratio is not None:
+        out["scenes.orientation_cost"] = f"{ratio:.2g}"
     return out
+
+
+ORIENTED = ("plume2d", "oblique")  # the shipped 2-D pair: one plume along the grid and at 45 degrees to it
+
+
+def orientation_cost(numbers: Mapping) -> float | None:
+    """The counted cost of oblique's answer over plume2d's (ORIENTED): what carrying the same plume at
+    45 degrees to the grid costs the cheapest model; None unless both scenes have an answer."""
+    cost = {}
+    for s in numbers.get("scenes", []):
+        chosen = [c for c in s["candidates"] if c["recommended"]]
+        if s["scene"] in ORIENTED and chosen:
+            cost[s["scene"]] = chosen[0]["answer"]["cost_s"]
+    return cost[ORIENTED[1]] / cost[ORIENTED[0]] if len(cost) == 2 else None
 
 
 def result_blocks(numbers: Mapping) -> dict[str, str]:
