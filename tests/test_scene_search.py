@@ -553,8 +553,6 @@ def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path)
     """A tiny real scene: every rung of every candidate run with all its seed blocks (run_seeds), read
     back as the workflow reads its tables (read_runs); the search replayed on those rows at targets
     across the errors' range answers as brute force on the same rows does."""
-    from particle_entropy.core.io import write_parquet
-    from particle_entropy.models.simulate import run_seeds
 
     spec = {
         "D": 1e-3,
@@ -568,6 +566,18 @@ def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path)
         ],
     }
     scene = Scene.from_config("tiny", spec)
+    by_seed = _whole_ladder(scene, tmp_path)
+    assert len(by_seed) == 4 + 4 * scene.max_realisations
+    checked, refined = _replayed_against_brute_force(scene, by_seed, 25)
+    assert len(checked) >= 5 and refined > 0  # the targets reach several answers, and seed blocks
+
+
+def _whole_ladder(scene, tmp_path) -> dict:
+    """Every rung of every candidate run with all its seed blocks (run_seeds), written and read back as
+    the workflow reads its tables (read_runs): (candidate, n, seed) -> that run's row."""
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.models.simulate import run_seeds
+
     rows, paths = [], []
     for ci, cand in enumerate(scene.candidates):
         for n in cand.ladder():
@@ -578,8 +588,12 @@ def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path)
                 rows.append({"candidate": ci, "n": n, "first": first, "last": last})
                 paths.append(str(path))
     every = S.read_runs(pd.DataFrame(rows), paths)
-    assert len(every) == 4 + 4 * scene.max_realisations
-    by_seed = {(int(r.candidate), int(r.n), int(r.seed)): r._asdict() for r in every.itertuples(index=False)}
+    return {(int(r.candidate), int(r.n), int(r.seed)): r._asdict() for r in every.itertuples(index=False)}
+
+
+def _replayed_against_brute_force(scene, by_seed: dict, targets: int) -> tuple[set, int]:
+    """The search replayed on ``by_seed``'s rows at ``targets`` targets across their errors' range, each
+    answer asserted equal to brute force's on the same rows -> (answers reached, rungs refined)."""
 
     def runs(plan, law=None):
         return pd.DataFrame(
@@ -594,8 +608,9 @@ def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path)
         return S.error(scene, by_seed[ci, n, seed])
 
     errors = sorted({law(ci, n, s) for ci, n, s in by_seed})
+    assert errors[0] > 0 and np.isfinite(errors).all()
     checked, refined = set(), 0
-    for value in np.quantile(errors, np.linspace(0.02, 0.98, 25)):
+    for value in np.quantile(errors, np.linspace(0.02, 0.98, targets)):
         at = replace(scene, value=float(value))
         plan = S.next_plan(at, None, None, 0)
         while not plan["done"].all():
@@ -605,7 +620,7 @@ def test_a_real_scenes_whole_ladder_replayed_gives_brute_forces_answer(tmp_path)
         assert {ci: (None if m is None else int(m)) for ci, m in mine.items()} == _brute_force(at, law)
         checked.update((ci, m) for ci, m in mine.items())
         refined += int((out["realisations"] > at.realisations).sum())
-    assert len(checked) >= 5 and refined > 0  # the targets reach several answers, and seed blocks
+    return checked, refined
 
 
 def test_only_rungs_that_can_still_be_the_answer_are_refined():
@@ -739,8 +754,6 @@ def test_a_2d_scene_s_whole_ladder_replayed_gives_brute_forces_answer(tmp_path):
     """A tiny 2-D scene (issue 52: a Gaussian carried at 30 degrees, D_L = 5 D_T): every rung of FD TVD,
     MTPT and PT run with all their seed blocks, read back as the workflow reads them; the search
     replayed at targets across the errors' range answers as brute force on the same rows does."""
-    from particle_entropy.core.io import write_parquet
-    from particle_entropy.models.simulate import run_seeds
 
     theta = math.radians(30.0)
     spec = {
@@ -759,40 +772,5 @@ def test_a_2d_scene_s_whole_ladder_replayed_gives_brute_forces_answer(tmp_path):
     }
     scene = Scene.from_config("tiny2d", spec)
     assert scene.dim == 2 and scene.n_points == 225
-    rows, paths = [], []
-    for ci, cand in enumerate(scene.candidates):
-        for n in cand.ladder():
-            for block in range(S._blocks(scene, cand)):
-                first, last = S.seeds(scene, cand, 0, block)
-                path = tmp_path / f"{ci}-{n}-{first}.parquet"
-                write_parquet(run_seeds(scene.run_config(cand, n), range(first, last + 1)), path)
-                rows.append({"candidate": ci, "n": n, "first": first, "last": last})
-                paths.append(str(path))
-    every = S.read_runs(pd.DataFrame(rows), paths)
-    by_seed = {(int(r.candidate), int(r.n), int(r.seed)): r._asdict() for r in every.itertuples(index=False)}
-
-    def runs(plan, law=None):
-        return pd.DataFrame(
-            [
-                {**by_seed[int(r.candidate), int(r.n), s], "half_step": r.half_step}
-                for r in plan.itertuples()
-                for s in range(r.first, r.last + 1)
-            ]
-        )
-
-    def law(ci, n, seed):
-        return S.error(scene, by_seed[ci, n, seed])
-
-    errors = sorted({law(ci, n, s) for ci, n, s in by_seed})
-    assert errors[0] > 0 and np.isfinite(errors).all()
-    checked = set()
-    for value in np.quantile(errors, np.linspace(0.02, 0.98, 15)):
-        at = replace(scene, value=float(value))
-        plan = S.next_plan(at, None, None, 0)
-        while not plan["done"].all():
-            plan = S.next_plan(at, plan, runs(plan), 0)
-        out = S.result(at, S.judged(at, runs(plan)))
-        mine = {ci: (g.loc[g["meets"], "n"].min() if g["meets"].any() else None) for ci, g in out.groupby("candidate")}
-        assert {ci: (None if m is None else int(m)) for ci, m in mine.items()} == _brute_force(at, law)
-        checked.update((ci, m) for ci, m in mine.items())
+    checked, _ = _replayed_against_brute_force(scene, _whole_ladder(scene, tmp_path), 15)
     assert len(checked) >= 5  # the targets reach several answers
