@@ -121,9 +121,10 @@ def scene(table: pd.DataFrame, maps=None):
             label=f"COMIC-best: {r['label']}, n = {r['n']:,}",
         )
     _say_what_is_not_drawn(ax, table, drawable, target)  # before the log scales: limits they can take
-    style_axes(
-        ax, "a", f"scene {name}: error against cost", MEASURE_LABEL[measure], "counted cost of one run [s]", logx=True
-    )
+    label = MEASURE_LABEL[measure]
+    if maps is not None:  # a 2-D scene's concentrations are per area
+        label = label.replace("[1/L]", "[1/L²]")
+    style_axes(ax, "a", f"scene {name}: error against cost", label, "counted cost of one run [s]", logx=True)
     ax.set_yscale("log")
     if not reactive:
         style_axes(
