@@ -14,9 +14,10 @@ give them on the line; their steps are the shared ones (models/simulate.py runs 
 Measures (a row's columns as on the line): H_C = -sum p ln p of the masses (nodes, particles, or PT's
 estimate on MEASURE_GRID^2 cells over the plume), dV the cell or sampling area [L^2], H_I = H_C +
 ln dV, E = exp(H_I) [L^2] (Eq. 8), and the SSE of the concentration at the scene's 15 x 15 points
-(Reference2D.points) against the exact one [L^-4]. MTPT's SSE and PT's H_C and SSE are computed at
-the last step only (a triangulation or a kernel sum each: NaN before); FD's and MTPT's H_C at every
-step. PT's mass is its N particles' of 1 / N, 1 whatever the estimate's cells hold.
+(Reference2D.points) against the exact one [L^-4]. The SSE, PT's H_C and the exact solution's H_C and
+E are computed at the last step only (a triangulation, a kernel sum, a box's entropy quadrature:
+NaN before); FD's and MTPT's H_C at every step. PT's mass is its N particles' of 1 / N, 1
+whatever the estimate's cells hold.
 """
 
 from __future__ import annotations
@@ -69,10 +70,10 @@ def bilinear(g, c: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.where(inside, out, 0.0)
 
 
-def fd_measure(cfg, g, c: np.ndarray, t: float) -> dict:
-    """H_C of the node masses c dx dy (Eq. 7 with dV = dx dy), E, and the SSE at the points."""
+def fd_measure(cfg, g, c: np.ndarray, t: float, last: bool) -> dict:
+    """H_C of the node masses c dx dy (Eq. 7 with dV = dx dy), E, and at the last step the SSE at the points."""
     dV = g.dx * g.dy
-    return _row(cfg, c.ravel() * dV, dV, t, lambda points: bilinear(g, c, points))
+    return _row(cfg, c.ravel() * dV, dV, t, (lambda points: bilinear(g, c, points)) if last else None)
 
 
 # ------------------------------------------------------------------------------------------ MTPT
@@ -170,7 +171,9 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
         "mass_total": total,
         "mass_min": float(masses.min()),
     }
-    if at_points is not None and t > 0:
+    if at_points is None:  # the exact H_I of a box is a quadrature (up to seconds): at the judged step only
+        return row
+    if t > 0:
         points = cfg.points(t)
         row["SSE_points"] = M.sse(at_points(points), ref.density(points))
         row["COMIC_points"] = M.comic(row["SSE_points"], len(points), dV)  # Eq. 43 at the points

@@ -297,13 +297,13 @@ def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict
     g, c = plane.fd_start(cfg)
     solvers: dict = {}
     extra = {"beta": 0.0, "h": g.dx, "substeps": 1}
-    rows.add(0, 0.0, 0.0, {**plane.fd_measure(cfg, g, c, 0.0), **extra})
+    rows.add(0, 0.0, 0.0, {**plane.fd_measure(cfg, g, c, 0.0, False), **extra})
     state = c[None]
     for k, dt in enumerate(dts, start=1):
         if dt not in solvers:
             solvers[dt] = plane.fd_solver(cfg, g, dt)
         transport(solvers[dt], state)
-        rows.add(k, ts[k], dt, {**plane.fd_measure(cfg, g, c, ts[k]), **extra})
+        rows.add(k, ts[k], dt, {**plane.fd_measure(cfg, g, c, ts[k], k == len(dts)), **extra})
     x, y = g.nodes()
     gx, gy = np.meshgrid(x, y, indexing="ij")
     return {"x": gx.ravel(), "y": gy.ravel(), "c": c.ravel()}
