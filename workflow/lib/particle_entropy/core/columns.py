@@ -30,6 +30,9 @@ CASE_COLUMN_DOCS = {  # case.CASE_COLUMNS
     "time_grid": "particle time grid: `exact` (the last step shortened to end at t_final) or `authors` (whole "
     "growing steps while t < t_final, as the authors' code); FD always `exact`",
 }
+# per-step columns only a 2-D run writes (models/simulate.py's plane runners): a 1-D table keeps its bytes
+PLANE_ONLY_COLUMNS = ("neighbours",)
+
 RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "step": "time-step index, 0 = initial condition",
     "time": "time at the end of the step [T]",

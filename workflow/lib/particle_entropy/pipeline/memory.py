@@ -36,9 +36,6 @@ def estimate_bytes(cfg: RunConfig) -> float:
 # solve falls back to); MTPT its pairs within the cut-off (numbers as the shear flow's, SHEAR_*);
 # PT its kernel estimate's chunk of (point, particle) pairs (particles2d.KDE_CHUNK_PAIRS)
 PLANE_PARTICLE_BYTES = 400.0
-# numba compiling the plane's loops (pair kernels, the stencil's BiCGSTAB) where its cache is cold: a
-# 2-D FD or MTPT run peaked 66 MB higher in a fresh cache (409 MB against 343 MB at n = 256)
-PLANE_COMPILE_BYTES = 100e6
 KDE_PAIR_BYTES = 64.0  # measured: 32,000 particles on 128 x 128 points peaked at 367 MB
 
 
@@ -49,7 +46,7 @@ def plane_bytes(cfg: RunConfig) -> float:
     from ..numerics.particles2d import EXCHANGE_CUTOFF_SIGMAS, KDE_CHUNK_PAIRS
 
     if cfg.method == "fd":
-        return PLANE_COMPILE_BYTES + fd_bytes(cfg.n)
+        return fd_bytes(cfg.n)
     n = float(cfg.n)
     if cfg.method == "pt":
         return PLANE_PARTICLE_BYTES * n + KDE_PAIR_BYTES * KDE_CHUNK_PAIRS
@@ -60,7 +57,7 @@ def plane_bytes(cfg: RunConfig) -> float:
     # the cut-off k sd of the kernel of covariance 4 eta D dt: an ellipse of area pi k^2 4 dt sqrt(det)
     area = math.pi * EXCHANGE_CUTOFF_SIGMAS**2 * 4.0 * dt * math.sqrt(det)
     pairs = 0.5 * n * n * min(1.0, area / cfg.omega**2)
-    return PLANE_COMPILE_BYTES + PLANE_PARTICLE_BYTES * n + SHEAR_PAIR_BYTES * pairs
+    return PLANE_PARTICLE_BYTES * n + SHEAR_PAIR_BYTES * pairs
 
 
 def estimate_mb(cfg: RunConfig, runs: int = 1) -> int:
