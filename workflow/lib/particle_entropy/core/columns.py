@@ -83,5 +83,6 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "plume's E above dV",
     "work": "particle-steps (FD node-steps, N + 1 nodes) from t = 0 to this step, substeps counted",
     "wall_s": "wall-clock seconds spent in this step (differs between identical runs) [s]",
-    "peak_rss_mb": "peak resident memory of the process so far (differs between machines and runs) [MB]",
+    "peak_rss_mb": "peak resident memory of the process so far (differs between machines and runs; getrusage's "
+    "ru_maxrss, which Linux carries over exec: at least the peak of the process that started the job) [MB]",
 }
