@@ -724,9 +724,10 @@ SCENE = (
 REACTIVE_COST = {"fd": (1.08, 1.45), "mtpt": (0.902, 1.58), "pt": (0.474, 2.64)}
 # A 2-D scene's default cost model, per method [seconds a step, seconds a unit of work]: work is FD's
 # (n + 1)^2 node-steps and the particles' N particle-steps (core/runcost.units_per_step). Fitted by
-# `python benchmarks/calibrate_scene_costs.py --max-s 10 plume2d oblique` (24 runs at 6 sd MTPT cut-off;
-# Intel Xeon, 2 vCPU, load 0.8-1.5; measured / fitted: medians within 5 % of 1, worst 1.58-2.21).
-PLANE_COST = {"fd": (9.39e-4, 1.00e-7), "mtpt": (0.0, 9.03e-7), "pt": (2.44e-3, 1.39e-6)}
+# `python benchmarks/calibrate_scene_costs.py --max-s 10 plume2d oblique` (24 runs at 6 sd MTPT cut-off,
+# after kde_2d's bounded chunks; Intel Xeon, 2 vCPU, load 0.2; measured / fitted: medians 0.97-1.09, worst
+# 1.33-2.07, the worst FD's n = 32 run, 0.02 s of overhead).
+PLANE_COST = {"fd": (7.27e-4, 1.02e-7), "mtpt": (0.0, 9.89e-7), "pt": (1.57e-3, 4.57e-7)}
 
 
 SCENES_PECLET = (
