@@ -194,12 +194,22 @@ def test_tvd_refuses_a_courant_number_above_1_along_either_axis():
     assert 0.3 * dt / 0.01 == pytest.approx(0.8) and 0.4 * dt / 0.02 < 0.8
 
 
-def test_a_grid_over_a_window_holds_the_path():
-    grid = fd2d.Grid.over((0.0, -1.0), (2.0, 1.0), 100, path=(3.0, -0.5))
+def test_a_run_s_grid_holds_the_window_and_path_with_a_node_on_the_source():
+    """core/plane.grid_span: the window fd_length = 2 around the source at (1, 0), lengthened by the path
+    v t_final = (3, -0.5), over n = 100 intervals a side, shifted by under half a cell to put a node on
+    the source."""
+    from particle_entropy.core.runconfig import RunConfig
+    from particle_entropy.models.plane import fd_grid
+
+    source = {"kind": "gaussian", "x0": [1.0, 0.0], "sd": [0.1, 0.1]}
+    D = [[1e-3, 0.0], [0.0, 1e-3]]
+    grid = fd_grid(RunConfig.of("fd", "implicit", 100, source=source, v=[3.0, -0.5], D=D, t_final=1.0, fd_length=2.0))
     x, y = grid.nodes()
     assert (grid.nx, grid.ny) == (100, 100)
-    assert x[0] == pytest.approx(0.0) and x[-1] == pytest.approx(5.0)
-    assert y[0] == pytest.approx(-1.5) and y[-1] == pytest.approx(1.0)
+    assert grid.dx == pytest.approx(5.0 / 100) and grid.dy == pytest.approx(2.5 / 100)
+    assert np.min(np.abs(x - 1.0)) < 1e-12 and np.min(np.abs(y)) < 1e-12  # a node on the source's centre
+    assert x[0] <= 0.0 + grid.dx / 2 and x[-1] >= 5.0 - grid.dx / 2  # [0, 2] and the path 3 along x
+    assert y[0] <= -1.5 + grid.dy / 2 and y[-1] >= 1.0 - grid.dy / 2  # [-1, 1] and the path -0.5 along y
 
 
 # --- the cross term ----------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 A run is 2-D when its source is a core/sources2d.Source2D. Then ``v`` is (vx, vy) [L/T] and ``D`` the
 dispersion tensor ((Dxx, Dxy), (Dxy, Dyy)) [L^2/T] (from a scene's {L, T} or {x, y}:
 sources2d.dispersion_tensor). The FD window is the square of side fd_length around the source's
-centre, lengthened along each axis by the path v t_final (fd2d.Grid.over); the particles' domain the
+centre, lengthened along each axis by the path v t_final (grid_span); the particles' domain the
 square of side omega around it, so that MTPT's sampling volume is dV = omega^2 / N. What a 2-D run
 cannot do yet is refused here by name: a reaction, MTPT's SPH kernel and the authors' sequential
 loop, PT's bins and fixed kernel, explicit FD.
@@ -76,7 +76,9 @@ def check(cfg) -> None:
     if cfg.method == "mtpt" and cfg.scheme != "symmetric":
         raise SettingError("scheme", cfg.scheme, "symmetric in 2-D (Eqs. 16-21 on the pairs within the cut-off)")
     if cfg.method == "mtpt" and cfg.truncation is not None:
-        raise SettingError("truncation", cfg.truncation, "none in 2-D: the exchange keeps every pair within 9 sd")
+        raise SettingError(
+            "truncation", cfg.truncation, "none in 2-D: the exchange keeps every pair within its cut-off (6 sd)"
+        )
     _check_domains(cfg, D)
     if cfg.method == "fd":
         check_fd_memory(cfg.n)
@@ -96,13 +98,18 @@ def check_physics(cfg) -> np.ndarray:
     return D
 
 
+def source_reach(source) -> np.ndarray:
+    """The source's own half extent along each axis around its centre: 3 sd of its covariance, a box's
+    half side [L] (2,)."""
+    if source.kind == "box":
+        return 0.5 * np.array([np.ptp(source.x), np.ptp(source.y)])
+    return 3.0 * np.sqrt(np.diag(source.covariance))
+
+
 def sd_reach(cfg, D: np.ndarray) -> np.ndarray:
     """The half width each axis of a domain must hold around the source's centre: the source's own
-    half extent (3 sd of its covariance, a box's half side) plus REACH_SDS sd of 2 D t_final [L] (2,)."""
-    own = 3.0 * np.sqrt(np.diag(cfg.source.covariance))
-    if cfg.source.kind == "box":
-        own = 0.5 * np.array([np.ptp(cfg.source.x), np.ptp(cfg.source.y)])
-    return own + REACH_SDS * np.sqrt(np.diag(2.0 * D * cfg.t_final))
+    (source_reach) plus REACH_SDS sd of 2 D t_final [L] (2,)."""
+    return source_reach(cfg.source) + REACH_SDS * np.sqrt(np.diag(2.0 * D * cfg.t_final))
 
 
 def _check_domains(cfg, D: np.ndarray) -> None:
@@ -169,15 +176,14 @@ def courant_step(cfg) -> float:
 
 
 def _check_courant(cfg) -> None:
-    """Refuse a tvd step beyond Courant 1 on either axis (fd2d.courant_number), naming courant or fd_dt."""
-    from .registry import COURANT_LIMIT
+    """Refuse a tvd step beyond Courant 1 on either axis (grid_numbers), naming courant or fd_dt."""
+    from .registry import COURANT_LIMIT, COURANT_SLACK
 
     limit = COURANT_LIMIT.get(cfg.advection)
     if limit is None or not any(cfg.v):
         return
-    _, (dx, dy) = grid_span(cfg)
-    cr = max(abs(cfg.v[0]) * cfg.dt0 / dx, abs(cfg.v[1]) * cfg.dt0 / dy)
-    if cr <= limit * (1.0 + 1e-12):
+    _, cr = grid_numbers(cfg, cfg.dt0)
+    if cr <= limit or math.isclose(cr, limit, rel_tol=COURANT_SLACK):
         return
     name, value = ("courant", cfg.courant) if cfg.courant is not None else ("fd_dt", cfg.dt0)
     raise SettingError(

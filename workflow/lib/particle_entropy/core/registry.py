@@ -95,6 +95,9 @@ SHEAR_CASES = ("rw_nodrift", "rw_drift", "mt")
 # |v| dt / dx of at most COURANT_LIMIT (the implicit two take any).
 ADVECTION_SCHEMES = ("upwind", "central", "tvd")
 COURANT_LIMIT = {"tvd": 1.0}
+# a Courant number within this relative round-off of its limit is the limit: courant dx / |v| read
+# back as |v| dt / dx may differ from courant by an ulp or two
+COURANT_SLACK = 1e-12
 DEFAULT_ADVECTION = ADVECTION_SCHEMES[0]  # a candidate or run in a flow that names none
 # what an adaptive search minimises over N (aggregate.CONVENTIONS) and where it takes SSE (optimum.MEASURES)
 CONVENTION_NAMES = ("mean_COMIC", "COMIC_of_mean_SSE")

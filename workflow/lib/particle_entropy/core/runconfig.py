@@ -15,7 +15,7 @@ from .case import DEFAULT, Case, SettingError, check_range
 from .measures import settling_time
 from .reactions import Reaction
 from .reference import Reference
-from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, DEFAULT_ADVECTION, DEFAULT_KERNEL
+from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, COURANT_SLACK, DEFAULT_ADVECTION, DEFAULT_KERNEL
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .sources import Source, source_names
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
@@ -25,9 +25,6 @@ PAPER_SOURCE = Source.of("point", x0=0.0)  # the paper's delta at x = 0
 # an interior node on either side. With 2 the one interior node's neighbours are both zero ends: its
 # mass only drains into them (5 % by t = 1000 at the paper's settings) and never spreads (H_C stays 0).
 FD_MIN_INTERVALS = 4
-# a Courant number within this relative round-off of its limit is the limit: courant dx / |v| read
-# back as |v| dt / dx may differ from courant by an ulp or two
-COURANT_SLACK = 1e-12
 
 
 def check_setting(setting: Setting, value):

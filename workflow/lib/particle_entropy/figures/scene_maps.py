@@ -6,7 +6,7 @@ drawn over both, so that a reader sees where the model departs from it.
 The model is the recommended candidate at its recommended rung, run once more on the scene's first
 seed (base_seed) for its final state (``model_run``: the scene's runs keep no state); when nothing
 is recommended, the cheapest candidate's best rung (``map_row``), its panel saying so. Its
-concentration on the grid is the one its run is scored with (``concentration``): FD's nodes
+concentration on the grid is the one its run is scored with (``concentration``, models/plane.at_points): FD's nodes
 bilinearly interpolated (models/plane.bilinear), MTPT's m / dV on its particles' triangles
 (particles2d.mtpt_concentration_2d), PT's kernel estimate with H = N^(-1/3) Sigma (models/plane.pt_bandwidth).
 """
@@ -105,22 +105,11 @@ def grid_points(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def concentration(cfg, state: pd.DataFrame, points: np.ndarray) -> np.ndarray:
-    """A 2-D run's concentration at ``points`` (M, 2) from its final ``state``, as its run scores it."""
-    if cfg.method == "fd":
-        from ..models.plane import bilinear, fd_grid
+    """A 2-D run's concentration at ``points`` (M, 2) from its final ``state``, as its run scores it
+    (models/plane.at_points)."""
+    from ..models.plane import at_points
 
-        g = fd_grid(cfg)
-        c = state["c"].to_numpy(float).reshape(g.nx + 1, g.ny + 1)
-        return bilinear(g, c, points)
-    x = state[["x", "y"]].to_numpy(float)
-    if cfg.method == "mtpt":
-        from ..numerics.particles2d import mtpt_concentration_2d
-
-        return mtpt_concentration_2d(points, x, state["mass"].to_numpy(float), cfg.dV)
-    from ..models.plane import pt_bandwidth
-    from ..numerics.particles2d import kde_2d
-
-    return kde_2d(points, x, pt_bandwidth(cfg, cfg.t_final))
+    return at_points(cfg, state)(points)
 
 
 def draw_maps(axes, cax, scene, run: ModelRun | None, nodes: int = MAP_NODES) -> Maps:

@@ -17,7 +17,8 @@ import math
 import numpy as np
 
 from ..core import measures as M
-from ..core.runconfig import COURANT_SLACK, RunConfig
+from ..core.registry import COURANT_SLACK
+from ..core.runconfig import RunConfig
 from ..numerics.compiled import kernels
 from .conservation import MassError
 

@@ -68,7 +68,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..core.runconfig import COURANT_SLACK
+from ..core.registry import COURANT_SLACK
 from ..numerics.compiled import kernels
 from . import fd
 from .conservation import MassError
@@ -105,15 +105,6 @@ class Grid:
     dy: float
     nx: int
     ny: int
-
-    @classmethod
-    def over(cls, lo, hi, n: int, path=(0.0, 0.0)) -> Grid:
-        """An n x n grid over the window [lo, hi] (2 corners) lengthened along each axis by the
-        plume's path v t_final, as fd.py's fd_span does in 1-D."""
-        lo, hi, path = (np.asarray(a, dtype=float) for a in (lo, hi, path))
-        start = lo + np.minimum(path, 0.0)
-        length = hi - lo + np.abs(path)
-        return cls(float(start[0]), float(start[1]), float(length[0] / n), float(length[1] / n), n, n)
 
     def nodes(self) -> tuple[np.ndarray, np.ndarray]:
         """The node coordinates along x (nx + 1) and along y (ny + 1) [L]."""

@@ -70,10 +70,15 @@ def bilinear(g, c: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.where(inside, out, 0.0)
 
 
+def fd_at(g, c: np.ndarray):
+    """FD's concentration at points (M, 2), as its run is scored: the nodes bilinearly interpolated."""
+    return lambda points: bilinear(g, c, points)
+
+
 def fd_measure(cfg, g, c: np.ndarray, t: float, last: bool) -> dict:
     """H_C of the node masses c dx dy (Eq. 7 with dV = dx dy), E, and at the last step the SSE at the points."""
     dV = g.dx * g.dy
-    return _row(cfg, c.ravel() * dV, dV, t, (lambda points: bilinear(g, c, points)) if last else None)
+    return _row(cfg, c.ravel() * dV, dV, t, fd_at(g, c) if last else None)
 
 
 # ------------------------------------------------------------------------------------------ MTPT
@@ -106,12 +111,17 @@ def mtpt_step(cfg, x, m, dt: float, rng):
     return x, done.mass, done.mean_neighbours, done.substeps
 
 
-def mtpt_measure(cfg, x, m, t: float, last: bool) -> dict:
-    """H_C of the masses (dV = Omega^2 / N), E and, at the last step, the SSE at the points (m / dV
-    on the particles' triangles, particles2d.mtpt_concentration_2d)."""
+def mtpt_at(cfg, x, m):
+    """MTPT's concentration at points (M, 2), as its run is scored: m / dV on the particles' triangles
+    (particles2d.mtpt_concentration_2d)."""
     from ..numerics.particles2d import mtpt_concentration_2d
 
-    return _row(cfg, m, cfg.dV, t, (lambda points: mtpt_concentration_2d(points, x, m, cfg.dV)) if last else None)
+    return lambda points: mtpt_concentration_2d(points, x, m, cfg.dV)
+
+
+def mtpt_measure(cfg, x, m, t: float, last: bool) -> dict:
+    """H_C of the masses (dV = Omega^2 / N), E and, at the last step, the SSE at the points (mtpt_at)."""
+    return _row(cfg, m, cfg.dV, t, mtpt_at(cfg, x, m) if last else None)
 
 
 # -------------------------------------------------------------------------------------------- PT
@@ -124,7 +134,7 @@ def pt_step(cfg, x, dt: float, rng) -> np.ndarray:
     """Carried by v dt and walked with D (models/walk.py)."""
     from .walk import walk
 
-    return walk(x + np.asarray(cfg.v) * dt, np.asarray(cfg.D)[None], dt, rng)
+    return walk(x, np.asarray(cfg.D)[None], dt, rng, v=np.asarray(cfg.v))
 
 
 def pt_bandwidth(cfg, t: float) -> np.ndarray:
@@ -134,24 +144,42 @@ def pt_bandwidth(cfg, t: float) -> np.ndarray:
     return plume_bandwidth_2d(cfg.n, cfg.reference(t).covariance)
 
 
+def pt_at(cfg, x, t: float):
+    """PT's concentration at points (M, 2) at time t, as its run is scored: the kernel estimate with
+    H = pt_bandwidth (particles2d.kde_2d)."""
+    from ..numerics.particles2d import kde_2d
+
+    H = pt_bandwidth(cfg, t)
+    return lambda points: kde_2d(points, x, H)
+
+
+def at_points(cfg, state):
+    """A finished 2-D run's concentration at points (M, 2) from its final state (models/simulate.py's
+    columns x, y and c or mass), by the rule its run was scored with (fd_at, mtpt_at, pt_at)."""
+    if cfg.method == "fd":
+        g = fd_grid(cfg)
+        return fd_at(g, np.asarray(state["c"], dtype=np.float64).reshape(g.nx + 1, g.ny + 1))
+    x = np.column_stack([np.asarray(state["x"], dtype=np.float64), np.asarray(state["y"], dtype=np.float64)])
+    if cfg.method == "mtpt":
+        return mtpt_at(cfg, x, np.asarray(state["mass"], dtype=np.float64))
+    return pt_at(cfg, x, cfg.t_final)
+
+
 def pt_measure(cfg, x, t: float, last: bool) -> dict:
     """At the last step: the kernel estimate on MEASURE_GRID^2 cells over +- PT_REACH sd of the plume
     (H_C of its cell masses, dV the cell area) and at the points; before it only the mass."""
     mass = {"beta": 0.0, "substeps": 1, "mass_total": 1.0, "mass_min": 1.0 / x.shape[0]}  # N particles of 1 / N
     if not last:
         return {**_row(cfg, np.ones(1), math.nan, t, None, entropy=False), "h": math.nan, **mass}
-    from ..numerics.particles2d import kde_2d
-
     H = pt_bandwidth(cfg, t)
     ref = cfg.reference(t)
     half = PT_REACH * np.sqrt(np.diag(ref.covariance + H))
     ticks = [np.linspace(-h, h, MEASURE_GRID) for h in half]
     dV = float((ticks[0][1] - ticks[0][0]) * (ticks[1][1] - ticks[1][0]))
     gx, gy = np.meshgrid(*ticks, indexing="ij")
-    cells = ref.centre + np.column_stack([gx.ravel(), gy.ravel()])
-    c = kde_2d(cells, x, H)
-    row = _row(cfg, c * dV, dV, t, lambda points: kde_2d(points, x, H))
-    return {**row, "h": math.sqrt(P.major(H)), **mass}
+    at = pt_at(cfg, x, t)
+    c = at(ref.centre + np.column_stack([gx.ravel(), gy.ravel()]))
+    return {**_row(cfg, c * dV, dV, t, at), "h": math.sqrt(P.major(H)), **mass}
 
 
 # ------------------------------------------------------------------------------------- the row
@@ -160,7 +188,6 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
     ``at_points(points)`` (NaN without it), the exact solution's, the total and least mass."""
     total = float(masses.sum())
     h_c = M.entropy_discrete(masses / total) if entropy and total > 0 else math.nan
-    ref = cfg.reference(t)
     row = {
         "H_C": h_c,
         "H_I": h_c + math.log(dV) if entropy else math.nan,
@@ -173,6 +200,7 @@ def _row(cfg, masses: np.ndarray, dV: float, t: float, at_points, entropy: bool 
     }
     if at_points is None:  # the exact H_I of a box is a quadrature (up to seconds): at the judged step only
         return row
+    ref = cfg.reference(t)
     if t > 0:
         points = cfg.points(t)
         row["SSE_points"] = M.sse(at_points(points), ref.density(points))

@@ -411,7 +411,7 @@ class Scene:
     @classmethod
     def _in_plane(cls, name: str, s, key, case_defaults: Mapping | None) -> Scene:
         """A 2-D scene (issue 52): v [vx, vy], D {L, T} or {x, y}, a 2-D source; its domains the source's
-        extent plus ``margin`` sd of 2 D t_final along each axis (core/plane.sd_reach), every candidate's
+        extent plus ``margin`` sd of 2 D t_final along each axis (core/plane.source_reach), every candidate's
         runs checked at both ends of its ladder (core/plane.check)."""
         _check_plane_keys(s, key)
         if s.reaction is not None:
@@ -429,9 +429,8 @@ class Scene:
             where = str(e).split(":", 1)[0]
             raise SettingError(key(where if where.startswith("D") else "D"), s.D.tensor_spec(), str(e)) from None
         t_final, r = s.t_final, s.realisations
-        probe = RunConfig.of("fd", "implicit", 4, source=source, D=D, v=v, t_final=t_final)
-        own = plane.sd_reach(probe, np.asarray(D)) - plane.REACH_SDS * np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))
-        span = 2.0 * float(np.max(own + s.margin * np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))))
+        sd = np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))  # of 2 D t_final along each axis
+        span = 2.0 * float(np.max(plane.source_reach(source) + s.margin * sd))
         omega = span if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         cands = tuple(
