@@ -312,17 +312,19 @@ def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict
 def _run_plane_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     """MTPT in the plane: carried, walked with (1 - eta) D and exchanged with eta D each step (models/plane.py)."""
     from ..core.plane import major
+    from ..numerics.particles2d import COLLISION_BETA
     from . import plane
 
     rng = cfg.rng()
     x, m = plane.particles_start(cfg, rng)
     start = {"beta": 0.0, "h": 0.0, "neighbours": 0.0, "substeps": 1}
     rows.add(0, 0.0, 0.0, {**plane.mtpt_measure(cfg, x, m, 0.0, False), **start})
+    d_major = major(cfg.D)  # the kernel's sd along D's major axis is sqrt(4 eta D_L dt)
     for k, dt in enumerate(dts, start=1):
         x, m, neighbours, sub = plane.mtpt_step(cfg, x, m, dt, rng)
         meas = plane.mtpt_measure(cfg, x, m, ts[k], k == len(dts))
-        h = math.sqrt(4.0 * cfg.eta * major(cfg.D) * dt)  # the kernel's sd along D's major axis
-        rows.add(k, ts[k], dt, {**meas, "beta": 0.5, "h": h, "neighbours": neighbours, "substeps": sub})
+        h = math.sqrt(4.0 * cfg.eta * d_major * dt)
+        rows.add(k, ts[k], dt, {**meas, "beta": COLLISION_BETA, "h": h, "neighbours": neighbours, "substeps": sub})
     return {"x": x[:, 0], "y": x[:, 1], "mass": m, "c": m / cfg.dV}
 
 
