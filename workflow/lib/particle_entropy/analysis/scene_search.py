@@ -129,12 +129,8 @@ def unscored(scene: Scene, row) -> str:
             f"minimum {row['mass_min']:.3g} of the total"
         )
         if scene.candidates[int(row["candidate"])].case.method == "fd" and scene.speed != 0.0:
-            if scene.dim == 2:
-                cfg = scene.run_config(scene.candidates[int(row["candidate"])], int(row["n"]))
-                peclet, courant = plane.grid_numbers(cfg, row["negative_dt"])
-            else:
-                dx = row["dV"]
-                peclet, courant = abs(scene.v) * dx / scene.D, abs(scene.v) * row["negative_dt"] / dx
+            cand = scene.candidates[int(row["candidate"])]
+            peclet, courant = grid_numbers(scene, cand, int(row["n"]), row["negative_dt"])
             why += f"; grid Peclet {peclet:.3g}{' > 2' if peclet > 2 else ''}, Courant {courant:.3g}"
         return why
     for name, lost in conserved_losses(row).items():
@@ -633,15 +629,16 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
 FAMILIES = {"fd": "grid (best FD)", "pt": "particles (best PT or MTPT)", "mtpt": "particles (best PT or MTPT)"}
 
 
-def grid_numbers(scene: Scene, candidate: Candidate, n: int) -> tuple[float, float]:
-    """(grid Peclet |v| dx / D, Courant |v| dt / dx) of an FD candidate's rung n in a flow; NaN, NaN for
-    particles and at rest."""
+def grid_numbers(scene: Scene, candidate: Candidate, n: int, dt: float | None = None) -> tuple[float, float]:
+    """(grid Peclet |v| dx / D, Courant |v| dt / dx) of an FD candidate's rung n in a flow at its step dt
+    (default its first, dt0); NaN, NaN for particles and at rest."""
     if candidate.case.method != "fd" or scene.speed == 0.0:
         return math.nan, math.nan
     cfg = scene.run_config(candidate, n)
+    dt = cfg.dt0 if dt is None else dt
     if scene.dim == 2:  # along the axis where each is largest (core/plane.grid_numbers)
-        return plane.grid_numbers(cfg, cfg.dt0)
-    return abs(scene.v) * cfg.fd_dx / scene.D, cfg.courant_number()
+        return plane.grid_numbers(cfg, dt)
+    return abs(scene.v) * cfg.fd_dx / scene.D, abs(scene.v) * dt / cfg.fd_dx
 
 
 def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
