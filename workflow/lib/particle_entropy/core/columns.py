@@ -32,6 +32,8 @@ CASE_COLUMN_DOCS = {  # case.CASE_COLUMNS
 }
 # per-step columns only a 2-D run writes (models/simulate.py's plane runners): a 1-D table keeps its bytes
 PLANE_ONLY_COLUMNS = ("neighbours",)
+# per-step columns only a run with a continuous release writes (RunConfig.release): others keep their bytes
+RELEASE_ONLY_COLUMNS = ("mass_released", "mass_outflow")
 
 RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "step": "time-step index, 0 = initial condition",
@@ -67,8 +69,17 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "COMIC_points": "2 ln(SSE_points / 15) - ln dV, Eq. 43 at the measurement points, same dV as `COMIC` (-inf for "
     "SSE_points = 0)",
     "dV": "sampling volume: Ω / N for particles, dx for FD; in 2-D an area: Ω² / N, dx dy, PT's estimate's cell [L]",
-    "mass_total": "total mass (1 at t = 0; PT always 1)",
-    "mass_min": "smallest particle or node mass (PT: 1/N)",
+    "mass_total": "total mass held (1 at t = 0; PT always 1). With a continuous release: the mass held, 0 at "
+    "t = 0; PT's is m_p times the particles released by then, within m_p / 2 of `mass_released`",
+    "mass_min": "smallest particle or node mass (PT: 1/N; with a release m_p, NaN while none is released)",
+    "mass_released": "with a continuous release only: the mass released by this time, q times the overlap of "
+    "[0, t] with [t0, t1] (models/release_step.py); FD's `mass_total` + `mass_outflow` and MTPT's `mass_total` "
+    "equal it to round-off. A release run's entropies are NaN while it holds no mass, and its scores against "
+    "the exact plume (`SSE`, `COMIC`, `SSE_points`, `COMIC_points`, `H_C_analytic`, `E_analytic`) NaN: the "
+    "release's exact reference is not part of the runs (core/released.py)",
+    "mass_outflow": "with a continuous release only: the mass that has left the FD window through its end nodes "
+    "(2-D: its boundary ring) by this time, the sum of each step's flux into them as its mass balance counts it "
+    "(0 for particles)",
     "beta": "mass-transfer coefficient of the step: 1/2 for the collision kernel, 2 η D dt / h² for SPH (Eq. 20); "
     "0 for PT, FD and steps without transfer",
     "h": "width of the step's kernel: MTPT the transfer kernel's standard deviation (collision sqrt(4 η D dt), "

@@ -98,7 +98,9 @@ def sse(model: np.ndarray, reference: np.ndarray) -> float:
 
 
 def _log_mse(sse_value: float, n: int) -> float:
-    return math.log(sse_value) - math.log(n) if sse_value > 0 else -math.inf  # no underflow of SSE / n
+    if not sse_value > 0:  # an exact fit's -inf; an SSE that was not computed (NaN) stays NaN
+        return -math.inf if sse_value == 0 else math.nan
+    return math.log(sse_value) - math.log(n)  # no underflow of SSE / n
 
 
 def aic(sse_value: float, n: int, k: int = 0) -> float:

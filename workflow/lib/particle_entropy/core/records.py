@@ -32,6 +32,8 @@ COLUMNS = (
     "dV",
     "mass_total",
     "mass_min",
+    "mass_released",
+    "mass_outflow",
     "beta",
     "h",
     "neighbours",

@@ -41,6 +41,11 @@ class Reference:
         return self.source.variance + self.spread
 
     @property
+    def kernel_variance(self) -> float:
+        """The variance the particles' bandwidth rules read (h_DE, Eq. 23; h_SPH, Eq. 26): the plume's [L^2]."""
+        return self.variance
+
+    @property
     def centre(self) -> float:
         """The plume's centre of mass, the source's plus v t [L]."""
         return self.source.centre + self.shift

@@ -163,6 +163,11 @@ class Reference2D:
         """Sigma = the source's covariance + 2 D t [L^2]."""
         return self.source.covariance + self.spread
 
+    @property
+    def kernel_covariance(self) -> np.ndarray:
+        """The covariance PT's bandwidth rule reads (particles2d.plume_bandwidth_2d): the plume's [L^2]."""
+        return self.covariance
+
     def density(self, points) -> np.ndarray:
         """c(p, t) at points (M, 2) [1/L^2] (a point source at t = 0, a delta, has none: ValueError)."""
         p = np.atleast_2d(np.asarray(points, dtype=np.float64))
@@ -201,30 +206,41 @@ class Reference2D:
         return math.exp(h) if h > -math.inf else 0.0
 
     def axes(self) -> tuple[np.ndarray, np.ndarray]:
-        """(standard deviations (2,), principal axes as columns (2, 2)) of the plume's covariance, the
-        larger first; the first axis points along v (along +x at v = 0 or across v), the second a
-        quarter turn anticlockwise from it; where the two are equal, along and across v (x and y at v = 0)."""
-        values, vectors = np.linalg.eigh(self.covariance)
-        values, vectors = values[::-1], vectors[:, ::-1]
-        speed = math.hypot(*self.v)
-        toward = self.v / speed if speed > 0 else np.array([1.0, 0.0])
-        if values[0] - values[1] <= 1e-12 * values[0]:
-            first = toward
-        else:
-            first = vectors[:, 0]
-            along = first @ toward
-            if along < 0 or (along == 0 and first[0] + first[1] < 0):
-                first = -first
-        axes = np.column_stack([first, [-first[1], first[0]]])
-        return np.sqrt(np.clip(values, 0.0, None)), axes
+        """(standard deviations (2,), principal axes as columns (2, 2)) of the plume's covariance
+        (principal_axes)."""
+        return principal_axes(self.covariance, self.v)
 
     def points(self, n: int = 15, sds: float = 3.0) -> np.ndarray:
-        """The measurement points (n * n, 2): an n x n lattice along the principal axes of the plume's
-        covariance, +- ``sds`` standard deviations along each, centred on the plume's centre (carried
-        with it), the first axis's index the slower; independent of any model's window [L]."""
-        sd, axes = self.axes()
-        if not sd[1] > 0:
-            raise ValueError("a point source at t = 0 has no spread to lay the measurement lattice over")
-        ticks = np.linspace(-sds, sds, n)
-        a, b = np.meshgrid(ticks * sd[0], ticks * sd[1], indexing="ij")
-        return self.centre + np.outer(a.ravel(), axes[:, 0]) + np.outer(b.ravel(), axes[:, 1])
+        """The measurement points (n * n, 2) over the plume (lattice), carried with it [L]."""
+        return lattice(self.centre, self.covariance, self.v, n, sds)
+
+
+def principal_axes(covariance, v) -> tuple[np.ndarray, np.ndarray]:
+    """(standard deviations (2,), principal axes as columns (2, 2)) of a plume's ``covariance``, the
+    larger first; the first axis points along v (along +x at v = 0 or across v), the second a
+    quarter turn anticlockwise from it; where the two are equal, along and across v (x and y at v = 0)."""
+    values, vectors = np.linalg.eigh(covariance)
+    values, vectors = values[::-1], vectors[:, ::-1]
+    speed = math.hypot(*v)
+    toward = v / speed if speed > 0 else np.array([1.0, 0.0])
+    if values[0] - values[1] <= 1e-12 * values[0]:
+        first = toward
+    else:
+        first = vectors[:, 0]
+        along = first @ toward
+        if along < 0 or (along == 0 and first[0] + first[1] < 0):
+            first = -first
+    axes = np.column_stack([first, [-first[1], first[0]]])
+    return np.sqrt(np.clip(values, 0.0, None)), axes
+
+
+def lattice(centre, covariance, v, n: int = 15, sds: float = 3.0) -> np.ndarray:
+    """The measurement points (n * n, 2): an n x n lattice along the principal axes of the plume's
+    ``covariance`` (principal_axes), +- ``sds`` standard deviations along each, centred on the plume's
+    ``centre`` (carried with it), the first axis's index the slower; independent of any model's window [L]."""
+    sd, axes = principal_axes(covariance, v)
+    if not sd[1] > 0:
+        raise ValueError("a point source at t = 0 has no spread to lay the measurement lattice over")
+    ticks = np.linspace(-sds, sds, n)
+    a, b = np.meshgrid(ticks * sd[0], ticks * sd[1], indexing="ij")
+    return centre + np.outer(a.ravel(), axes[:, 0]) + np.outer(b.ravel(), axes[:, 1])

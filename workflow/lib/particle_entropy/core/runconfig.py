@@ -16,6 +16,7 @@ from .measures import settling_time
 from .reactions import Reaction
 from .reference import Reference
 from .registry import ADVECTION_SCHEMES, COURANT_LIMIT, COURANT_SLACK, DEFAULT_ADVECTION, DEFAULT_KERNEL
+from .release import Release
 from .run_settings import BY_NAME, MAX_SEED, PAPER, Setting
 from .sources import Source, source_names
 from .timegrid import MAX_STEPS, count_text, max_first_step, step_count
@@ -170,6 +171,9 @@ class RunConfig:
     # an operator applied after each transport step (core/reactions.Reaction: its kinetics and B), or None:
     # a conservative run of one species
     reaction: Reaction | None = None
+    # a continuous release of the source's mass (core/release.py: rate q from start to end), or None: the
+    # source's unit mass all at t = 0
+    release: Release | None = None
 
     def __post_init__(self):
         if isinstance(self.source, Mapping):  # as a job's settings carry it: a pair x0 (or x and y) is 2-D
@@ -181,6 +185,11 @@ class RunConfig:
                 object.__setattr__(self, "D", plane.tensor(self.D))
         if isinstance(self.reaction, Mapping):
             object.__setattr__(self, "reaction", Reaction.of(self.reaction))
+        if isinstance(self.release, Mapping):  # a config's {rate, from, until}, or the fields {rate, start, end}
+            spec = self.release
+            object.__setattr__(
+                self, "release", Release.from_spec(spec) if {"from", "until"} & set(spec) else Release(**spec)
+            )
 
     @classmethod
     def of(
@@ -237,12 +246,22 @@ class RunConfig:
         return self.source == PAPER_SOURCE and self.v == 0.0
 
     def reference(self, t: float):
-        """The exact solution at time t that this run is measured against (2-D: core/reference2d.py)."""
+        """The exact solution at time t that this run is measured against (2-D: core/reference2d.py); with a
+        release, its plume's moments without a density (core/released.py: its scores are NaN)."""
+        if self.release is not None:
+            from .released import ReleasedPlume, ReleasedPlume2D
+
+            kind = ReleasedPlume2D if self.dim == 2 else ReleasedPlume
+            return kind(self.source, self.D, self.v, t, self.release, self.t_final)
         if self.dim == 2:
             from .reference2d import Reference2D
 
             return Reference2D(self.source, self.D, self.v, t)
         return Reference(self.source, self.D, self.v, t)
+
+    def mass(self, t: float) -> float:
+        """The run's mass at time t: the source's unit mass, or the mass its release has released by t [M]."""
+        return 1.0 if self.release is None else self.release.mass(t)
 
     def points(self, t: float) -> np.ndarray:
         """The measurement points at time t: the paper's 15 (measures.measurement_points), or a
@@ -330,6 +349,7 @@ class RunConfig:
             )
         if self.dim == 2:  # the plane's own checks (core/plane.py) instead of the line's below
             plane.check(self)
+            self._check_release()
             return
         check_arithmetic(self)
         check_setting(BY_NAME["transfer_method"], self.transfer_method)
@@ -368,6 +388,54 @@ class RunConfig:
                 "transfer_method",
                 self.transfer_method,
                 "auto or direct when truncation is set (taylor and fgt sum the whole Gaussian)",
+            )
+        self._check_release()
+
+    def _check_release(self) -> None:
+        """Refuse a release that is not a Release, that starts before 0 (a run starts empty) or at or after
+        t_final (nothing would enter), that comes with a reaction (a reactive run's rows count its source's
+        unit mass) or with the authors' time grid (whose last step ends past t_final, where a release has
+        stopped)."""
+        if self.release is None:
+            return
+        if not isinstance(self.release, Release):
+            raise SettingError("release", self.release, "a Release (rate, start, end) or None")
+        if not 0.0 <= self.release.start < self.t_final:
+            raise SettingError(
+                "release",
+                self.release,
+                f"a start in [0, t_final = {self.t_final:g}): a run starts empty at t = 0 and ends at t_final",
+            )
+        if self.method != "fd" and self.time_grid == "authors":
+            raise SettingError(
+                "time_grid", self.time_grid, "exact with a release: the authors' last step ends past t_final"
+            )
+        if self.reaction is not None:
+            raise SettingError(
+                "release", self.release, "none in a reactive run: reactions with a release are not built"
+            )
+        if self.method == "mtpt":
+            self._check_release_domain()
+
+    def _check_release_domain(self) -> None:
+        """Refuse an MTPT omega that does not hold a release in a flow: the particles' square moves with v
+        while the source stays, so that by the release's end t_e = min(end, t_final) the source lies
+        |v| t_e behind its centre, with the plume's reach (the source's extent and the spread of 2 D
+        t_final, as the instantaneous run's check) beyond it."""
+        from .released import released_span
+
+        t_e = released_span(self.release, self.t_final, self.t_final)[1]
+        if self.dim == 2:
+            D = np.asarray(self.D, dtype=np.float64)
+            need = 2.0 * float(np.max(plane.sd_reach(self, D) + np.abs(np.asarray(self.v, dtype=np.float64)) * t_e))
+        else:
+            need = 2.0 * (abs(self.v) * t_e + self.source.half_width + math.sqrt(2.0 * self.D * self.t_final))
+        if self.omega < need:
+            raise SettingError(
+                "omega",
+                self.omega,
+                f"a domain >= {need:.6g} for mtpt with a release: its particles move with v while the source "
+                f"stays, |v| t_e behind their centre by the release's end t_e = {t_e:g}, with the plume's reach beyond",
             )
 
     def _check_courant(self) -> None:
@@ -442,7 +510,9 @@ class RunConfig:
         if self.method != "fd" or self.v != 0.0:
             return
         dx = self.fd_span()[1] / self.n
-        spread = self.reference(self.t_final).dilution()
+        # a release's oldest mass, released at its start, has spread the longest
+        age = self.t_final if self.release is None else self.t_final - self.release.start
+        spread = Reference(self.source, self.D, self.v, age).dilution()
         if dx <= spread:
             return
         low = 2.0 * (self.source.half_width + math.sqrt(2.0 * self.D * self.t_final))

@@ -13,11 +13,11 @@ class MassError(ArithmeticError):
     """A model step that did not conserve mass beyond round-off (one line: the mass error)."""
 
 
-def check_particle_mass(total: float, t: float, method: str = "mtpt") -> None:
-    """MassError unless the particles' total mass ``total`` at time t is 1 to within
-    PARTICLE_MASS_TOLERANCE (NaN fails too)."""
-    if not abs(total - 1.0) <= PARTICLE_MASS_TOLERANCE:
+def check_particle_mass(total: float, t: float, method: str = "mtpt", expected: float = 1.0) -> None:
+    """MassError unless the particles' total mass ``total`` at time t is ``expected`` (the unit mass, or a
+    release's mass released by t) to within PARTICLE_MASS_TOLERANCE times max(1, expected) (NaN fails too)."""
+    if not abs(total - expected) <= PARTICLE_MASS_TOLERANCE * max(1.0, expected):
         raise MassError(
-            f"{method} lost mass: total {total:.17g} at t = {t:.6g}, an error of {total - 1.0:.3g} beyond "
+            f"{method} lost mass: total {total:.17g} at t = {t:.6g}, an error of {total - expected:.3g} beyond "
             f"round-off ({PARTICLE_MASS_TOLERANCE:g})"
         )

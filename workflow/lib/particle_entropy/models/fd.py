@@ -63,7 +63,8 @@ def initial_concentration(cfg: RunConfig) -> np.ndarray:
 def transport(solve, rows: np.ndarray) -> None:
     """One transport step of every species row of ``rows`` (species, N + 1) or, on a d-dimensional grid,
     (species, N_1 + 1, ..., N_d + 1), in place: each row's interior by the step's solver ``solve``
-    (``solver``), its boundary nodes held (the zero boundary, or a background's departure from itself)."""
+    (``solver``), its boundary nodes held (the zero boundary, or a background's departure from itself). The
+    solver keeps what its last solve sent out through the boundary, per dx (or cell area), in ``last_outflow``."""
     inner = (slice(1, -1),) * (rows.ndim - 1)
     for row in rows:
         row[inner] = solve.solve(row[inner])
@@ -114,7 +115,8 @@ class ImplicitSolver:
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         out = kernels().thomas_solve(self._inv_piv, self._upper, self.r, c_interior)
         # summing (I - r A) c' = c: sum c - sum c' = r (c'_1 + c'_M), the flux into the zero ends
-        check_balance(c_interior, out, self.r * (out[0] + out[-1]), 1.0 + 4.0 * self.r)
+        self.last_outflow = self.r * (out[0] + out[-1])
+        check_balance(c_interior, out, self.last_outflow, 1.0 + 4.0 * self.r)
         return out
 
 
@@ -145,7 +147,8 @@ class AdvectionSolver:
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         dl, d, du, du2, ipiv, _ = self._factors
         out = kernels().gt_solve(dl, d, du, du2, ipiv, c_interior)
-        check_balance(c_interior, out, self.outflow(out), 1.0 + 4.0 * self.r + 2.0 * abs(self.p))
+        self.last_outflow = self.outflow(out)
+        check_balance(c_interior, out, self.last_outflow, 1.0 + 4.0 * self.r + 2.0 * abs(self.p))
         return out
 
     def outflow(self, c: np.ndarray) -> float:
@@ -208,10 +211,13 @@ class TVDSolver:
         """The advection substep, its mass balanced against the flux through the end faces."""
         out, outflow = advect_tvd(c_interior, self.p)
         check_balance(c_interior, out, outflow, 1.0 + 4.0 * abs(self.p))
+        self._advected_out = outflow
         return out
 
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
-        return self._diffuse.solve(self.advect(c_interior))
+        out = self._diffuse.solve(self.advect(c_interior))
+        self.last_outflow = self._advected_out + self._diffuse.last_outflow
+        return out
 
 
 class ExplicitSolver:
@@ -223,7 +229,8 @@ class ExplicitSolver:
     def solve(self, c_interior: np.ndarray) -> np.ndarray:
         padded = np.concatenate([[0.0], c_interior, [0.0]])
         out = c_interior + self.r * (padded[:-2] - 2.0 * c_interior + padded[2:])
-        check_balance(c_interior, out, self.r * (c_interior[0] + c_interior[-1]), 1.0 + 4.0 * self.r)
+        self.last_outflow = self.r * (c_interior[0] + c_interior[-1])
+        check_balance(c_interior, out, self.last_outflow, 1.0 + 4.0 * self.r)
         return out
 
 

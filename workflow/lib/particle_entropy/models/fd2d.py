@@ -361,6 +361,11 @@ class Solver:
         """The new interior after one step (fd.py's solver interface); the step's Step in ``last``."""
         return self.step(c_interior)[0]
 
+    @property
+    def last_outflow(self) -> float:
+        """The mass per cell area the last step sent into the ring (fd.py's solvers' ``last_outflow``)."""
+        return self.last.outflow
+
 
 def solver(D, v, grid: Grid, dt: float, scheme: str, method: str = "auto", **options) -> Solver:
     """The solver of one step dt on ``grid``'s interior (``method`` and ``options``: Solver's)."""

@@ -18,8 +18,15 @@ from .walk import walk as ito_walk
 def initial_state(cfg: RunConfig, rng: np.random.Generator):
     """N particles on [-Omega/2, Omega/2] around the source carrying its unit mass
     (Source.weighted_particles: a point's on one particle stored first, others' by their density)
-    -> (positions sorted, masses, storage index of each), as sequential.py stores them."""
-    x, m = cfg.source.weighted_particles(cfg.n, cfg.omega, cfg.dV, rng)
+    -> (positions sorted, masses, storage index of each), as sequential.py stores them. With a release
+    the N particles are uniform there and carry nothing yet: its mass enters them step by step
+    (models/release_step.py)."""
+    if cfg.release is not None:
+        centre = cfg.source.centre
+        x = rng.uniform(centre - cfg.omega / 2.0, centre + cfg.omega / 2.0, cfg.n)
+        m = np.zeros(cfg.n)
+    else:
+        x, m = cfg.source.weighted_particles(cfg.n, cfg.omega, cfg.dV, rng)
     order = np.argsort(x, kind="stable")
     return x[order], m[order], order
 
@@ -39,7 +46,9 @@ def kernel_for_step(cfg: RunConfig, dt: float, t_end: float):
         return 0.0, 0.0
     if cfg.kernel == "collision":
         return kernel(cfg.eta, cfg.D, dt)
-    h = h_sph(cfg.n, cfg.omega, cfg.reference(t_end).variance, SCHEME_RECORDS[cfg.scheme].sph_constant)
+    h = h_sph(cfg.n, cfg.omega, cfg.reference(t_end).kernel_variance, SCHEME_RECORDS[cfg.scheme].sph_constant)
+    if h == 0.0:  # a point's release before any of its mass has spread: nothing to transfer yet
+        return 0.0, 0.0
     return kernel(cfg.eta, cfg.D, dt, h)
 
 
@@ -109,8 +118,9 @@ def measure(cfg: RunConfig, x, m, t: float) -> dict:
     the cloud, measures.sse_points)."""
     dV = cfg.dV
     total = float(m.sum())
-    check_particle_mass(total, t)  # a transfer that lost or made mass is a failure, never a score
-    h_d = M.entropy_discrete(m / total)
+    # a transfer that lost or made mass is a failure, never a score; with a release, the mass it released by t
+    check_particle_mass(total, t, expected=cfg.mass(t))
+    h_d = M.entropy_discrete(m / total) if total > 0 else math.nan  # a release's particles before it starts
     ref = cfg.reference(t)
     g = ref.sampled(x, dV)
     c = m / dV

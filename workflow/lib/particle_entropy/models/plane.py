@@ -84,18 +84,30 @@ def fd_measure(cfg, g, c: np.ndarray, t: float, last: bool) -> dict:
 # ------------------------------------------------------------------------------------------ MTPT
 def particles_start(cfg, rng) -> tuple[np.ndarray, np.ndarray]:
     """MTPT's N positions (N, 2), uniform on the square of side Omega around the source, and their
-    masses: the source's density times dV (a point's mass on the particle nearest it), summing to 1."""
+    masses: the source's shape on them (source_weights), summing to 1; with a release none yet (its
+    mass enters them step by step, models/release_step.py)."""
     centre = cfg.source.centre
     x = centre + cfg.omega * (rng.random((cfg.n, 2)) - 0.5)
+    if cfg.release is not None:
+        return x, np.zeros(cfg.n)
+    return x, source_weights(cfg, x)
+
+
+def source_weights(cfg, x) -> np.ndarray:
+    """The source's unit mass on particles at x (N, 2): its density times dV, normalised to 1 (a point's
+    on the particle nearest it)."""
+    from ..core.reference2d import Reference2D
+
+    centre = cfg.source.centre
     if cfg.source.kind == "point":
-        m = np.zeros(cfg.n)
+        m = np.zeros(x.shape[0])
         m[int(np.argmin(np.sum((x - centre) ** 2, axis=1)))] = 1.0
-        return x, m
-    m = cfg.reference(0.0).density(x) * cfg.dV
+        return m
+    m = Reference2D(cfg.source, cfg.D, cfg.v, 0.0).density(x) * cfg.dV
     total = m.sum()
     if not total > 0:
-        raise ValueError(f"none of the {cfg.n} particles lies on the source: raise n or shrink omega")
-    return x, m / total
+        raise ValueError(f"none of the {x.shape[0]} particles lies on the source: raise n or shrink omega")
+    return m / total
 
 
 def mtpt_step(cfg, x, m, dt: float, rng):
@@ -126,7 +138,9 @@ def mtpt_measure(cfg, x, m, t: float, last: bool) -> dict:
 
 # -------------------------------------------------------------------------------------------- PT
 def pt_start(cfg, rng) -> np.ndarray:
-    """PT's N positions (N, 2) drawn from the source."""
+    """PT's N positions (N, 2) drawn from the source; with a release none yet (release_step.Batches)."""
+    if cfg.release is not None:
+        return np.empty((0, 2))
     return cfg.source.positions(cfg.n, rng)
 
 
@@ -137,20 +151,24 @@ def pt_step(cfg, x, dt: float, rng) -> np.ndarray:
     return walk(x, np.asarray(cfg.D)[None], dt, rng, v=np.asarray(cfg.v))
 
 
-def pt_bandwidth(cfg, t: float) -> np.ndarray:
-    """H = N^(-1/3) Sigma(t), the exact plume's covariance (particles2d.plume_bandwidth_2d) [L^2]."""
+def pt_bandwidth(cfg, t: float, n: int | None = None) -> np.ndarray:
+    """H = N^(-1/3) Sigma(t), the exact plume's covariance (particles2d.plume_bandwidth_2d), for ``n``
+    particles (default N); a release's Sigma is its puffs' mean (core/released.py) [L^2]."""
     from ..numerics.particles2d import plume_bandwidth_2d
 
-    return plume_bandwidth_2d(cfg.n, cfg.reference(t).covariance)
+    return plume_bandwidth_2d(cfg.n if n is None else n, cfg.reference(t).kernel_covariance)
 
 
-def pt_at(cfg, x, t: float):
+def pt_at(cfg, x, t: float, mass: float | None = None):
     """PT's concentration at points (M, 2) at time t, as its run is scored: the kernel estimate with
-    H = pt_bandwidth (particles2d.kde_2d)."""
+    H = pt_bandwidth (particles2d.kde_2d), of unit mass, or with a release of the ``mass`` its particles hold."""
     from ..numerics.particles2d import kde_2d
 
-    H = pt_bandwidth(cfg, t)
-    return lambda points: kde_2d(points, x, H)
+    if mass is None:
+        H = pt_bandwidth(cfg, t)
+        return lambda points: kde_2d(points, x, H)
+    H = pt_bandwidth(cfg, t, x.shape[0])
+    return lambda points: mass * kde_2d(points, x, H)
 
 
 def at_points(cfg, state):
@@ -162,22 +180,28 @@ def at_points(cfg, state):
     x = np.column_stack([np.asarray(state["x"], dtype=np.float64), np.asarray(state["y"], dtype=np.float64)])
     if cfg.method == "mtpt":
         return mtpt_at(cfg, x, np.asarray(state["mass"], dtype=np.float64))
-    return pt_at(cfg, x, cfg.t_final)
+    mass = None if cfg.release is None else float(np.sum(state["mass"]))
+    return pt_at(cfg, x, cfg.t_final, mass)
 
 
-def pt_measure(cfg, x, t: float, last: bool) -> dict:
+def pt_measure(cfg, x, t: float, last: bool, m_p: float | None = None) -> dict:
     """At the last step: the kernel estimate on MEASURE_GRID^2 cells over +- PT_REACH sd of the plume
-    (H_C of its cell masses, dV the cell area) and at the points; before it only the mass."""
-    mass = {"beta": 0.0, "substeps": 1, "mass_total": 1.0, "mass_min": 1.0 / x.shape[0]}  # N particles of 1 / N
-    if not last:
+    (H_C of its cell masses, dV the cell area) and at the points; before it only the mass. ``m_p``: a
+    release's particle mass, its particles those released so far; None: N particles of 1 / N."""
+    n = x.shape[0]
+    if m_p is None:
+        mass = {"beta": 0.0, "substeps": 1, "mass_total": 1.0, "mass_min": 1.0 / n}  # N particles of 1 / N
+    else:
+        mass = {"beta": 0.0, "substeps": 1, "mass_total": n * m_p, "mass_min": m_p if n else math.nan}
+    if not last or not n:
         return {**_row(cfg, np.ones(1), math.nan, t, None, entropy=False), "h": math.nan, **mass}
-    H = pt_bandwidth(cfg, t)
+    H = pt_bandwidth(cfg, t, None if m_p is None else n)
     ref = cfg.reference(t)
     half = PT_REACH * np.sqrt(np.diag(ref.covariance + H))
     ticks = [np.linspace(-h, h, MEASURE_GRID) for h in half]
     dV = float((ticks[0][1] - ticks[0][0]) * (ticks[1][1] - ticks[1][0]))
     gx, gy = np.meshgrid(*ticks, indexing="ij")
-    at = pt_at(cfg, x, t)
+    at = pt_at(cfg, x, t, None if m_p is None else n * m_p)
     c = at(ref.centre + np.column_stack([gx.ravel(), gy.ravel()]))
     return {**_row(cfg, c * dV, dV, t, at), "h": math.sqrt(P.major(H)), **mass}
 

@@ -14,14 +14,15 @@ from ..numerics.gauss import gauss_transform
 from .walk import walk
 
 
-def reconstruction_width(cfg: RunConfig, t: float) -> float:
+def reconstruction_width(cfg: RunConfig, t: float, n: int | None = None) -> float:
     """Bin width dx = Omega / N (Eq. 11), fixed kernel sqrt(2 D t_k), or h_DE (Eq. 23) of the plume's
-    variance (the source's plus 2 D t)."""
+    variance (the source's plus 2 D t; a release's puffs' mean, core/released.py) for ``n`` particles
+    (default N)."""
     if cfg.kernel == "bins":
         return cfg.dV
     if cfg.kernel == "fixed":
         return math.sqrt(2.0 * cfg.D * cfg.fixed_kernel_time)
-    return h_de(cfg.n, cfg.reference(t).variance)
+    return h_de(cfg.n if n is None else n, cfg.reference(t).kernel_variance)
 
 
 def bin_density(x: np.ndarray, dx: float, origin: float):
@@ -57,9 +58,10 @@ def bin_origin(cfg: RunConfig, t: float) -> float:
     return cfg.reference(t).centre - cfg.omega / 2.0
 
 
-def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
-    """(points, density, point spacing, width) of the chosen reconstruction at time t."""
-    h = reconstruction_width(cfg, t)
+def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float, n: int | None = None):
+    """(points, density, point spacing, width) of the chosen reconstruction at time t (its width for ``n``
+    particles, default N: reconstruction_width)."""
+    h = reconstruction_width(cfg, t, n)
     if cfg.kernel == "bins":
         pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         return pts, f, h, h
@@ -69,12 +71,23 @@ def reconstruct(cfg: RunConfig, x_sorted: np.ndarray, t: float):
     return pts, kernel_density(pts, x_sorted, h), spacing, h
 
 
-def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
+def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float, m_p: float | None = None) -> dict:
     """Entropies, dilution index and fitness of the reconstruction at time t; SSE_points and
     COMIC_points interpolate the same reconstruction (bin centres or the kernel's grid) to the
-    measurement points (measures.sse_points)."""
+    measurement points (measures.sse_points). ``m_p``: a release's particle mass (models/release_step.py),
+    its particles those released so far (none yet: NaN measures); None: N particles of 1 / N."""
     dV = cfg.dV
-    pts, f, spacing, h = reconstruct(cfg, x_sorted, t)
+    n = cfg.n if m_p is None else x_sorted.size
+    if n == 0:
+        return {
+            **dict.fromkeys(_MEASURED, math.nan),
+            "n_sse": 0,
+            "dV": dV,
+            "mass_total": 0.0,
+            "mass_min": math.nan,
+            **_STEP,
+        }
+    pts, f, spacing, h = reconstruct(cfg, x_sorted, t, n)
     ref = cfg.reference(t)
     points = cfg.points(t)
     if h == 0.0:
@@ -84,7 +97,7 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
         err, n_pts = M.sse(f, ref.sampled(pts, spacing)), pts.size
         err_points = ref.sse_points(points, pts, f, spacing)
     h_c = M.entropy_consistent(h_i, dV)
-    h_d = math.log(cfg.n)  # Eq. 13: equal masses 1/N
+    h_d = math.log(n)  # Eq. 13: equal masses 1/N
     return {
         "H_D": h_d,
         "H_C": h_c,
@@ -98,12 +111,17 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
         "SSE_points": err_points,
         "COMIC_points": M.comic(err_points, points.size, dV),
         "dV": dV,
-        "mass_total": 1.0,
-        "mass_min": 1.0 / cfg.n,
+        "mass_total": 1.0 if m_p is None else n * m_p,
+        "mass_min": 1.0 / cfg.n if m_p is None else m_p,
         "beta": 0.0,
         "h": h,
         "substeps": 1,
     }
+
+
+# a PT row's measured columns, NaN while a release has released no particle
+_MEASURED = ("H_D", "H_C", "H_I", "H_PMF", "E", "SSE", "AIC", "COMIC", "SSE_points", "COMIC_points", "h")
+_STEP = {"beta": 0.0, "substeps": 1}
 
 
 def initial_positions(cfg: RunConfig, rng: np.random.Generator) -> np.ndarray:
@@ -128,15 +146,20 @@ def step(xs: list[np.ndarray], D: float, dt: float, rng: np.random.Generator, v:
     return out
 
 
-def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float) -> dict:
-    """Particle positions, masses and the reconstructed concentration at each particle."""
-    h = reconstruction_width(cfg, t)
+def final_state(cfg: RunConfig, x_sorted: np.ndarray, t: float, m_p: float | None = None) -> dict:
+    """Particle positions, masses and the reconstructed concentration at each particle: the density of unit
+    mass, or with a release's particle mass ``m_p`` the concentration of the mass held (m_p each)."""
+    if m_p is not None and not x_sorted.size:
+        return {"x": x_sorted, "mass": np.empty(0), "c": np.empty(0)}
+    h = reconstruction_width(cfg, t, None if m_p is None else x_sorted.size)
     if cfg.kernel == "bins":
         pts, f = bin_density(x_sorted, h, bin_origin(cfg, t))
         idx = np.floor((x_sorted - pts[0] + 0.5 * h) / h).astype(np.int64)
         c = f[idx]
     else:
         c = kernel_density(x_sorted, x_sorted, h) if h > 0 else np.full(x_sorted.size, np.inf)
+    if m_p is not None:
+        return {"x": x_sorted, "mass": np.full(x_sorted.size, m_p), "c": x_sorted.size * m_p * c}
     return {"x": x_sorted, "mass": np.full(x_sorted.size, 1.0 / cfg.n), "c": c}
 
 

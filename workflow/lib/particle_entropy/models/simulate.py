@@ -19,11 +19,19 @@ node and particle rules (models/reaction_step.py).
   everywhere, as the reference's) and react by the kind's particle rule; C_A and C_C are each
   species' kernel reconstruction (models/pt.py) times its mass.
 
+A run with a continuous release (RunConfig.release, conservative only) starts empty and takes in, each
+step, the mass its source releases over the step (models/release_step.py): FD half of it before the step's
+transport and half after, on the nodes the source covers; MTPT at the step's end, on its particles as the
+exact plume the step's release has become; PT as particles released at their own times within the step,
+each walked from its release on.
+
 A conservative row holds the paper's measures (each model's ``measure``) and the exact solution's; a
-reactive row the masses of A, B and the product made so far, A + C still held (mass_total) and the
-fraction of B + C lost (mass_lost_BC: FD's window ends let both totals out, particles none), and the
-last row also the errors against the scene's reference: the SSE of C_A and of C_C at the scene's
-points (SSE_points, SSE_points_C) and the product mass's relative error (product_error).
+release's row also the mass released so far and, for FD, the mass that has left the window (its exact
+solution's scores are NaN here: core/released.py); a reactive row the masses of A, B and the product
+made so far, A + C still held (mass_total) and the fraction of B + C lost (mass_lost_BC: FD's window
+ends let both totals out, particles none), and the last row also the errors against the scene's
+reference: the SSE of C_A and of C_C at the scene's points (SSE_points, SSE_points_C) and the product
+mass's relative error (product_error).
 """
 
 from __future__ import annotations
@@ -40,6 +48,7 @@ from ..core import measures as M
 from ..core.records import Recorder, arrow_table
 from ..core.runconfig import RunConfig
 from ..core.timegrid import time_steps, times
+from . import release_step
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -58,7 +67,10 @@ def run_arrow(cfg: RunConfig, progress: Callable[[str], None] | None = None, wan
     warm_up(cfg)
     size = (cfg.n + 1) ** cfg.dim if cfg.method == "fd" else cfg.n
     rec = Recorder(cfg.case_columns(), len(dts), progress, size=size)
-    rows = _Conservative(cfg, rec) if cfg.reaction is None else _Reactive(cfg, rec, reference, len(dts))
+    if cfg.reaction is not None:
+        rows = _Reactive(cfg, rec, reference, len(dts))
+    else:
+        rows = _Conservative(cfg, rec) if cfg.release is None else _Released(cfg, rec)
     state = runner(cfg, dts, times(dts, cfg.t_final if grid == "exact" else None), rows)
     table = rec.table()
     if not want_state:
@@ -123,6 +135,20 @@ class _Conservative:
         self.rec.add(step=step, time=t, dt=dt, **meas, **analytic)
 
 
+class _Released(_Conservative):
+    """A release's rows: the conservative run's, with the mass released by then (mass_released) and the mass
+    that has left an FD window (mass_outflow, which the FD runners put in ``meas``; particles 0). While the
+    run holds no mass its entropies are NaN: there is nothing to normalise."""
+
+    def add(self, step: int, t: float, dt: float, meas: dict) -> None:
+        meas = {**meas, "mass_released": self.cfg.mass(t), "mass_outflow": meas.get("mass_outflow", 0.0)}
+        if not meas["mass_total"] > 0:
+            meas.update(dict.fromkeys(_ENTROPIES, math.nan))
+        super().add(step, t, dt, meas)
+
+
+_ENTROPIES = ("H_D", "H_C", "H_I", "H_PMF", "E")
+
 # a reactive run's columns beside the conservative run's: its errors at t_final (last row only) and
 # no entropy (a reactive scene's reference has none: its measure is rmse of C_A or product)
 _NAN = dict.fromkeys(
@@ -180,6 +206,10 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     fd = _model("fd")
     x, dx = fd.grid(cfg)
     c = fd.initial_concentration(cfg)
+    entering = None
+    if cfg.release is not None:  # the source's mass enters step by step, where its start would put it
+        entering = release_step.fd_source(cfg, c, dx)
+        c = np.zeros_like(c)
     solvers: dict = {}
 
     def solver(dt):
@@ -190,10 +220,11 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     extra = {"beta": 0.0, "h": dx, "substeps": 1}
     if cfg.reaction is None:
         state = c[None, :]
-        rows.add(0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra})
+        out = _Outflow(entering, dx)
+        rows.add(0, 0.0, 0.0, {**fd.measure(cfg, x, c, dx, 0.0), **extra, **out.row()})
         for k, dt in enumerate(dts, start=1):
-            fd.transport(solver(dt), state)
-            rows.add(k, ts[k], dt, {**fd.measure(cfg, x, c, dx, ts[k]), **extra})
+            _fd_step(solver(dt), state, entering, ts[k - 1], ts[k], out)
+            rows.add(k, ts[k], dt, {**fd.measure(cfg, x, c, dx, ts[k]), **extra, **out.row()})
         return {"x": x, "c": c}
     from .reaction_step import react_masses
 
@@ -220,6 +251,35 @@ def _run_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     return {"x": x, "c": masses[0] / dx}
 
 
+class _Outflow:
+    """The mass an FD run with a release has sent out of its window so far (the steps' boundary fluxes
+    times the cell, dx or dx dy); without a release nothing is counted and its rows carry no column."""
+
+    def __init__(self, entering, cell: float):
+        self.entering, self.cell, self.total = entering, cell, 0.0
+
+    def add(self, solve) -> None:
+        self.total += solve.last_outflow * self.cell
+
+    def row(self) -> dict:
+        return {} if self.entering is None else {"mass_outflow": self.total}
+
+
+def _fd_step(solve, state: np.ndarray, entering, t_a: float, t_b: float, out: _Outflow) -> None:
+    """One FD step of ``state`` (species, nodes...) over [t_a, t_b] by ``solve`` (fd.transport); with a
+    release (``entering``), half the mass released in the step added to the interior before the
+    transport and half after (release_step.py), and the step's outflow counted in ``out``."""
+    fd = _model("fd")
+    if entering is None:
+        fd.transport(solve, state)
+        return
+    inner = (slice(1, -1),) * (state.ndim - 1)
+    state[0][inner] = entering.add(state[0][inner], t_a, t_b)
+    fd.transport(solve, state)
+    state[0][inner] = entering.add(state[0][inner], t_a, t_b)
+    out.add(solve)
+
+
 def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     """MTPT: every species row walked and exchanged by one step (mtpt.step), then, in a reactive
     run, every particle reacted (reaction_step.react_masses)."""
@@ -228,10 +288,14 @@ def _run_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     x, m, label = mtpt.initial_state(cfg, rng)
     dV = cfg.dV
     if cfg.reaction is None:
+        # a release's mass enters the particles at each step's end, as the plume it has become (release_step.py)
+        entering = None if cfg.release is None else release_step.ParticleSource(cfg)
         rows.add(0, 0.0, 0.0, {**mtpt.measure(cfg, x, m, 0.0), "beta": 0.0, "h": 0.0, "substeps": 1})
         for k, dt in enumerate(dts, start=1):
             t = ts[k]
             x, m, label, h, beta, sub = mtpt.step(cfg, x, m, label, dt, t, rng, order_rng)
+            if entering is not None:
+                m = entering.add(m, x, ts[k - 1], t)
             rows.add(k, t, dt, {**mtpt.measure(cfg, x, m, t), "beta": beta, "h": h, "substeps": sub})
         return {"x": x, "mass": m, "c": m / dV}
     from .reaction_step import A, B, C, react_masses
@@ -256,13 +320,20 @@ def _run_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict:
     pt = _model("pt")
     rng = cfg.rng()
     if cfg.reaction is None:
-        x = np.sort(pt.initial_positions(cfg, rng))
-        rows.add(0, 0.0, 0.0, pt.measure(cfg, x, 0.0))
+        if cfg.release is None:
+            batches, m_p = None, None
+            x = np.sort(pt.initial_positions(cfg, rng))
+        else:  # particles enter at their release times (release_step.Batches)
+            batches = release_step.Batches(cfg)
+            m_p, x = batches.mass, np.empty(0)
+        rows.add(0, 0.0, 0.0, pt.measure(cfg, x, 0.0, m_p))
         for k, dt in enumerate(dts, start=1):
             t = ts[k]
             (x,) = pt.step([x], cfg.D, dt, rng, cfg.v)
-            rows.add(k, t, dt, pt.measure(cfg, x, t))
-        return pt.final_state(cfg, x, t)
+            if batches is not None:
+                x = np.sort(np.concatenate([x, batches.enter(ts[k - 1], t, rng)]))
+            rows.add(k, t, dt, pt.measure(cfg, x, t, m_p))
+        return pt.final_state(cfg, x, t, m_p)
     from .reaction_step import react_particles
 
     reaction = cfg.reaction
@@ -292,18 +363,22 @@ def _run_plane_fd(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict
     solver per distinct step size: a sparse LU below 2^16 unknowns, BiCGSTAB from there, models/fd2d.py),
     measured every step (models/plane.py)."""
     from . import plane
-    from .fd import transport
 
     g, c = plane.fd_start(cfg)
+    entering = None
+    if cfg.release is not None:  # the source's mass enters step by step, where its start would put it
+        entering = release_step.fd_source(cfg, c, g.dx * g.dy)
+        c = np.zeros_like(c)
     solvers: dict = {}
     extra = {"beta": 0.0, "h": g.dx, "substeps": 1}
-    rows.add(0, 0.0, 0.0, {**plane.fd_measure(cfg, g, c, 0.0, False), **extra})
+    out = _Outflow(entering, g.dx * g.dy)
+    rows.add(0, 0.0, 0.0, {**plane.fd_measure(cfg, g, c, 0.0, False), **extra, **out.row()})
     state = c[None]
     for k, dt in enumerate(dts, start=1):
         if dt not in solvers:
             solvers[dt] = plane.fd_solver(cfg, g, dt)
-        transport(solvers[dt], state)
-        rows.add(k, ts[k], dt, {**plane.fd_measure(cfg, g, c, ts[k], k == len(dts)), **extra})
+        _fd_step(solvers[dt], state, entering, ts[k - 1], ts[k], out)
+        rows.add(k, ts[k], dt, {**plane.fd_measure(cfg, g, c, ts[k], k == len(dts)), **extra, **out.row()})
     x, y = g.nodes()
     gx, gy = np.meshgrid(x, y, indexing="ij")
     return {"x": gx.ravel(), "y": gy.ravel(), "c": c.ravel()}
@@ -317,11 +392,15 @@ def _run_plane_mtpt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> di
 
     rng = cfg.rng()
     x, m = plane.particles_start(cfg, rng)
+    # a release's mass enters the particles at each step's end, as the plume it has become (release_step.py)
+    entering = None if cfg.release is None else release_step.ParticleSource(cfg)
     start = {"beta": 0.0, "h": 0.0, "neighbours": 0.0, "substeps": 1}
     rows.add(0, 0.0, 0.0, {**plane.mtpt_measure(cfg, x, m, 0.0, False), **start})
     d_major = major(cfg.D)  # the kernel's sd along D's major axis is sqrt(4 eta D_L dt)
     for k, dt in enumerate(dts, start=1):
         x, m, neighbours, sub = plane.mtpt_step(cfg, x, m, dt, rng)
+        if entering is not None:
+            m = entering.add(m, x, ts[k - 1], ts[k])
         meas = plane.mtpt_measure(cfg, x, m, ts[k], k == len(dts))
         h = math.sqrt(4.0 * cfg.eta * d_major * dt)
         rows.add(k, ts[k], dt, {**meas, "beta": COLLISION_BETA, "h": h, "neighbours": neighbours, "substeps": sub})
@@ -334,11 +413,16 @@ def _run_plane_pt(cfg: RunConfig, dts: np.ndarray, ts: np.ndarray, rows) -> dict
 
     rng = cfg.rng()
     x = plane.pt_start(cfg, rng)
-    rows.add(0, 0.0, 0.0, plane.pt_measure(cfg, x, 0.0, False))
+    batches = None if cfg.release is None else release_step.Batches(cfg)  # particles enter at their release times
+    m_p = None if batches is None else batches.mass
+    rows.add(0, 0.0, 0.0, plane.pt_measure(cfg, x, 0.0, False, m_p))
     for k, dt in enumerate(dts, start=1):
         x = plane.pt_step(cfg, x, dt, rng)
-        rows.add(k, ts[k], dt, plane.pt_measure(cfg, x, ts[k], k == len(dts)))
-    return {"x": x[:, 0], "y": x[:, 1], "mass": np.full(x.shape[0], 1.0 / x.shape[0])}
+        if batches is not None:
+            x = np.concatenate([x, batches.enter(ts[k - 1], ts[k], rng)])
+        rows.add(k, ts[k], dt, plane.pt_measure(cfg, x, ts[k], k == len(dts), m_p))
+    mass = 1.0 / x.shape[0] if m_p is None else m_p
+    return {"x": x[:, 0], "y": x[:, 1], "mass": np.full(x.shape[0], mass)}
 
 
 # the runners of a 2-D run (RunConfig.dim): the same steps, the plane's start and measures

@@ -34,7 +34,7 @@ def pairs_per_step(cfg: RunConfig, dt: np.ndarray, t_end: np.ndarray) -> np.ndar
         sigma = np.array([collision_sigma(cfg.eta, cfg.D, d) for d in dt])
     else:
         constant = SCHEME_RECORDS[cfg.scheme].sph_constant
-        sigma = np.array([h_sph(cfg.n, cfg.omega, cfg.reference(t).variance, constant) for t in t_end])
+        sigma = np.array([h_sph(cfg.n, cfg.omega, cfg.reference(t).kernel_variance, constant) for t in t_end])
     radius = np.array([cutoff_radius(s, cfg.truncation) for s in sigma])
     return cfg.n * np.minimum(cfg.n * radius / cfg.omega, cfg.n / 2.0)
 
