@@ -190,6 +190,68 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
         assert err.value.name == key
 
 
+PLANE_BASE = {
+    "D": {"L": 1e-2, "T": 1e-3},
+    "t_final": 4.0,
+    "source": {"kind": "point", "x0": [0.0, 0.0]},
+    "target": {"measure": "rmse", "value": 0.1},
+    "candidates": [
+        {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75, "n_range": [32, 128]},
+        {"method": "pt", "kernel": "adaptive", "n_range": [1000, 4000]},
+    ],
+}
+
+
+def test_the_2d_peclet_sweep_makes_one_scene_a_speed_along_its_angle():
+    """scenes_peclet2d: each speed of v along `angle` is a 2-D scene peclet2d-<k>, D_L along its flow."""
+    got = scenes({"scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 2.0], "angle": 45}})
+    assert list(got) == list(got.sweep) == ["peclet2d-0", "peclet2d-1"]
+    fast = got["peclet2d-1"]
+    assert fast.dim == 2 and fast.v == (2.0 * math.sqrt(0.5), 2.0 * math.sqrt(0.5))
+    eigenvalues, vectors = np.linalg.eigh(np.asarray(fast.D))
+    assert eigenvalues == pytest.approx([1e-3, 1e-2], rel=1e-12)
+    assert abs(vectors[:, 1] @ np.array(fast.v)) / fast.speed == pytest.approx(1.0, rel=1e-12)  # D_L along v
+    assert fast.peclet == pytest.approx(2.0 * fast.fd_length / 1e-2, rel=1e-12)
+    along = scenes({"scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 2.0]}})
+    assert along["peclet2d-0"].v == (0.5, 0.0)  # angle 0 by default: exactly along x
+    written = Scene.from_config("mine", {**PLANE_BASE, "v": [0.5, 0.0]})
+    sweep = along["peclet2d-0"]
+    assert [sweep.identity(c) for c in sweep.candidates] == [written.identity(c) for c in written.candidates]
+
+
+def test_both_sweeps_side_by_side_keep_their_names_and_dimensions():
+    base = spec()
+    del base["v"]
+    both = {"scenes_peclet": {"base": base, "v": [0.0, 0.01]}, "scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 1.0]}}
+    got = scenes(both)
+    assert list(got.sweep) == ["peclet-0", "peclet-1", "peclet2d-0", "peclet2d-1"]
+    assert [got[n].dim for n in got.sweep] == [1, 1, 2, 2]
+
+
+@pytest.mark.parametrize(
+    "bad, key",
+    [
+        ({"base": {**PLANE_BASE, "v": [1.0, 0.0]}, "v": [0.5, 1.0]}, "scenes_peclet2d.base.v"),
+        ({"base": PLANE_BASE, "v": [1.0, 0.5]}, "scenes_peclet2d.v"),
+        ({"base": PLANE_BASE, "v": [0.0, 0.5]}, "scenes_peclet2d.v[0]"),  # D {L, T} needs a flow
+        ({"base": PLANE_BASE, "v": [0.5, 1.0], "angle": 181.0}, "scenes_peclet2d.angle"),
+        ({"base": PLANE_BASE, "v": [0.5]}, "scenes_peclet2d.v"),
+    ],
+)
+def test_a_bad_2d_sweep_is_refused_naming_its_key(bad, key):
+    with pytest.raises(SettingError) as err:
+        scenes({"scenes_peclet2d": bad})
+    assert err.value.name == key
+
+
+def test_a_2d_sweep_scene_s_refusals_name_the_2d_sweep_s_keys():
+    base = {**PLANE_BASE, "candidates": [PLANE_BASE["candidates"][0], PLANE_BASE["candidates"][0]]}
+    every = scenes({"scenes_peclet2d": {"base": base, "v": [0.5, 1.0]}})
+    with pytest.raises(SettingError) as err:
+        every["peclet2d-1"]
+    assert err.value.name == "scenes_peclet2d.base.candidates[1]"
+
+
 def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
     at_rest = Scene.from_config("s", spec(v=0.0, candidates=[FD, {**FD, "advection": "central"}, MTPT]))
     labels = ["fd implicit dt=0.05", "fd implicit dt=0.05", "mtpt collision eta=1"]

@@ -49,18 +49,32 @@ _DEFAULTS = defaults(SCENE)
 SPEC = shared().Scene  # a scene's model: its keys, their ranges and the rules between them (core/typed.py)
 
 
-SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
+# The Peclet sweeps by the prefix of their scenes' names (peclet-0, peclet2d-1, ...: a '-' no user
+# scene's name has): their config section and the dimension of their scenes.
+SWEEPS = {"peclet-": ("scenes_peclet", 1), "peclet2d-": ("scenes_peclet2d", 2)}
+SWEEP_NAME = "|".join(f"{prefix}[0-9]+" for prefix in SWEEPS)  # a sweep scene's name, as a pattern
 USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (the schema's pattern)
 # what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 _CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
 
 
+def sweep_of(name: str) -> tuple[str, int, int] | None:
+    """A Peclet sweep's scene (SWEEPS) -> (its config section, its dimension, its index k); None for
+    a scene of config `scenes`."""
+    for prefix, (section, dim) in SWEEPS.items():
+        if name.startswith(prefix) and name[len(prefix) :].isdigit():
+            return section, dim, int(name[len(prefix) :])
+    return None
+
+
 def key_path(name: str, key: str) -> str:
-    """The config key of ``key`` in scene ``name``: scenes.<name>.<key>; in a scene of the Peclet
-    sweep (peclet-<k>) its base's key, and its v: scenes_peclet.v[k]."""
-    if name.startswith(SWEEP_PREFIX):
-        return f"scenes_peclet.v[{name[len(SWEEP_PREFIX) :]}]" if key == "v" else f"scenes_peclet.base.{key}"
+    """The config key of ``key`` in scene ``name``: scenes.<name>.<key>; in a scene of a Peclet
+    sweep (peclet-<k>, peclet2d-<k>) its base's key, and its v: <section>.v[k]."""
+    sweep = sweep_of(name)
+    if sweep is not None:
+        section, _, k = sweep
+        return f"{section}.v[{k}]" if key == "v" else f"{section}.base.{key}"
     return f"scenes.{name}.{key}"
 
 
@@ -567,10 +581,10 @@ class Scenes(Mapping):
                 raise SettingError(
                     f"scenes.{name}",
                     "(a scene)",
-                    f"a name of letters, digits and _ ({SWEEP_PREFIX}<k> names the scenes of scenes_peclet)",
+                    "a name of letters, digits and _ (peclet-<k> and peclet2d-<k> name the sweeps' scenes)",
                 )
         self._specs = {**user, **sweep}
-        self.sweep = tuple(sweep)  # the Peclet sweep's scenes (figures/scenes_peclet.png draws these only)
+        self.sweep = tuple(sweep)  # the Peclet sweeps' scenes (figures/scenes_peclet.png draws these only)
         self._defaults = config.get("case_defaults", {})
         self._check = check  # a further check of each built scene (the workflow's memory check)
         self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
@@ -684,14 +698,37 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
 
 
 def peclet_scenes(config: Mapping) -> dict[str, dict]:
-    """The scenes of config `scenes_peclet` as written: its base at each velocity, named peclet-<k>
-    (SWEEP_PREFIX, a name no scene of config `scenes` can have). The sweep is parsed by its model
-    (core/typed.py: a base without v, velocities ascending >= 0); SettingError names the key."""
-    sweep = config.get("scenes_peclet")
-    if not sweep:
-        return {}
-    parsed = validate(shared().ScenesPeclet, sweep, lambda path: typed_key_path(["scenes_peclet", *path]))
-    return {f"{SWEEP_PREFIX}{k}": {**sweep["base"], "v": v} for k, v in enumerate(parsed.v)}
+    """The scenes of the Peclet sweeps (SWEEPS: config `scenes_peclet`, `scenes_peclet2d`) as written:
+    each base at each velocity, named <prefix><k>, a name no scene of config `scenes` can have. A 2-D
+    sweep's v is a speed along its `angle`. Each sweep is parsed by its model (core/typed.py: a base
+    without v, velocities ascending); SettingError names the key."""
+    out = {}
+    for prefix, (section, dim) in SWEEPS.items():
+        sweep = config.get(section)
+        if not sweep:
+            continue
+        model = shared().ScenesPeclet if dim == 1 else shared().ScenesPeclet2D
+        parsed = validate(model, sweep, lambda path, section=section: typed_key_path([section, *path]))
+        for k, speed in enumerate(parsed.v):
+            out[f"{prefix}{k}"] = {**sweep["base"], "v": speed if dim == 1 else _along(speed, parsed.angle)}
+    return out
+
+
+def has_sweep(config: Mapping) -> bool:
+    """Whether the config sets a Peclet sweep (figures/scenes_peclet.png draws them)."""
+    return any(config.get(section) for section, _ in SWEEPS.values())
+
+
+def _along(speed: float, angle: float) -> list[float]:
+    """The velocity of ``speed`` at ``angle`` degrees from the x axis; exact along an axis or a diagonal
+    (cos 45 = sin 45 as Python's math gives them, as a user writes 0.7071067811865476)."""
+    a = math.radians(angle)
+    c, s = math.cos(a), math.sin(a)
+    if angle % 90 == 0:
+        c, s = float(round(c)), float(round(s))
+    elif angle % 45 == 0:
+        c, s = math.copysign(math.sqrt(0.5), c), math.copysign(math.sqrt(0.5), s)
+    return [speed * c, speed * s]
 
 
 def scenes(config: Mapping, check=None, paper=None) -> Scenes:
