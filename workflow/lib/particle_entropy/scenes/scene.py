@@ -300,8 +300,9 @@ class Scene:
 
     @property
     def points(self):
-        """The measurement points at t_final, as a run's (RunConfig.points): a span on the line, the
-        plume's 15 x 15 lattice in 2-D [L]."""
+        """The measurement points at t_final, as a run at the scene's v has them (RunConfig.points; a run
+        computed at rest has them less frame_shift): a span on the line, the plume's 15 x 15 lattice in
+        2-D [L]."""
         exact = self.reference
         return exact.points() if self.dim == 2 else exact.points(self.points_span)
 
