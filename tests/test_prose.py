@@ -212,3 +212,38 @@ def test_formats():
     assert prose.exponent(10**8) == "10^8" and prose.exponent(12345) == "12,345"
     assert prose.percent(0.95) == "95 %" and prose.target("entropy", 0.01) == "H_C within 0.01 nats"
     assert prose.model("mtpt collision eta=1") == "MTPT collision eta=1"
+
+
+def test_the_2d_sweep_has_its_own_rows_crossover_and_target(results):
+    """The 2-D sweep (peclet2d-<k>) is tabulated apart from the 1-D one, with its own crossover: here
+    the grid wins at Pe 170 and particles at 679, while the 1-D sweep's crossover stays (0, 5,091]."""
+    for k, (pe, fd_cost) in enumerate(((169.7, 0.04), (678.8, 13.0))):
+        t = scene_rows(
+            f"peclet2d-{k}",
+            pe,
+            [
+                [0, FD, "fd", 64 * 4**k, 1, True, fd_cost, 32.0 * 4**k, ""],
+                [1, PT, "pt", 16000, 8, True, 1.5, 8000.0, ""],
+            ],
+            target=0.2,
+        )
+        write_parquet(t, results / "scenes" / f"peclet2d-{k}.parquet")
+    numbers = prose.numbers_from_results(results)
+    assert [r["scene"] for r in numbers["sweep"]] == ["peclet-0", "peclet-1"]
+    assert [r["scene"] for r in numbers["sweep2d"]] == ["peclet2d-0", "peclet2d-1"]
+    assert [r["scene"] for r in numbers["scenes"]] == ["flow", "rest"]  # neither sweep among the user's
+    values = prose.result_values(numbers)
+    assert values["scenes.crossover"] == "(0, 5,091]"
+    assert values["scenes.crossover2d"] == "(170, 679]"
+    assert values["scenes.sweep2d_target"] == "RMSE <= 0.2"
+    rows = prose.result_blocks(numbers)["scenes.sweep2d"].splitlines()[2:]
+    assert [r.split(" | ")[-1] for r in rows] == ["grid |", "particles |"]
+    assert rows[1].startswith("| 679 | FD implicit tvd Cr=0.75, n = 256, grid Péclet")
+
+
+def test_numbers_without_a_2d_sweep_name_no_2d_values(results):
+    """A config without scenes_peclet2d: no 2-D key in the numbers, so no page needs its markers."""
+    numbers = prose.numbers_from_results(results)
+    assert "sweep2d" not in numbers and "crossover2d" not in numbers
+    assert not {k for k in prose.result_values(numbers) if "2d" in k}
+    assert "scenes.sweep2d" not in prose.result_blocks(numbers)

@@ -28,7 +28,7 @@ def _resolve(node: dict) -> dict:
 
 # objects that are a user's problem, not settings: their defaults are a scene's (what an unset key
 # means), and the shipped config writes its own problem there (the sweep's base scene)
-USER_OBJECTS = {("scenes_peclet", "base")}
+USER_OBJECTS = {("scenes_peclet", "base"), ("scenes_peclet2d", "base")}
 
 
 def _defaults(node: dict, path: tuple = ()) -> list[tuple[tuple, object]]:

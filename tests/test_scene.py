@@ -149,8 +149,9 @@ def test_a_job_finds_its_settings_in_an_index_digested_once(monkeypatch):
 
     good = scenes({"scenes": {"one": spec(), "two": spec(v=0.0)}})
     two = good["two"]
-    half = two.half_step(two.candidates[1])
-    assert good.settings(identity(two, half)) == two.settings(half) != two.settings(two.candidates[1])
+    # FD's half step, which only "two" has (MTPT's is one's too: particle runs are computed at rest)
+    half = two.half_step(two.candidates[0])
+    assert good.settings(identity(two, half)) == two.settings(half) != two.settings(two.candidates[0])
     digested.clear()
     for _ in range(2):
         with pytest.raises(KeyError, match="no scene candidate has runs keyed '000000000000'"):
@@ -187,6 +188,68 @@ def test_the_peclet_sweep_makes_one_scene_a_velocity():
         with pytest.raises(SettingError) as err:
             scenes({"scenes_peclet": bad})
         assert err.value.name == key
+
+
+PLANE_BASE = {
+    "D": {"L": 1e-2, "T": 1e-3},
+    "t_final": 4.0,
+    "source": {"kind": "point", "x0": [0.0, 0.0]},
+    "target": {"measure": "rmse", "value": 0.1},
+    "candidates": [
+        {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75, "n_range": [32, 128]},
+        {"method": "pt", "kernel": "adaptive", "n_range": [1000, 4000]},
+    ],
+}
+
+
+def test_the_2d_peclet_sweep_makes_one_scene_a_speed_along_its_angle():
+    """scenes_peclet2d: each speed of v along `angle` is a 2-D scene peclet2d-<k>, D_L along its flow."""
+    got = scenes({"scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 2.0], "angle": 45}})
+    assert list(got) == list(got.sweep) == ["peclet2d-0", "peclet2d-1"]
+    fast = got["peclet2d-1"]
+    assert fast.dim == 2 and fast.v == (2.0 * math.sqrt(0.5), 2.0 * math.sqrt(0.5))
+    eigenvalues, vectors = np.linalg.eigh(np.asarray(fast.D))
+    assert eigenvalues == pytest.approx([1e-3, 1e-2], rel=1e-12)
+    assert abs(vectors[:, 1] @ np.array(fast.v)) / fast.speed == pytest.approx(1.0, rel=1e-12)  # D_L along v
+    assert fast.peclet == pytest.approx(2.0 * fast.fd_length / 1e-2, rel=1e-12)
+    along = scenes({"scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 2.0]}})
+    assert along["peclet2d-0"].v == (0.5, 0.0)  # angle 0 by default: exactly along x
+    written = Scene.from_config("mine", {**PLANE_BASE, "v": [0.5, 0.0]})
+    sweep = along["peclet2d-0"]
+    assert [sweep.identity(c) for c in sweep.candidates] == [written.identity(c) for c in written.candidates]
+
+
+def test_both_sweeps_side_by_side_keep_their_names_and_dimensions():
+    base = spec()
+    del base["v"]
+    both = {"scenes_peclet": {"base": base, "v": [0.0, 0.01]}, "scenes_peclet2d": {"base": PLANE_BASE, "v": [0.5, 1.0]}}
+    got = scenes(both)
+    assert list(got.sweep) == ["peclet-0", "peclet-1", "peclet2d-0", "peclet2d-1"]
+    assert [got[n].dim for n in got.sweep] == [1, 1, 2, 2]
+
+
+@pytest.mark.parametrize(
+    "bad, key",
+    [
+        ({"base": {**PLANE_BASE, "v": [1.0, 0.0]}, "v": [0.5, 1.0]}, "scenes_peclet2d.base.v"),
+        ({"base": PLANE_BASE, "v": [1.0, 0.5]}, "scenes_peclet2d.v"),
+        ({"base": PLANE_BASE, "v": [0.0, 0.5]}, "scenes_peclet2d.v[0]"),  # D {L, T} needs a flow
+        ({"base": PLANE_BASE, "v": [0.5, 1.0], "angle": 181.0}, "scenes_peclet2d.angle"),
+        ({"base": PLANE_BASE, "v": [0.5]}, "scenes_peclet2d.v"),
+    ],
+)
+def test_a_bad_2d_sweep_is_refused_naming_its_key(bad, key):
+    with pytest.raises(SettingError) as err:
+        scenes({"scenes_peclet2d": bad})
+    assert err.value.name == key
+
+
+def test_a_2d_sweep_scene_s_refusals_name_the_2d_sweep_s_keys():
+    base = {**PLANE_BASE, "candidates": [PLANE_BASE["candidates"][0], PLANE_BASE["candidates"][0]]}
+    every = scenes({"scenes_peclet2d": {"base": base, "v": [0.5, 1.0]}})
+    with pytest.raises(SettingError) as err:
+        every["peclet2d-1"]
+    assert err.value.name == "scenes_peclet2d.base.candidates[1]"
 
 
 def test_at_rest_fd_candidates_that_differ_only_in_advection_are_one():
@@ -265,10 +328,15 @@ def test_the_paper_scene_runs_are_the_paper_run_s_own_files():
     )
     assert run_path(scene, fd, 30, 0, 0).startswith("results/runs/fd/implicit/n~30/")
     # any difference of physics, step or points keeps a scene's runs its own
-    for over in ({"D": 5e-4}, {"v": 1e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
+    for over in ({"D": 5e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
         other, _ = _with_paper({**PAPER, **over})
         assert other.paper_runs == frozenset(), over
         assert run_path(other, other.candidates[1], 100, 0, 19).startswith("results/scenes/")
+    # carried: FD's runs are its own, the particles' are computed at rest (Scene.runs_at_rest), the paper's
+    carried, _ = _with_paper({**PAPER, "v": 1e-4})
+    assert carried.paper_runs == {1, 2}
+    assert run_path(carried, carried.candidates[0], 30, 0, 0).startswith("results/scenes/")
+    assert run_path(carried, carried.candidates[1], 100, 0, 19) == run_path(scene, mtpt, 100, 0, 19)
     other, _ = _with_paper({**PAPER, "candidates": [{**PAPER["candidates"][0], "fd_dt": 0.1}, PAPER["candidates"][1]]})
     assert other.paper_runs == {1}  # FD at another step is not the paper's FD
 
@@ -507,8 +575,9 @@ def test_the_measurement_points_sample_the_plume_whatever_the_window():
     wide = Scene.from_config("s", {**S_SMALL, "fd_length": 1.0e6})
     default = Scene.from_config("s", S_SMALL)
     fd, pt = wide.candidates
-    pts = wide.run_config(pt, 30).points(50.0)
-    assert pts.tobytes() == default.run_config(default.candidates[1], 30).points(50.0).tobytes()
+    assert wide.frame_shift(pt, 50.0) == 0.5  # PT runs at rest (Scene.runs_at_rest): its points, carried by v t
+    pts = wide.run_config(pt, 30).points(50.0) + wide.frame_shift(pt, 50.0)
+    assert pts.tobytes() == (default.run_config(default.candidates[1], 30).points(50.0) + 0.5).tobytes()
     reach = 3.0 * math.sqrt(4e-3 * 50.0)  # 1.342: +- 4.24 standard deviations around x = v t = 0.5
     assert np.allclose(pts, M.measurement_points(2 * reach) + 0.5, rtol=0, atol=1e-12)
     assert 0.5 - reach <= pts.min() and pts.max() <= 0.5 + reach
@@ -617,7 +686,8 @@ def test_identities_of_candidates_without_courant_are_unchanged():
     """Digests of spec()'s candidates taken at 77a862f, before courant existed: frozen, since a run's
     file is keyed by them."""
     moving = Scene.from_config("s", spec(candidates=[FD, {**FD, "advection": "central", "fd_dt": 0.1}, MTPT]))
-    assert [moving.identity(c) for c in moving.candidates] == ["c7b20328ac6c", "d3855894c74e", "1f90db7bbccc"]
+    # MTPT's runs in the flow are its runs at rest (Scene.runs_at_rest): at-rest's digest, no longer 1f90db7bbccc
+    assert [moving.identity(c) for c in moving.candidates] == ["c7b20328ac6c", "d3855894c74e", "39998f06084d"]
     at_rest = Scene.from_config("s", spec(v=0.0))
     assert [at_rest.identity(c) for c in at_rest.candidates] == ["a61c6cc525bb", "39998f06084d"]
     assert all("courant" not in moving.settings(c) for c in moving.candidates)

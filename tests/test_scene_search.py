@@ -208,6 +208,24 @@ def test_the_peclet_table_and_its_crossover():
     assert grid.loc[50.0, "grid_peclet"] == 0.25 and grid.loc[50.0, "courant"] == 0.5  # the answer's (n = 200)
 
 
+def test_each_sweep_has_its_own_crossover_by_its_scenes_dimension():
+    """peclet-<k> scenes are the 1-D sweep and peclet2d-<k> the 2-D one: one table, a crossover each,
+    even where the two sweeps share a Peclet number."""
+    tables = [
+        _answer("peclet-0", 50.0, 0.1, 0.4),
+        _answer("peclet-1", 500.0, 1.0, 0.3),  # 1-D: particles cheaper from here
+        _answer("peclet2d-0", 50.0, 0.01, 0.4),
+        _answer("peclet2d-1", 500.0, 0.1, 0.4),
+        _answer("peclet2d-2", 700.0, 13.0, 1.5),  # 2-D: particles cheaper from here
+    ]
+    table = S.peclet_table(tables)
+    assert table.groupby("dim")["scene"].nunique().to_dict() == {1: 2, 2: 3}
+    assert S.crossover(table, 1) == (50.0, 500.0)
+    assert S.crossover(table, 2) == (500.0, 700.0)
+    both = table[table["peclet"] == 500.0].drop_duplicates("scene").set_index("dim")["particles_cheaper"]
+    assert both.to_dict() == {1: True, 2: False}  # the same Pe, each sweep's own answer
+
+
 def test_an_fd_rung_names_its_grid_peclet_and_courant_numbers():
     """dx = the grid's span over n, dt = courant dx / |v| (or fd_dt): Pe_dx = |v| dx / D, Cr = |v| dt / dx."""
     tvd = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75, "n_range": [64, 4096]}
@@ -774,3 +792,28 @@ def test_a_2d_scene_s_whole_ladder_replayed_gives_brute_forces_answer(tmp_path):
     assert scene.dim == 2 and scene.n_points == 225
     checked, _ = _replayed_against_brute_force(scene, _whole_ladder(scene, tmp_path), 15)
     assert len(checked) >= 5  # the targets reach several answers
+
+
+def test_the_sweep_figure_draws_each_dimension_in_its_own_lines_and_shades_each_crossover():
+    """figures/scenes_peclet.png: the 1-D sweep in full lines, the 2-D one dashed, and two shaded
+    crossovers whose spans are each sweep's own (50, 500] and (500, 700]."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from particle_entropy.figures.scenes_peclet import scenes_peclet
+
+    tables = [
+        _answer("peclet-0", 50.0, 0.1, 0.4),
+        _answer("peclet-1", 500.0, 1.0, 0.3),
+        _answer("peclet2d-0", 500.0, 0.1, 0.4),
+        _answer("peclet2d-1", 700.0, 13.0, 1.5),
+    ]
+    fig = scenes_peclet(S.peclet_table(tables))
+    ax = fig.axes[0]
+    styles = {c.get_label(): c.lines[0].get_linestyle() for c in ax.containers}  # errorbar: (line, caps, bars)
+    assert styles[f"1-D: {S.FAMILIES['fd']}"] == "-" and styles[f"2-D: {S.FAMILIES['fd']}"] == "--"
+    shaded = [p for p in ax.patches if "overtake" in p.get_label()]  # axvspan: a rectangle over the span
+    spans = sorted((round(p.get_x(), 6), round(p.get_x() + p.get_width(), 6)) for p in shaded)
+    assert spans == [(50.0, 500.0), (500.0, 700.0)]
+    labels = [p.get_label() for p in shaded]
+    assert any(lab.startswith("1-D:") for lab in labels) and any(lab.startswith("2-D:") for lab in labels)

@@ -18,7 +18,7 @@ export_library_path(LIB)  # jobs import this checkout's library in any software 
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import SHEAR
 from particle_entropy.scenes.reference import REFERENCE_PATTERN, path as reactive_reference_path
-from particle_entropy.scenes.scene import SCENE_RUN_PATTERN, SWEEP_PREFIX, scenes
+from particle_entropy.scenes.scene import SCENE_RUN_PATTERN, SWEEP_NAME, has_sweep, scenes
 from particle_entropy.figures import BY_NAME as FIGURE, figure_options
 from particle_entropy.pipeline import inputs
 from particle_entropy.pipeline.codeversion import script_code, simulation_code
@@ -59,8 +59,8 @@ SCENES = scenes(
     partial(check_scene, base_seed=CONFIG.base_seed, available=AVAILABLE),
     paper=(RUN_PATTERN, partial(run_config, config=config)),  # the paper scene's runs are the paper's
 )
-# A scene's name: a user's (the schema's pattern) or one of the Peclet sweep's, peclet-<k>.
-SCENE_NAME = rf"[A-Za-z0-9_]+|{SWEEP_PREFIX}[0-9]+"
+# A scene's name: a user's (the schema's pattern) or one of a Peclet sweep's, peclet-<k> or peclet2d-<k>.
+SCENE_NAME = rf"[A-Za-z0-9_]+|{SWEEP_NAME}"
 
 # Before any job, the main process stops in one line where the run cannot write, holds results/'s
 # own lock and sets corrupt tables aside; a dry run, a command that runs no job and a run that a
@@ -114,7 +114,7 @@ def scene_files_set_aside(wildcards=None):
     scenes = [SCENES[name] for name in SCENES]
     ids = {scene.identity(c) for scene in scenes for c in scene.candidates}
     references = {reactive_reference_path(scene) for scene in scenes if scene.reaction is not None}
-    sweep = ["results/scenes_peclet.parquet"] if config.get("scenes_peclet") else []
+    sweep = ["results/scenes_peclet.parquet"] if has_sweep(config) else []
 
     def ours(path):
         parts = Path(path).parts  # results, scenes, <name>.parquet | <name> | <run digest>, ...

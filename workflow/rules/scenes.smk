@@ -118,8 +118,8 @@ rule plot_scene:
         "../scripts/plot_scene.py"
 
 
-# Where particles overtake grids: the Peclet sweep's scenes (peclet-<k>, names no user scene has)
-# side by side (config `scenes_peclet`); its data beside no scene's table.
+# Where particles overtake grids: the Peclet sweeps' scenes (peclet-<k> and peclet2d-<k>, names no
+# user scene has) side by side (config `scenes_peclet`, `scenes_peclet2d`); its data beside no scene's table.
 rule plot_scenes_peclet:
     input:
         [f"results/scenes/{name}.parquet" for name in SCENES.sweep],
@@ -167,6 +167,6 @@ rule scene_numbers:
 rule scenes:
     input:
         expand("figures/scene_{name}.png", name=SCENES),
-        ["figures/scenes_peclet.png"] if config.get("scenes_peclet") else [],
+        ["figures/scenes_peclet.png"] if has_sweep(config) else [],
         "results/scenes_numbers.json",
         scene_files_set_aside,  # set aside before this run (pipeline/preflight.py): rebuilt now

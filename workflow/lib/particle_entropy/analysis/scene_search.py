@@ -32,7 +32,7 @@ import pandas as pd
 from ..core import plane
 from ..core.io import read_parquet
 from ..scenes import defined
-from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene
+from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene, sweep_of
 from .resampling import CONFIDENCE
 from .search import AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
 
@@ -650,10 +650,12 @@ def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
     rows = []
     for t in tables:
         peclet, name = float(t["peclet"].iloc[0]), str(t["scene"].iloc[0])
+        dim = sweep_of(name)[1] if sweep_of(name) else 1
         t = t.assign(family=t["method"].map(FAMILIES))
         for family in dict.fromkeys(FAMILIES.values()):
             meets = t[(t["family"] == family) & t["meets"]]
-            row = {"scene": name, "peclet": peclet, "family": family, "label": "", "n": np.nan, "cost_s": np.nan}
+            row = {"scene": name, "dim": dim, "peclet": peclet, "family": family, "label": "", "n": np.nan}
+            row["cost_s"] = np.nan
             row.update(cost_lo=np.nan, grid_peclet=np.nan, courant=np.nan)
             first = meets.sort_values("n").groupby("candidate").head(1)
             if "holds_at_half_step" in first:  # an answer that depends on its step answers nothing here
@@ -665,19 +667,22 @@ def peclet_table(tables: list[pd.DataFrame]) -> pd.DataFrame:
                 row.update(grid_peclet=float(best["grid_peclet"]), courant=float(best["courant"]))
                 row["cost_lo"] = float(below["cost_s"].iloc[0]) if len(below) else np.nan
             rows.append(row)
-    out = pd.DataFrame(rows).sort_values(["peclet", "family"]).reset_index(drop=True)
-    wide = out.pivot(index="peclet", columns="family", values="cost_s")
+    out = pd.DataFrame(rows).sort_values(["dim", "peclet", "family"]).reset_index(drop=True)
+    wide = out.pivot(index=["dim", "peclet"], columns="family", values="cost_s")
     grid, particles = wide.get(FAMILIES["fd"]), wide.get(FAMILIES["pt"])
     cheaper = {
         p: bool(np.isfinite(q) and (not np.isfinite(g) or q < g)) for p, g, q in zip(wide.index, grid, particles)
     }
-    out["particles_cheaper"] = out["peclet"].map(cheaper)
+    out["particles_cheaper"] = [cheaper[key] for key in zip(out["dim"], out["peclet"])]
     return out
 
 
-def crossover(table: pd.DataFrame) -> tuple[float, float] | None:
-    """(Pe_lo, Pe_hi]: the particles first win at Pe_hi and did not at Pe_lo, the sweep's previous
-    point (the crossover's uncertainty: the sweep's spacing); None if they never win or always do."""
+def crossover(table: pd.DataFrame, dim: int = 1) -> tuple[float, float] | None:
+    """(Pe_lo, Pe_hi]: in the sweep of dimension ``dim``, the particles first win at Pe_hi and did not
+    at Pe_lo, the sweep's previous point (the crossover's uncertainty: the sweep's spacing); None if
+    they never win or always do."""
+    if "dim" in table:
+        table = table[table["dim"] == dim]
     by = table.drop_duplicates("peclet").sort_values("peclet")
     pe, win = by["peclet"].to_numpy(), by["particles_cheaper"].to_numpy()
     for k in range(1, len(pe)):

@@ -251,6 +251,9 @@ SECTION_DOCS = {
     "scenes_peclet": "Where particles overtake grids: one scene (`base`) at each velocity of `v`, searched as "
     "scenes peclet-0, peclet-1, ... (names no scene of `scenes` can have) and drawn as "
     "figures/scenes_peclet.png (its own target).",
+    "scenes_peclet2d": "Where particles overtake grids in 2-D: one 2-D scene (`base`) at each speed of `v` along the "
+    "direction `angle`, searched as scenes peclet2d-0, peclet2d-1, ... and drawn on figures/scenes_peclet.png "
+    "beside the 1-D sweep.",
     "optimum.<name>": "One search: a model, the time COMIC is judged at, an N range and a budget (runs, "
     "core-seconds or both).",
 }
@@ -754,6 +757,39 @@ SCENES_PECLET = (
     ),
 )
 
+SCENES_PECLET2D = (
+    Setting(
+        "base",
+        "scenes_peclet2d.base",
+        NO_DEFAULT,
+        "a 2-D scene without its v (the keys of scenes.<name>, D as {L, T}); each speed of `v` makes one scene of it",
+        kind="shape",
+        shape=dict,
+        range_text="a 2-D scene (scenes.<name>) without v",
+        required=True,
+    ),
+    Setting(
+        "v",
+        "scenes_peclet2d.v",
+        NO_DEFAULT,
+        "the speeds |v|, ascending; the Peclet number of each is |v| L / D_L (L: the base's FD window)",
+        "L/T",
+        kind="shape",
+        shape=array(number(gt=0), min_length=2),
+        range_text="at least two numbers > 0, ascending (D_L and D_T act along and across a flow)",
+        required=True,
+    ),
+    Setting(
+        "angle",
+        "scenes_peclet2d.angle",
+        0.0,
+        "the flow's direction, counter-clockwise from the grid's x axis: v = |v| (cos angle, sin angle)",
+        "degrees",
+        low=-180.0,
+        high=180.0,
+    ),
+)
+
 DECLARED = (
     *SETTINGS,
     *SEEDS,
@@ -765,6 +801,7 @@ DECLARED = (
     *TRADEOFF,
     *SCENE,
     *SCENES_PECLET,
+    *SCENES_PECLET2D,
     *MECHANISM,
     *SHEAR,
     *SEARCH,

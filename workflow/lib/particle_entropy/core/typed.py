@@ -53,6 +53,7 @@ from .settings import (
     REALISATIONS_DOC,
     SCENE,
     SCENES_PECLET,
+    SCENES_PECLET2D,
     SEARCH,
     SECTION_DOCS,
     UNIQUE,
@@ -563,24 +564,32 @@ class _Scene(Section):
 
 
 class _SceneBase(_Scene):
-    """The Peclet sweep's base: a scene without v."""
+    """A Peclet sweep's base: a scene without v."""
 
     @model_validator(mode="before")
     @classmethod
     def _no_v(cls, data):
         if isinstance(data, Mapping) and "v" in data:
-            raise refuse("v", "no v: the sweep sets it (scenes_peclet.v)")
+            raise refuse("v", "no v: the sweep sets it (its section's v)")
         return data
 
 
 class _ScenesPeclet(Section):
-    """The Peclet sweep: its velocities ascend."""
+    """A Peclet sweep: its velocities (in 2-D its speeds) ascend."""
 
     @model_validator(mode="after")
     def _ascending(self):
         if any(b <= a for a, b in zip(self.v, self.v[1:])):
-            raise refuse("v", "at least two numbers >= 0, ascending")
+            raise refuse("v", BY_KEY[f"{self.KEY}.v"].range_text)
         return self
+
+
+class _ScenesPeclet1D(_ScenesPeclet):
+    KEY: ClassVar[str] = "scenes_peclet"
+
+
+class _ScenesPeclet2D(_ScenesPeclet):
+    KEY: ClassVar[str] = "scenes_peclet2d"
 
 
 class _Reaction(OneOf):
@@ -698,7 +707,16 @@ def shared(settings: tuple = SETTINGS) -> SimpleNamespace:
         "ScenesPeclet",
         SCENES_PECLET,
         SECTION_DOCS["scenes_peclet"],
-        parent=_ScenesPeclet,
+        parent=_ScenesPeclet1D,
         base=(m.SceneBase, Field(..., description=description(base))),
+    )
+    base2d = BY_KEY["scenes_peclet2d.base"]
+    m.SceneBase2D = of("SceneBase2D", without_v, description(base2d), parent=_SceneBase, order=order, target=target)
+    m.ScenesPeclet2D = of(
+        "ScenesPeclet2D",
+        SCENES_PECLET2D,
+        SECTION_DOCS["scenes_peclet2d"],
+        parent=_ScenesPeclet2D,
+        base=(m.SceneBase2D, Field(..., description=description(base2d))),
     )
     return m

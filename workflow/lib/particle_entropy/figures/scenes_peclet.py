@@ -1,5 +1,5 @@
-"""figures/scenes_peclet.png: where particles overtake grids, drawn from the Peclet sweep's table
-(analysis/scene_search.peclet_table): the counted cost of one run of the cheapest FD candidate and
+"""figures/scenes_peclet.png: where particles overtake grids, in 1-D and in 2-D, drawn from the Peclet
+sweeps' table (analysis/scene_search.peclet_table): the counted cost of one run of the cheapest FD candidate and
 of the cheapest particle candidate that meet the target, against v L / D; bars from the cost of the
 failing resolution below each answer, hollow markers where a family never meets it, the crossover
 shaded over the sweep's spacing. Each FD answer is labelled with its scheme, grid Peclet number
@@ -22,18 +22,58 @@ def _fd_numbers(row) -> str:
     return f"{scheme}\nPe_dx {row.grid_peclet:.3g}, Cr {row.courant:.3g}"
 
 
+LINES = {1: "-", 2: "--"}  # a sweep's dimension -> its lines
+SHADES = {1: {"color": "0.88"}, 2: {"facecolor": "none", "edgecolor": "0.55", "hatch": "///", "lw": 0}}
+
+
 def scenes_peclet(table: pd.DataFrame):
-    """figures/scenes_peclet.png: the cost to reach the sweep's accuracy for the best grid and the
-    best particle model against the Peclet number, the crossover shaded (scene_search.peclet_table)."""
+    """figures/scenes_peclet.png: the cost to reach each sweep's accuracy for the best grid and the
+    best particle model against the Peclet number, the 1-D sweep in full lines and the 2-D one in
+    dashed, each crossover shaded (scene_search.peclet_table)."""
     fig, (ax,) = new_figure(1, width=6.4, height=4.4)
+    table = table if "dim" in table else table.assign(dim=1)
     pe = sorted(table["peclet"].unique())
     positive = [p for p in pe if p > 0]
     zero_at = min(positive) / 10 if positive else 1.0  # Pe = 0 drawn a decade left of the first
     x_of = {p: (p if p > 0 else zero_at) for p in pe}
     finite = table["cost_s"].dropna()
     top = finite.max() * 3 if len(finite) else 1.0
+    dims = sorted(table["dim"].unique())
+    for dim in dims:
+        _draw_sweep(ax, table[table["dim"] == dim], dim, x_of, top, named=len(dims) > 1)
+        cross = crossover(table, dim)
+        if cross is not None:
+            where = f"{dim}-D: " if len(dims) > 1 else ""
+            ax.axvspan(
+                x_of[cross[0]],
+                x_of[cross[1]],
+                zorder=0,
+                label=f"{where}particles overtake the grid: Pe in ({cross[0]:,.3g}, {cross[1]:,.3g}]",
+                **SHADES[int(dim)],
+            )
+    style_axes(
+        ax,
+        None,
+        "Where particles overtake grids",
+        "counted cost of one run that meets the target [s]",
+        "scene Péclet number |v| L / D (L the FD window; 2-D: D_L)",
+        logx=True,
+        logy=True,
+        legend=None,
+    )
+    ticks = [x_of[p] for p in pe]
+    ax.set_xticks(ticks, [f"{p:,.3g}" for p in pe], rotation=30)
+    ax.minorticks_off()
+    ax.legend(fontsize=6, loc="best")
+    return fig
+
+
+def _draw_sweep(ax, table: pd.DataFrame, dim: int, x_of: dict, top: float, named: bool) -> None:
+    """One sweep's families: the answers' costs joined by lines of its dimension (LINES), bars down to
+    the failing rung below, FD answers labelled (_fd_numbers), hollow markers where none meets it."""
     for i, (family, rows) in enumerate(table.groupby("family", sort=False)):
         colour, marker = AUTO_COLOURS[i], AUTO_MARKERS[i]
+        name = f"{dim}-D: {family}" if named else family
         rows = rows.sort_values("peclet")
         x = rows["peclet"].map(x_of)
         met = rows["cost_s"].notna()
@@ -44,10 +84,12 @@ def scenes_peclet(table: pd.DataFrame):
             yerr=[lo[met].clip(lower=0), 0 * lo[met]],
             color=colour,
             marker=marker,
+            mfc=colour if dim == 1 else "white",
             ms=6,
             lw=1.4,
+            ls=LINES[int(dim)],
             capsize=2,
-            label=family,
+            label=name,
         )
         if family == FAMILIES["fd"]:
             for px, row in zip(x[met], rows[met].itertuples()):
@@ -68,29 +110,5 @@ def scenes_peclet(table: pd.DataFrame):
                 ms=9,
                 mfc="white",
                 mec=colour,
-                label=f"{family}: not met within its range",
+                label=f"{name}: not met within its range",
             )
-    cross = crossover(table)
-    if cross is not None:
-        ax.axvspan(
-            x_of[cross[0]],
-            x_of[cross[1]],
-            color="0.88",
-            zorder=0,
-            label=f"particles overtake the grid: Pe in ({cross[0]:,.3g}, {cross[1]:,.3g}]",
-        )
-    style_axes(
-        ax,
-        None,
-        "Where particles overtake grids",
-        "counted cost of one run that meets the target [s]",
-        "scene Péclet number |v| L / D (L the FD window)",
-        logx=True,
-        logy=True,
-        legend=None,
-    )
-    ticks = [x_of[p] for p in pe]
-    ax.set_xticks(ticks, [f"{p:,.3g}" for p in pe], rotation=30)
-    ax.minorticks_off()
-    ax.legend(fontsize=7, loc="best")
-    return fig

@@ -277,10 +277,11 @@ FIGURE_CONTENTS = (
     ),
     (
         "scenes_peclet",
-        "`results/scenes/peclet-<k>.parquet`, its source data `results/scenes_peclet.parquet`",
+        "`results/scenes/peclet-<k>.parquet` and `peclet2d-<k>.parquet`, its source data "
+        "`results/scenes_peclet.parquet`",
         "one",
-        "`peclet` → `cost_s` per `family` (grid, particles), bars down to `cost_lo`; the crossover shaded where "
-        "`particles_cheaper` turns true",
+        "`peclet` → `cost_s` per `family` (grid, particles) and `dim` (1-D full lines, 2-D dashed), bars down to "
+        "`cost_lo`; each sweep's crossover shaded where `particles_cheaper` turns true",
     ),
 )
 FIGURE_NOTES = "\n".join(

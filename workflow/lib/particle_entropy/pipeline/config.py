@@ -179,6 +179,7 @@ def build(settings: tuple = SETTINGS) -> SimpleNamespace:
         optimum=(dict[name, m.Search], Field(default_factory=dict, description=SECTION_DOCS["optimum"])),
         scenes=(dict[name, m.Scene], Field(default_factory=dict, description=SECTION_DOCS["scenes"])),
         scenes_peclet=(m.ScenesPeclet, None),
+        scenes_peclet2d=(m.ScenesPeclet2D, None),
     )
     return m
 

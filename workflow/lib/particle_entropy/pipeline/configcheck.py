@@ -308,7 +308,7 @@ def check_config(
     ``not_judged``, one that would be refused is not raised but said there, one line each, naming
     the targets that would refuse it (the check-config command: judged as the run judges).
     Every message is bounded (``bounded``): a long value is abbreviated."""
-    from ..scenes.scene import scenes
+    from ..scenes.scene import scenes, sweep_of
 
     if schema is not None:  # the workflow's, as check_schema takes it
         check_schema(config, schema)
@@ -335,11 +335,11 @@ def check_config(
         )
     every = scenes(config, lambda scene: check_scene(scene, config["base_seed"], available))
     for name in every:  # builds and checks each scene
-        peclet = name in every.sweep
+        sweep = sweep_of(name)
         judge(
             lambda name=name: every[name],
-            f"scenes_peclet (its scene {name})" if peclet else f"scenes.{name}",
-            "`snakemake scenes` and " + ("figures/scenes_peclet.png" if peclet else f"figures/scene_{name}.png"),
+            f"{sweep[0]} (its scene {name})" if sweep else f"scenes.{name}",
+            "`snakemake scenes` and " + ("figures/scenes_peclet.png" if sweep else f"figures/scene_{name}.png"),
         )
     return typed
 

@@ -222,7 +222,7 @@ def check_scene(scene, base_seed: int, available: float | None) -> None:
 def check_scene_memory(scene, available: float) -> None:
     """Every job a scene may run must fit in ``available`` bytes: each candidate's top resolution
     with its realisations in one process (memory.estimate_mb); SettingError naming its n_range (or
-    ladder), under scenes_peclet.base for a scene of the Peclet sweep."""
+    ladder), under <sweep>.base for a scene of a Peclet sweep."""
     for i, c in enumerate(scene.candidates):
         runs = 1 if c.case.method == "fd" else scene.realisations
         need = estimate_mb(scene.run_config(c, c.n_hi), runs) * 2**20

@@ -37,7 +37,7 @@ from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
 from ..core.settings import REACTIVE_COST, SCENE, SCENE_MIN_MARGIN, defaults
 from ..core.timegrid import MAX_STEPS
 from ..scenes import scene
-from ..scenes.scene import SWEEP_PREFIX
+from ..scenes.scene import sweep_of
 from . import configcheck, joblogs
 
 PAGES = ("README.md", "docs/*.md")  # where spots may be marked (globs under the repository root)
@@ -204,44 +204,47 @@ def _finite(x) -> float | None:
     return float(x) if math.isfinite(float(x)) else None
 
 
-def _crossover(tables: list[pd.DataFrame]) -> list[float] | None:
-    found = scene_search.crossover(scene_search.peclet_table(tables)) if tables else None
+def _crossover(tables: list[pd.DataFrame], dim: int = 1) -> list[float] | None:
+    found = scene_search.crossover(scene_search.peclet_table(tables), dim) if tables else None
     return list(found) if found else None
 
 
 def numbers_from_tables(tables: Sequence[pd.DataFrame]) -> dict:
-    """The numbers prose quotes, from finished scene tables: the user's scenes by name, the Peclet
-    sweep's (names SWEEP_PREFIX<k>) by Peclet number with the best grid and particle answer of each,
-    and the crossover against every FD scheme and against the implicit ones alone (no tvd)."""
+    """The numbers prose quotes, from finished scene tables: the user's scenes by name, each Peclet
+    sweep's (scenes/scene.SWEEPS: `sweep` in 1-D, `sweep2d`) by Peclet number with the best grid and
+    particle answer of each, and its crossover; in 1-D also against the implicit schemes alone (no tvd)."""
     tables = sorted(tables, key=lambda t: str(t["scene"].iloc[0]))
-    in_sweep = [str(t["scene"].iloc[0]).startswith(SWEEP_PREFIX) for t in tables]
-    user = [t for t, s in zip(tables, in_sweep) if not s]
-    sweep = sorted((t for t, s in zip(tables, in_sweep) if s), key=lambda t: float(t["peclet"].iloc[0]))
-    implicit = [t[~t["label"].str.contains(" tvd ", regex=False)] for t in sweep]
-    rows = []
-    for t in sweep:
-        s = scene_summary(t)
-        grid, particles = _best(s, ("fd",)), _best(s, PARTICLES)
-        cheaper = particles is not None and (grid is None or particles["answer"]["cost_s"] < grid["answer"]["cost_s"])
-        fd_row = t[(t["label"] == grid["label"]) & (t["n"] == grid["answer"]["n"])].iloc[0] if grid else None
-        rows.append(
-            {
-                "scene": s["scene"],
-                "peclet": s["peclet"],
-                "measure": s["measure"],
-                "target": s["target"],
-                "grid": grid,
-                "grid_peclet": _finite(fd_row["grid_peclet"]) if fd_row is not None else None,
-                "courant": _finite(fd_row["courant"]) if fd_row is not None else None,
-                "particles": particles,
-                "particles_cheaper": cheaper,
-            }
-        )
+    dims = [(sweep_of(str(t["scene"].iloc[0])) or (None, 0))[1] for t in tables]
+    user = [t for t, d in zip(tables, dims) if not d]
+    out = {"scenes": [scene_summary(t) for t in user]}
+    for dim, key in ((1, "sweep"), (2, "sweep2d")):
+        sweep = sorted((t for t, d in zip(tables, dims) if d == dim), key=lambda t: float(t["peclet"].iloc[0]))
+        if dim == 2 and not sweep:
+            continue  # a config without a 2-D sweep: its numbers, as before
+        out[key] = [_sweep_row(t) for t in sweep]
+        out["crossover" if dim == 1 else "crossover2d"] = _crossover(sweep, dim)
+        if dim == 1:
+            implicit = [t[~t["label"].str.contains(" tvd ", regex=False)] for t in sweep]
+            out["crossover_implicit"] = _crossover(implicit, dim)
+    return out
+
+
+def _sweep_row(t: pd.DataFrame) -> dict:
+    """A sweep scene's row: its Peclet number, target, best grid and particle answers, which is cheaper."""
+    s = scene_summary(t)
+    grid, particles = _best(s, ("fd",)), _best(s, PARTICLES)
+    cheaper = particles is not None and (grid is None or particles["answer"]["cost_s"] < grid["answer"]["cost_s"])
+    fd_row = t[(t["label"] == grid["label"]) & (t["n"] == grid["answer"]["n"])].iloc[0] if grid else None
     return {
-        "scenes": [scene_summary(t) for t in user],
-        "sweep": rows,
-        "crossover": _crossover(list(sweep)),
-        "crossover_implicit": _crossover(implicit),
+        "scene": s["scene"],
+        "peclet": s["peclet"],
+        "measure": s["measure"],
+        "target": s["target"],
+        "grid": grid,
+        "grid_peclet": _finite(fd_row["grid_peclet"]) if fd_row is not None else None,
+        "courant": _finite(fd_row["courant"]) if fd_row is not None else None,
+        "particles": particles,
+        "particles_cheaper": cheaper,
     }
 
 
@@ -298,13 +301,14 @@ def scene_table(numbers: Mapping) -> str:
     return "\n".join(lines) + "\n"
 
 
-def sweep_table(numbers: Mapping) -> str:
-    """The Peclet sweep of docs/scenes.md: per Peclet number the cheapest grid and particle answers."""
+def sweep_table(numbers: Mapping, key: str = "sweep") -> str:
+    """A Peclet sweep of docs/scenes.md (``key``: sweep, sweep2d): per Peclet number the cheapest grid
+    and particle answers."""
     lines = [
         "| Pe | best grid: scheme, n, grid Péclet, Courant, counted cost | best particles: N, counted cost | cheaper |",
         "|---:|---|---|---|",
     ]
-    for r in numbers["sweep"]:
+    for r in numbers[key]:
         g, p = r["grid"], r["particles"]
         grid = "none meets it"
         if g:
@@ -324,12 +328,13 @@ def sweep_table(numbers: Mapping) -> str:
 def result_values(numbers: Mapping) -> dict[str, str]:
     """The inline numbers of the results: the crossovers and the sweep's target."""
     out = {}
-    for key in ("crossover", "crossover_implicit"):
+    for key in ("crossover", "crossover_implicit", *(("crossover2d",) if "sweep2d" in numbers else ())):
         found = numbers.get(key)
         out[f"scenes.{key}"] = interval(*found) if found else "none in the sweep"
-    sweep = numbers.get("sweep") or []
-    if sweep:
-        out["scenes.sweep_target"] = target(sweep[0]["measure"], sweep[0]["target"])
+    for key in ("sweep", "sweep2d"):
+        sweep = numbers.get(key) or []
+        if sweep:
+            out[f"scenes.{key}_target"] = target(sweep[0]["measure"], sweep[0]["target"])
     ratio = orientation_cost(numbers)
     if ratio is not None:
         out["scenes.orientation_cost"] = f"{ratio:.2g}"
@@ -352,7 +357,10 @@ def orientation_cost(numbers: Mapping) -> float | None:
 
 def result_blocks(numbers: Mapping) -> dict[str, str]:
     """The tables of the results."""
-    return {"scenes.table": scene_table(numbers), "scenes.sweep": sweep_table(numbers)}
+    out = {"scenes.table": scene_table(numbers), "scenes.sweep": sweep_table(numbers)}
+    if numbers.get("sweep2d"):
+        out["scenes.sweep2d"] = sweep_table(numbers, "sweep2d")
+    return out
 
 
 # ------------------------------------------------------------------------------ marked spots

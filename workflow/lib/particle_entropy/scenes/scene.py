@@ -49,18 +49,32 @@ _DEFAULTS = defaults(SCENE)
 SPEC = shared().Scene  # a scene's model: its keys, their ranges and the rules between them (core/typed.py)
 
 
-SWEEP_PREFIX = "peclet-"  # the Peclet sweep's scenes: peclet-0, peclet-1, ... (a '-' no user scene's name has)
+# The Peclet sweeps by the prefix of their scenes' names (peclet-0, peclet2d-1, ...: a '-' no user
+# scene's name has): their config section and the dimension of their scenes.
+SWEEPS = {"peclet-": ("scenes_peclet", 1), "peclet2d-": ("scenes_peclet2d", 2)}
+SWEEP_NAME = "|".join(f"{prefix}[0-9]+" for prefix in SWEEPS)  # a sweep scene's name, as a pattern
 USER_NAME = re.compile(r"[A-Za-z0-9_]+")  # a scene's name in config `scenes` (the schema's pattern)
 # what a candidate of a reactive scene may be: the models that carry a reaction (models/simulate.py)
 REACTIVE_SCHEMES = ("symmetric",)  # MTPT's transfer matrix of Eqs. 16-21, which moves every species at once
 _CASE_DIMS = ("eta", "truncation", "dt_growth", "scheme", "time_grid")
 
 
+def sweep_of(name: str) -> tuple[str, int, int] | None:
+    """A Peclet sweep's scene (SWEEPS) -> (its config section, its dimension, its index k); None for
+    a scene of config `scenes`."""
+    for prefix, (section, dim) in SWEEPS.items():
+        if name.startswith(prefix) and name[len(prefix) :].isdigit():
+            return section, dim, int(name[len(prefix) :])
+    return None
+
+
 def key_path(name: str, key: str) -> str:
-    """The config key of ``key`` in scene ``name``: scenes.<name>.<key>; in a scene of the Peclet
-    sweep (peclet-<k>) its base's key, and its v: scenes_peclet.v[k]."""
-    if name.startswith(SWEEP_PREFIX):
-        return f"scenes_peclet.v[{name[len(SWEEP_PREFIX) :]}]" if key == "v" else f"scenes_peclet.base.{key}"
+    """The config key of ``key`` in scene ``name``: scenes.<name>.<key>; in a scene of a Peclet
+    sweep (peclet-<k>, peclet2d-<k>) its base's key, and its v: <section>.v[k]."""
+    sweep = sweep_of(name)
+    if sweep is not None:
+        section, _, k = sweep
+        return f"{section}.v[{k}]" if key == "v" else f"{section}.base.{key}"
     return f"scenes.{name}.{key}"
 
 
@@ -149,6 +163,8 @@ class Candidate:
         for n in dict.fromkeys((self.n_lo, self.ladder()[-1])):
             try:
                 scene.run_config(self, n)
+                if scene.runs_at_rest(self):  # and the carried run it stands for, as the scene states it
+                    scene.run_config(self, n, carried=True)
             except SettingError as e:
                 raise self.run_error(scene, i, written, e) from None
 
@@ -315,18 +331,48 @@ class Scene:
         """v L / D with L the FD window: how far advection outruns dispersion over the scene [-]."""
         return self.speed * self.fd_length / self.d_along
 
+    def runs_at_rest(self, candidate: Candidate) -> bool:
+        """Whether a candidate's runs are computed at rest (v = 0) and stand for the scene's carried
+        plume. Galilean invariance: in a uniform flow each particle's step is its step at rest plus
+        v dt (PT's and MTPT's walks alike; MTPT's transfer depends on separations only), and the
+        measurement points and the exact plume are carried by v t with the particles, so every error
+        and measure of a run at v is that of the run at rest, to the round-off of x + v t
+        (tests/test_rest_frame.py).
+        Scenes that differ only in v thus share their particle runs (the identity digests settings).
+        Not FD, whose grid and advection scheme the flow sets; not a reactive scene, whose B need not
+        move with A; not a 2-D scene whose measurement lattice turns with v (an isotropic plume's
+        axes are along v: Reference2D.axes), whose points at rest would be others."""
+        if candidate.case.method == "fd" or self.reaction is not None or self.speed == 0.0:
+            return False
+        if self.dim == 1:
+            return True
+        # the axes at rest and in the flow: one lattice (up to a common sign, which only reorders it)
+        rest = Reference2D(self.source, self.D, (0.0, 0.0), self.t_final).axes()[1]
+        moving = self.reference.axes()[1]
+        return bool(np.array_equal(rest, moving) or np.array_equal(rest, -moving))
+
+    def frame_shift(self, candidate: Candidate, t: float):
+        """What the scene's frame adds to a position in a candidate's runs at time t: v t where they are
+        computed at rest (runs_at_rest), else 0; a pair in 2-D [L]. A run's state (particle positions)
+        plus this is where the scene's plume is."""
+        if not self.runs_at_rest(candidate):
+            return np.zeros(2) if self.dim == 2 else 0.0
+        return np.asarray(self.v, dtype=np.float64) * t if self.dim == 2 else self.v * t
+
     def settings(self, candidate: Candidate) -> dict:
-        """The run settings of a candidate's runs (RunConfig's fields besides case and seed)."""
+        """The run settings of a candidate's runs (RunConfig's fields besides case and seed): a particle
+        candidate's at rest where runs_at_rest says so."""
+        still = self.runs_at_rest(candidate)
         out = {
             "D": self.D,
             "t_final": self.t_final,
             "omega": self.omega,
             "fd_length": self.fd_length,
             "source": self.source.record(),
-            "v": self.v,
+            "v": 0.0 if still else self.v,
         }
         if self.dim == 2:  # the tensor and v as lists; the points are the plume's lattice, not a span
-            out.update(D=[list(row) for row in self.D], v=list(self.v))
+            out.update(D=[list(row) for row in self.D], v=[0.0, 0.0] if still else list(self.v))
         else:
             out["window"] = self.points_span  # the measurement points span the plume, at rest too
         if self.reaction is not None:  # only then: a conservative scene's runs keep their identity
@@ -347,10 +393,13 @@ class Scene:
         two scenes share a run only when their physics (and FD's scheme and step) are equal."""
         return digest(self.settings(candidate))
 
-    def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
-        """The checked run of a candidate at resolution n."""
+    def run_config(self, candidate: Candidate, n: int, seed: int = 0, carried: bool = False) -> RunConfig:
+        """The checked run of a candidate at resolution n, as its jobs run it (settings); ``carried``:
+        at the scene's own v, the run that one at rest stands for (runs_at_rest), as the checks judge it."""
         settings = self.settings(candidate)
         settings["source"], settings["reaction"] = self.source, self.reaction
+        if carried:
+            settings["v"] = self.v
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
     def half_step(self, candidate: Candidate) -> Candidate:
@@ -532,10 +581,10 @@ class Scenes(Mapping):
                 raise SettingError(
                     f"scenes.{name}",
                     "(a scene)",
-                    f"a name of letters, digits and _ ({SWEEP_PREFIX}<k> names the scenes of scenes_peclet)",
+                    "a name of letters, digits and _ (peclet-<k> and peclet2d-<k> name the sweeps' scenes)",
                 )
         self._specs = {**user, **sweep}
-        self.sweep = tuple(sweep)  # the Peclet sweep's scenes (figures/scenes_peclet.png draws these only)
+        self.sweep = tuple(sweep)  # the Peclet sweeps' scenes (figures/scenes_peclet.png draws these only)
         self._defaults = config.get("case_defaults", {})
         self._check = check  # a further check of each built scene (the workflow's memory check)
         self._paper = paper  # (the paper run's table pattern, its RunConfig of a Case at seed 0)
@@ -628,7 +677,9 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     """``scene`` with its candidates whose runs are the paper run's own marked (``paper_runs``): the
     same RunConfig as ``paper_run(case)`` gives (the paper's physics, first step and numerics) and
     the same measurement points. Their tables are the paper's (``pattern``): the paper scene
-    recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
+    recomputes none of the paper's runs, and a rung it adds is one more file of the paper run. A
+    particle candidate of a carried scene of the paper's physics shares them too: its runs are
+    computed at rest (Scene.runs_at_rest), with the paper's RunConfig and points exactly."""
     shared = set()
     if scene.reaction is not None or scene.dim == 2:  # a reactive or 2-D scene's runs: none is the paper's
         return replace(scene, paper_pattern=pattern)
@@ -640,21 +691,44 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
             continue
         same_points = all(
             mine.points(t).tobytes() == theirs.points(t).tobytes() for t in (0.0, scene.t_final)
-        )  # at rest the points do not move; a carried plume's would, and then v differs anyway
+        )  # a run at rest: its points do not move; FD's in a flow would, and then v differs anyway
         if replace(mine, window=None) == theirs and same_points:
             shared.add(ci)
     return replace(scene, paper_runs=frozenset(shared), paper_pattern=pattern)
 
 
 def peclet_scenes(config: Mapping) -> dict[str, dict]:
-    """The scenes of config `scenes_peclet` as written: its base at each velocity, named peclet-<k>
-    (SWEEP_PREFIX, a name no scene of config `scenes` can have). The sweep is parsed by its model
-    (core/typed.py: a base without v, velocities ascending >= 0); SettingError names the key."""
-    sweep = config.get("scenes_peclet")
-    if not sweep:
-        return {}
-    parsed = validate(shared().ScenesPeclet, sweep, lambda path: typed_key_path(["scenes_peclet", *path]))
-    return {f"{SWEEP_PREFIX}{k}": {**sweep["base"], "v": v} for k, v in enumerate(parsed.v)}
+    """The scenes of the Peclet sweeps (SWEEPS: config `scenes_peclet`, `scenes_peclet2d`) as written:
+    each base at each velocity, named <prefix><k>, a name no scene of config `scenes` can have. A 2-D
+    sweep's v is a speed along its `angle`. Each sweep is parsed by its model (core/typed.py: a base
+    without v, velocities ascending); SettingError names the key."""
+    out = {}
+    for prefix, (section, dim) in SWEEPS.items():
+        sweep = config.get(section)
+        if not sweep:
+            continue
+        model = shared().ScenesPeclet if dim == 1 else shared().ScenesPeclet2D
+        parsed = validate(model, sweep, lambda path, section=section: typed_key_path([section, *path]))
+        for k, speed in enumerate(parsed.v):
+            out[f"{prefix}{k}"] = {**sweep["base"], "v": speed if dim == 1 else _along(speed, parsed.angle)}
+    return out
+
+
+def has_sweep(config: Mapping) -> bool:
+    """Whether the config sets a Peclet sweep (figures/scenes_peclet.png draws them)."""
+    return any(config.get(section) for section, _ in SWEEPS.values())
+
+
+def _along(speed: float, angle: float) -> list[float]:
+    """The velocity of ``speed`` at ``angle`` degrees from the x axis; exact along an axis or a diagonal
+    (cos 45 = sin 45 as Python's math gives them, as a user writes 0.7071067811865476)."""
+    a = math.radians(angle)
+    c, s = math.cos(a), math.sin(a)
+    if angle % 90 == 0:
+        c, s = float(round(c)), float(round(s))
+    elif angle % 45 == 0:
+        c, s = math.copysign(math.sqrt(0.5), c), math.copysign(math.sqrt(0.5), s)
+    return [speed * c, speed * s]
 
 
 def scenes(config: Mapping, check=None, paper=None) -> Scenes:
