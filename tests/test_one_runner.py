@@ -1,7 +1,8 @@
 """The one runner (models/simulate.py) against the runs of the three runners before it (issue 51):
 every shipped scene's candidates, conservative and reactive, at their low rungs and short times,
 and their half-step twins, give the same bytes as the code at 5399db0 (measured cost columns left
-out). The digests in tests/data/runs_before_one_runner.json were made by that code."""
+out), each at its scene's v. The digests in tests/data/runs_before_one_runner.json were made by that
+code."""
 
 from __future__ import annotations
 
@@ -79,7 +80,8 @@ def test_every_frozen_run_is_listed():
 def test_a_run_has_the_bytes_of_the_runners_before(key, scene, cand, n):
     seeds = [0] if cand.case.method == "fd" else [0, 1]
     ref = None if scene.reaction is None else _stub_reference(scene)
-    table = run_seeds_arrow(scene.run_config(cand, n), seeds, reference=ref)
+    # at the scene's own v, as the runners before ran it (a particle's jobs now run it at rest: test_rest_frame.py)
+    table = run_seeds_arrow(scene.run_config(cand, n, carried=True), seeds, reference=ref)
     assert _digest(table) == BEFORE[key]
 
 

@@ -15,7 +15,7 @@ from scipy.special import erfc, erfcx
 
 from particle_entropy.core import measures as M
 from particle_entropy.core.case import SettingError
-from particle_entropy.core.release import Release
+from particle_entropy.core.release import Release, point_release
 from particle_entropy.core.runconfig import RunConfig
 from particle_entropy.core.sources import Source
 from particle_entropy.core.sources2d import Source2D, dispersion_tensor
@@ -75,6 +75,9 @@ def test_the_closed_form_is_the_time_integral_of_the_gaussian():
 
             by_quad = Q * quad(gauss, max(T - t1, 0.0), T - t0, epsabs=1e-14, epsrel=1e-12, limit=200)[0]
             assert continuous_point(x, T, t0=t0, t1=t1) == pytest.approx(by_quad, rel=1e-9, abs=1e-14)
+            # and core/release.py's closed form: released from t0 on, less what is released from t1 on
+            theirs = point_release(x, T, Q, D, V, start=t0) - (point_release(x, T, Q, D, V, start=t1) if t1 < T else 0)
+            assert continuous_point(x, T, t0=t0, t1=t1) == pytest.approx(float(theirs), rel=1e-9, abs=1e-14)
 
 
 # ------------------------------------------------------------------------ the release itself

@@ -149,8 +149,9 @@ def test_a_job_finds_its_settings_in_an_index_digested_once(monkeypatch):
 
     good = scenes({"scenes": {"one": spec(), "two": spec(v=0.0)}})
     two = good["two"]
-    half = two.half_step(two.candidates[1])
-    assert good.settings(identity(two, half)) == two.settings(half) != two.settings(two.candidates[1])
+    # FD's half step, which only "two" has (MTPT's is one's too: particle runs are computed at rest)
+    half = two.half_step(two.candidates[0])
+    assert good.settings(identity(two, half)) == two.settings(half) != two.settings(two.candidates[0])
     digested.clear()
     for _ in range(2):
         with pytest.raises(KeyError, match="no scene candidate has runs keyed '000000000000'"):
@@ -327,10 +328,15 @@ def test_the_paper_scene_runs_are_the_paper_run_s_own_files():
     )
     assert run_path(scene, fd, 30, 0, 0).startswith("results/runs/fd/implicit/n~30/")
     # any difference of physics, step or points keeps a scene's runs its own
-    for over in ({"D": 5e-4}, {"v": 1e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
+    for over in ({"D": 5e-4}, {"fd_length": 14.0}, {"source": {"kind": "point", "x0": 0.5}}):
         other, _ = _with_paper({**PAPER, **over})
         assert other.paper_runs == frozenset(), over
         assert run_path(other, other.candidates[1], 100, 0, 19).startswith("results/scenes/")
+    # carried: FD's runs are its own, the particles' are computed at rest (Scene.runs_at_rest), the paper's
+    carried, _ = _with_paper({**PAPER, "v": 1e-4})
+    assert carried.paper_runs == {1, 2}
+    assert run_path(carried, carried.candidates[0], 30, 0, 0).startswith("results/scenes/")
+    assert run_path(carried, carried.candidates[1], 100, 0, 19) == run_path(scene, mtpt, 100, 0, 19)
     other, _ = _with_paper({**PAPER, "candidates": [{**PAPER["candidates"][0], "fd_dt": 0.1}, PAPER["candidates"][1]]})
     assert other.paper_runs == {1}  # FD at another step is not the paper's FD
 
@@ -569,8 +575,9 @@ def test_the_measurement_points_sample_the_plume_whatever_the_window():
     wide = Scene.from_config("s", {**S_SMALL, "fd_length": 1.0e6})
     default = Scene.from_config("s", S_SMALL)
     fd, pt = wide.candidates
-    pts = wide.run_config(pt, 30).points(50.0)
-    assert pts.tobytes() == default.run_config(default.candidates[1], 30).points(50.0).tobytes()
+    assert wide.frame_shift(pt, 50.0) == 0.5  # PT runs at rest (Scene.runs_at_rest): its points, carried by v t
+    pts = wide.run_config(pt, 30).points(50.0) + wide.frame_shift(pt, 50.0)
+    assert pts.tobytes() == (default.run_config(default.candidates[1], 30).points(50.0) + 0.5).tobytes()
     reach = 3.0 * math.sqrt(4e-3 * 50.0)  # 1.342: +- 4.24 standard deviations around x = v t = 0.5
     assert np.allclose(pts, M.measurement_points(2 * reach) + 0.5, rtol=0, atol=1e-12)
     assert 0.5 - reach <= pts.min() and pts.max() <= 0.5 + reach
@@ -679,7 +686,8 @@ def test_identities_of_candidates_without_courant_are_unchanged():
     """Digests of spec()'s candidates taken at 77a862f, before courant existed: frozen, since a run's
     file is keyed by them."""
     moving = Scene.from_config("s", spec(candidates=[FD, {**FD, "advection": "central", "fd_dt": 0.1}, MTPT]))
-    assert [moving.identity(c) for c in moving.candidates] == ["c7b20328ac6c", "d3855894c74e", "1f90db7bbccc"]
+    # MTPT's runs in the flow are its runs at rest (Scene.runs_at_rest): at-rest's digest, no longer 1f90db7bbccc
+    assert [moving.identity(c) for c in moving.candidates] == ["c7b20328ac6c", "d3855894c74e", "39998f06084d"]
     at_rest = Scene.from_config("s", spec(v=0.0))
     assert [at_rest.identity(c) for c in at_rest.candidates] == ["a61c6cc525bb", "39998f06084d"]
     assert all("courant" not in moving.settings(c) for c in moving.candidates)

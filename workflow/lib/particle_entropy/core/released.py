@@ -14,10 +14,12 @@ released plume (normalised to unit mass: the mixture of the source's plumes over
   streak of puffs, whose variance grows with its length v A while its concentration varies on the
   puffs' scale. At v = 0 the two are equal. Before any mass is released (A = 0) both are the source's.
 
-Its exact density is core/release.py's reference (issue 53, another part of the work): here every score
-against it (density, sampled, SSE at points, H_C and E of the exact plume) is NaN, so that a release
-run's table carries its model's own measures and masses, and the scores wait for that reference.
-RunConfig.reference returns a ReleasedPlume (ReleasedPlume2D in 2-D) for a run with a release.
+Its exact density and entropy are core/release.py's ReleaseReference (ReleaseReference2D), which the
+runs' scores do not read yet: here every score against the exact plume (density, sampled, SSE at
+points, H_C and E) is NaN, so that a release run's table carries its model's own measures and masses.
+RunConfig.reference returns a ReleasedPlume (ReleasedPlume2D in 2-D) for a run with a release; scoring
+a release run is making these methods that reference's (a per-step quadrature in age: its cost per row
+is the open question).
 """
 
 from __future__ import annotations

@@ -36,7 +36,8 @@ CMAP = "YlGnBu"  # light where nothing is: the plume stands out on white
 @dataclass(frozen=True)
 class ModelRun:
     """A model's final state, the map's model panel: the table row it comes from (label, n, ...),
-    whether the scene recommends it, the run's settings and state (models/simulate.run_arrow), its
+    whether the scene recommends it, the run's settings and state (models/simulate.run_arrow; the
+    state in the scene's frame, where its plume is, also for a run computed at rest: model_run), its
     seed and the wall time the plot job spent on it [s]."""
 
     row: pd.Series
@@ -89,7 +90,11 @@ def model_run(scene, table: pd.DataFrame, base_seed: int) -> ModelRun | None:
     cfg = scene.run_config(candidate, int(row["n"]), seed=int(base_seed))
     start = time.perf_counter()
     _, state = run(cfg, want_state=True)
-    return ModelRun(row, recommended, cfg, state, int(base_seed), time.perf_counter() - start)
+    wall = time.perf_counter() - start
+    # where the scene's plume is: a particle run computed at rest, carried by v t_final (Scene.runs_at_rest)
+    dx, dy = scene.frame_shift(candidate, scene.t_final)
+    state = state.assign(x=state["x"] + dx, y=state["y"] + dy)
+    return ModelRun(row, recommended, cfg, state, int(base_seed), wall)
 
 
 def map_grid(reference, nodes: int = MAP_NODES) -> tuple[np.ndarray, np.ndarray]:

@@ -163,6 +163,8 @@ class Candidate:
         for n in dict.fromkeys((self.n_lo, self.ladder()[-1])):
             try:
                 scene.run_config(self, n)
+                if scene.runs_at_rest(self):  # and the carried run it stands for, as the scene states it
+                    scene.run_config(self, n, carried=True)
             except SettingError as e:
                 raise self.run_error(scene, i, written, e) from None
 
@@ -298,8 +300,9 @@ class Scene:
 
     @property
     def points(self):
-        """The measurement points at t_final, as a run's (RunConfig.points): a span on the line, the
-        plume's 15 x 15 lattice in 2-D [L]."""
+        """The measurement points at t_final, as a run at the scene's v has them (RunConfig.points; a run
+        computed at rest has them less frame_shift): a span on the line, the plume's 15 x 15 lattice in
+        2-D [L]."""
         exact = self.reference
         return exact.points() if self.dim == 2 else exact.points(self.points_span)
 
@@ -329,18 +332,48 @@ class Scene:
         """v L / D with L the FD window: how far advection outruns dispersion over the scene [-]."""
         return self.speed * self.fd_length / self.d_along
 
+    def runs_at_rest(self, candidate: Candidate) -> bool:
+        """Whether a candidate's runs are computed at rest (v = 0) and stand for the scene's carried
+        plume. Galilean invariance: in a uniform flow each particle's step is its step at rest plus
+        v dt (PT's and MTPT's walks alike; MTPT's transfer depends on separations only), and the
+        measurement points and the exact plume are carried by v t with the particles, so every error
+        and measure of a run at v is that of the run at rest, to the round-off of x + v t
+        (tests/test_rest_frame.py).
+        Scenes that differ only in v thus share their particle runs (the identity digests settings).
+        Not FD, whose grid and advection scheme the flow sets; not a reactive scene, whose B need not
+        move with A; not a 2-D scene whose measurement lattice turns with v (an isotropic plume's
+        axes are along v: Reference2D.axes), whose points at rest would be others."""
+        if candidate.case.method == "fd" or self.reaction is not None or self.speed == 0.0:
+            return False
+        if self.dim == 1:
+            return True
+        # the axes at rest and in the flow: one lattice (up to a common sign, which only reorders it)
+        rest = Reference2D(self.source, self.D, (0.0, 0.0), self.t_final).axes()[1]
+        moving = self.reference.axes()[1]
+        return bool(np.array_equal(rest, moving) or np.array_equal(rest, -moving))
+
+    def frame_shift(self, candidate: Candidate, t: float):
+        """What the scene's frame adds to a position in a candidate's runs at time t: v t where they are
+        computed at rest (runs_at_rest), else 0; a pair in 2-D [L]. A run's state (particle positions)
+        plus this is where the scene's plume is."""
+        if not self.runs_at_rest(candidate):
+            return np.zeros(2) if self.dim == 2 else 0.0
+        return np.asarray(self.v, dtype=np.float64) * t if self.dim == 2 else self.v * t
+
     def settings(self, candidate: Candidate) -> dict:
-        """The run settings of a candidate's runs (RunConfig's fields besides case and seed)."""
+        """The run settings of a candidate's runs (RunConfig's fields besides case and seed): a particle
+        candidate's at rest where runs_at_rest says so."""
+        still = self.runs_at_rest(candidate)
         out = {
             "D": self.D,
             "t_final": self.t_final,
             "omega": self.omega,
             "fd_length": self.fd_length,
             "source": self.source.record(),
-            "v": self.v,
+            "v": 0.0 if still else self.v,
         }
         if self.dim == 2:  # the tensor and v as lists; the points are the plume's lattice, not a span
-            out.update(D=[list(row) for row in self.D], v=list(self.v))
+            out.update(D=[list(row) for row in self.D], v=[0.0, 0.0] if still else list(self.v))
         else:
             out["window"] = self.points_span  # the measurement points span the plume, at rest too
         if self.reaction is not None:  # only then: a conservative scene's runs keep their identity
@@ -361,10 +394,13 @@ class Scene:
         two scenes share a run only when their physics (and FD's scheme and step) are equal."""
         return digest(self.settings(candidate))
 
-    def run_config(self, candidate: Candidate, n: int, seed: int = 0) -> RunConfig:
-        """The checked run of a candidate at resolution n."""
+    def run_config(self, candidate: Candidate, n: int, seed: int = 0, carried: bool = False) -> RunConfig:
+        """The checked run of a candidate at resolution n, as its jobs run it (settings); ``carried``:
+        at the scene's own v, the run that one at rest stands for (runs_at_rest), as the checks judge it."""
         settings = self.settings(candidate)
         settings["source"], settings["reaction"] = self.source, self.reaction
+        if carried:
+            settings["v"] = self.v
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
 
     def half_step(self, candidate: Candidate) -> Candidate:
@@ -642,7 +678,9 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     """``scene`` with its candidates whose runs are the paper run's own marked (``paper_runs``): the
     same RunConfig as ``paper_run(case)`` gives (the paper's physics, first step and numerics) and
     the same measurement points. Their tables are the paper's (``pattern``): the paper scene
-    recomputes none of the paper's runs, and a rung it adds is one more file of the paper run."""
+    recomputes none of the paper's runs, and a rung it adds is one more file of the paper run. A
+    particle candidate of a carried scene of the paper's physics shares them too: its runs are
+    computed at rest (Scene.runs_at_rest), with the paper's RunConfig and points exactly."""
     shared = set()
     if scene.reaction is not None or scene.dim == 2:  # a reactive or 2-D scene's runs: none is the paper's
         return replace(scene, paper_pattern=pattern)
@@ -654,7 +692,7 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
             continue
         same_points = all(
             mine.points(t).tobytes() == theirs.points(t).tobytes() for t in (0.0, scene.t_final)
-        )  # at rest the points do not move; a carried plume's would, and then v differs anyway
+        )  # a run at rest: its points do not move; FD's in a flow would, and then v differs anyway
         if replace(mine, window=None) == theirs and same_points:
             shared.add(ci)
     return replace(scene, paper_runs=frozenset(shared), paper_pattern=pattern)
