@@ -264,8 +264,22 @@ def _entropy(c: np.ndarray, weights: np.ndarray, mass: float) -> float:
 
 
 # ------------------------------------------------------------------------ the references
+class _Released:
+    """What both references read off their release at their time t: the ages and the mass."""
+
+    @property
+    def ages(self) -> tuple[float, float]:
+        """(s_lo, s_hi): the ages of the mass released by t [T]."""
+        return self.release.ages(self.t)
+
+    @property
+    def mass(self) -> float:
+        """M(t) = q (min(t1, t) - t0) [M]."""
+        return self.release.mass(self.t)
+
+
 @dataclass(frozen=True)
-class ReleaseReference:
+class ReleaseReference(_Released):
     """The exact concentration at time t of ``release`` from ``source`` under uniform velocity v and
     dispersion D on the line."""
 
@@ -281,16 +295,6 @@ class ReleaseReference:
         if not _finite(self.v):
             raise ValueError(f"v: a finite velocity [L/T], got {self.v!r}")
         self.release.check(self.t)
-
-    @property
-    def ages(self) -> tuple[float, float]:
-        """(s_lo, s_hi): the ages of the mass released by t [T]."""
-        return self.release.ages(self.t)
-
-    @property
-    def mass(self) -> float:
-        """M(t) = q (min(t1, t) - t0) [M]."""
-        return self.release.mass(self.t)
 
     def age_rule(self) -> tuple[np.ndarray, np.ndarray]:
         """The ages and weights of the release's age integral (age_rule; kappa = v^2 / (4 D), graded
@@ -344,7 +348,7 @@ class ReleaseReference:
 
 
 @dataclass(frozen=True, eq=False)
-class ReleaseReference2D:
+class ReleaseReference2D(_Released):
     """The exact concentration at time t of ``release`` from ``source`` under uniform velocity v (2,)
     and dispersion tensor D (2, 2), symmetric positive definite, on the plane."""
 
@@ -359,16 +363,6 @@ class ReleaseReference2D:
         object.__setattr__(self, "D", checked.D)
         object.__setattr__(self, "v", checked.v)
         self.release.check(self.t)
-
-    @property
-    def ages(self) -> tuple[float, float]:
-        """(s_lo, s_hi): the ages of the mass released by t [T]."""
-        return self.release.ages(self.t)
-
-    @property
-    def mass(self) -> float:
-        """M(t) = q (min(t1, t) - t0) [M]."""
-        return self.release.mass(self.t)
 
     @property
     def kappa(self) -> float:
