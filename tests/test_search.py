@@ -283,3 +283,62 @@ def test_a_runs_measured_core_seconds_are_its_steps_wall_times_summed():
         {"n": 20, "seed": 0, "core_s": 2.0},
     ]
     assert list(E.measured_core_s(steps.iloc[:0], ["seed"]).columns) == ["seed", "core_s"]
+
+
+def _run_table(r, seeds) -> pd.DataFrame:
+    """A per-step run table of plan row ``r`` (three steps a seed) whose last step's error is _law's."""
+    rows = []
+    for seed in seeds:
+        e = _law(r.candidate, r.n, seed)
+        for step in (1, 2, 3):
+            rows.append(
+                {
+                    **{"seed": seed, "step": step, "time": 0.5 * step, "dt": 0.5, "mass_min": 0.0, "wall_s": 0.002},
+                    **{"SSE_points": 15 * e * e * (4 - step), "COMIC_points": math.log(e), "H_C": 0.1, "E": 1.5},
+                    **{"H_C_analytic": 0.1, "E_analytic": 1.5, "mass_total": 1.0, "dV": 0.1, "work": 10.0 * r.n},
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def test_a_round_reads_only_the_runs_its_last_round_added_and_gets_what_a_full_read_gets(tmp_path):
+    """A scene's round k reads what round k-1 read (its table, written and read back as the workflow
+    does) and only the run tables of the rows round k-1 added: the table equals reading every run
+    again, and the older run tables are not opened (they are moved away before the round reads)."""
+    from particle_entropy.core.io import read_parquet
+
+    search = S.SceneSearch(_scene(0.01))
+    assert search.KEEPS_READS
+    plan, earlier, rounds = search.first_plan(0), None, 0
+    while not plan["done"].all():
+        paths = []
+        for i, r in enumerate(plan.itertuples()):
+            path = tmp_path / f"row{i}.parquet"
+            if not path.exists():
+                write_parquet(_run_table(r, range(int(r.first), int(r.last) + 1)), path)
+            paths.append(str(path))
+        full = search.read_runs(plan, paths)
+        hidden = tmp_path / "hidden"
+        hidden.mkdir(exist_ok=True)
+        old = [p for p, k in zip(paths, plan["round"]) if k < plan["round"].max()]
+        for p in old:
+            (tmp_path / p).rename(hidden / (tmp_path / p).name)
+        got = search.runs_since(plan, paths, earlier)
+        for p in old:
+            (hidden / (tmp_path / p).name).rename(p)
+        pd.testing.assert_frame_equal(got, full)
+        if earlier is not None:
+            assert len(earlier) < len(got)
+        write_parquet(got, tmp_path / "read.parquet")
+        earlier = read_parquet(tmp_path / "read.parquet")
+        plan = search.next_plan(plan, got, 0)
+        rounds += 1
+    assert rounds >= 4
+
+
+def test_the_round_s_read_table_lies_beside_its_plan():
+    from particle_entropy.analysis.rounds import read_path
+
+    assert read_path("results/scenes/a/round~3.parquet") == "results/scenes/a/round~3.read.parquet"
+    with pytest.raises(ValueError, match="ends in .parquet"):
+        read_path("results/scenes/a/round~3")

@@ -19,6 +19,7 @@ from conftest import ROOT, TINY, run_snakemake, snakemake_command
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
+from particle_entropy.analysis.rounds import READ_SUFFIX, read_path
 from particle_entropy.core.case import CASE_COLUMNS, MODEL_COLUMNS, Case, rows_of
 from particle_entropy.core.columns import PLANE_ONLY_COLUMNS, RELEASE_ONLY_COLUMNS
 from particle_entropy.core.labels import case_label
@@ -1153,9 +1154,12 @@ def test_a_scene_is_searched_recommended_and_drawn(tmp_path):
     (quoted,) = numbers["scenes"]
     chosen = [c for c in quoted["candidates"] if c["recommended"]]
     assert quoted["scene"] == "carried" and chosen[0]["answer"]["n"] == best["n"] and not numbers["sweep"]
-    plans = sorted((work / "results/scenes/carried").glob("round~*.parquet"), key=lambda p: int(p.stem.split("~")[1]))
+    rounds = (work / "results/scenes/carried").glob("round~*.parquet")
+    plans = sorted((p for p in rounds if not p.name.endswith(READ_SUFFIX)), key=lambda p: int(p.stem.split("~")[1]))
     last = pd.read_parquet(plans[-1])
     assert last["done"].all() and len(plans) >= 3
+    read = pd.read_parquet(read_path(str(plans[-1])))  # what the last round read: every run of the finished plan
+    assert len(read) == int((last["last"] - last["first"] + 1).sum()) and len(read) > 0
     spec = yaml.safe_load(SCENE_CONFIG.read_text())["scenes"]["carried"]
     scene = Scene.from_config("carried", spec, yaml.safe_load(TINY.read_text()).get("case_defaults"))
     assert all((work / p).exists() for p in plan_paths(scene, last))  # every run an ordinary table

@@ -15,6 +15,7 @@ sys.path.insert(0, LIB)
 from particle_entropy.pipeline.codeversion import export_library_path
 
 export_library_path(LIB)  # jobs import this checkout's library in any software environment
+from particle_entropy.analysis.rounds import read_path
 from particle_entropy.core.registry import ALL_KERNELS, METHODS, SCHEMES, SHEAR_CASES, TIME_GRIDS
 from particle_entropy.core.settings import SHEAR
 from particle_entropy.scenes.reference import REFERENCE_PATTERN, path as reactive_reference_path

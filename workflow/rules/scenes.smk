@@ -51,7 +51,8 @@ checkpoint scene_round:
     input:
         unpack(scene_round_inputs),
     output:
-        "results/scenes/{name}/round~{k}.parquet",
+        plan="results/scenes/{name}/round~{k}.parquet",
+        read=read_path("results/scenes/{name}/round~{k}.parquet"),
     log:
         "logs/scenes/{name}/round~{k}.log",
     wildcard_constraints:

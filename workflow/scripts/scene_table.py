@@ -5,7 +5,8 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from particle_entropy.analysis.scene_search import judged, read_runs, result
+from particle_entropy.analysis.scene_search import judged, result
+from particle_entropy.analysis.search import runs_in
 from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.scenes.scene import Scene
 
@@ -21,7 +22,10 @@ if scene.reaction is not None:  # judged against its reference, which may leave 
 
     reference = read(inp.reference)
     why = undefined(scene.measure, scene.value, reference)
-table = result(scene, judged(scene, read_runs(plan, list(inp.runs))), why)
+runs = read_parquet(inp.read)  # what the finished plan's round read: every run of it (AdaptiveSearch.final_inputs)
+if len(runs) != runs_in(plan):
+    raise RuntimeError(f"{inp.read}: {len(runs)} runs read, where the finished plan {inp.plan} has {runs_in(plan)}")
+table = result(scene, judged(scene, runs), why)
 if reference is not None:  # the product over time, each rung's and the reference's (panel b)
     from particle_entropy.analysis.scene_search import with_reference
 

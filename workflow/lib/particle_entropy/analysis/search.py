@@ -31,6 +31,7 @@ from collections.abc import Callable, Sequence
 import pandas as pd
 
 from ..core.io import read_parquet
+from .rounds import read_path
 
 ROUND, FIRST, LAST, DONE = "round", "first", "last", "done"
 PLAN_COLUMNS = (ROUND, FIRST, LAST, DONE)  # every kind's plan has these, beside its own columns
@@ -106,6 +107,10 @@ class AdaptiveSearch(ABC):
     """One search of a kind: how its next points are chosen, and where its runs are. The engine
     (round, round_inputs, final_inputs) does the rest."""
 
+    # its rounds write what they read (read_path) and read only the run tables of the rows the last
+    # round added (runs_since): round k otherwise reads every run of rounds 0 .. k-1 again
+    KEEPS_READS: bool = False
+
     @property
     @abstractmethod
     def title(self) -> str:
@@ -140,24 +145,46 @@ class AdaptiveSearch(ABC):
             return self.first_plan(base_seed)
         return self.next_plan(plan, self.read_runs(plan, list(paths)), base_seed)
 
+    def runs_since(self, plan: pd.DataFrame, paths: list[str], earlier: pd.DataFrame | None) -> pd.DataFrame:
+        """What read_runs reads of ``plan``'s runs at ``paths``, given ``earlier``: what the round before
+        read (of every row but those ``plan``'s last round added, which come last: ``extended``), so
+        that only the new rows' run tables are read. ``earlier`` None: every row's. A kind whose
+        read_runs gives a table with a row per run, in the plan's order (KEEPS_READS)."""
+        if earlier is None or plan.empty:
+            return self.read_runs(plan, list(paths))
+        new = (plan[ROUND] == plan[ROUND].max()).to_numpy()
+        if new.all():
+            return self.read_runs(plan, list(paths))
+        old = plan[~new].reset_index(drop=True)
+        if not new[len(old) :].all():
+            raise ValueError(f"{self.title}: a plan's last round must add its rows after the earlier ones")
+        added = self.read_runs(plan[new].reset_index(drop=True), [p for p, n in zip(paths, new) if n])
+        if added.empty:
+            return earlier
+        return added if earlier.empty else pd.concat([earlier, added], ignore_index=True)
+
     def round_inputs(self, k: int, plan_at: Callable[[int], str], plan_paths: PlanPaths) -> dict:
         """What round ``k`` reads: nothing for round 0; plan k-1 (its path: ``plan_at(k - 1)``) and
-        its runs (``plan_paths``: the run table of each row). A finished plan has no round after it
-        (ValueError)."""
+        its runs (``plan_paths``: the run table of each row), and for a kind that KEEPS_READS what
+        round k-1 read of them (``read``: read_path). A finished plan has no round after it (ValueError)."""
         if k == 0:
             return {}
         path = plan_at(k - 1)
         plan = read_parquet(path)  # every page checked (core.io)
         if plan[DONE].any():
             raise ValueError(f"{self.title} stopped at round {k - 1}: there is no round {k}")
-        return {"plan": path, "runs": plan_paths(plan)}
+        out = {"plan": path, "runs": plan_paths(plan)}
+        return {**out, "read": read_path(path)} if self.KEEPS_READS and k > 1 else out
 
     def final_inputs(self, plan_at: Callable[[int], str], plan_paths: PlanPaths) -> dict:
-        """The first finished plan and its runs; plans are asked for one at a time (``plan_at``,
-        a checkpoint's output), at most ``max_plans`` (ValueError if none is finished)."""
+        """The first finished plan and its runs, and for a kind that KEEPS_READS what its round read
+        of them (``read``: a finished plan adds no row, so that is every run of it); plans are asked
+        for one at a time (``plan_at``, a checkpoint's output), at most ``max_plans`` (ValueError if
+        none is finished)."""
         for k in range(self.max_plans):
             path = plan_at(k)
             plan = read_parquet(path)  # every page checked (core.io)
             if plan[DONE].all():
-                return {"plan": path, "runs": plan_paths(plan)}
+                out = {"plan": path, "runs": plan_paths(plan)}
+                return {**out, "read": read_path(path)} if self.KEEPS_READS else out
         raise ValueError(f"{self.title}: no finished plan after {self.max_plans} rounds")
