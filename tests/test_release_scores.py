@@ -301,20 +301,25 @@ def test_every_row_counts_the_mass_released_and_the_last_is_scored(method, dim):
 def test_a_2d_point_still_releasing_is_infinite_at_its_point_only():
     """At rest the lattice's centre is the well: a run's SSE at the points is NaN (and measure_finite says
     so), its H_C and E against the exact plume finite; away from the well, after the release, of a
-    Gaussian source or on the line every measure is finite."""
+    Gaussian source or on the line every measure is finite. A box's H_I under an oblique D is NaN."""
     settings = {**PLANE, "v": (0.0, 0.0), "D": np.diag([0.01, 0.01]), "release": Release(Q, 0.0)}
     cfg = RunConfig.of("fd", kernel="implicit", n=32, dt0=0.25, advection="central", fd_length=3.0, **settings)
     row = _last(cfg)
     assert math.isnan(row["SSE_points"]) and np.isfinite([row["H_C_analytic"], row["E_analytic"]]).all()
     points = cfg.resolved().points(T)
-    assert not measure_finite("SSE_points", POINT2, Release(Q, 0.0), T, points)
-    assert not measure_finite("rmse", POINT2, Release(Q, 0.0), T)  # no points given: one may be on the well
-    assert measure_finite("rmse", POINT2, Release(Q, 0.0), T, points[points[:, 0] != 0.0])
-    assert measure_finite("entropy", POINT2, Release(Q, 0.0), T, points)
-    assert measure_finite("SSE_points", POINT2, Release(Q, 0.0, 3.0), T, points)  # ended at 3 < 4
-    assert not measure_finite("SSE_points", POINT2, Release(Q, 0.0, T), T, points)  # releasing up to t
+    assert not measure_finite("SSE_points", POINT2, D2, Release(Q, 0.0), T, points)
+    assert not measure_finite("rmse", POINT2, D2, Release(Q, 0.0), T)  # no points given: one may be on the well
+    assert measure_finite("rmse", POINT2, D2, Release(Q, 0.0), T, points[points[:, 0] != 0.0])
+    assert measure_finite("entropy", POINT2, D2, Release(Q, 0.0), T, points)
+    assert measure_finite("SSE_points", POINT2, D2, Release(Q, 0.0, 3.0), T, points)  # ended at 3 < 4
+    assert not measure_finite("SSE_points", POINT2, D2, Release(Q, 0.0, T), T, points)  # releasing up to t
     gaussian = Source2D.of("gaussian", x0=[0.0, 0.0], sd=[0.1, 0.1])
-    assert measure_finite("SSE_points", gaussian, Release(Q, 0.0), T, points)
-    assert measure_finite("SSE_points", POINT, Release(Q, 0.0), T, np.zeros((1, 1)))
+    assert measure_finite("SSE_points", gaussian, D2, Release(Q, 0.0), T, points)
+    assert measure_finite("SSE_points", POINT, D, Release(Q, 0.0), T, np.zeros((1, 1)))
     with pytest.raises(ValueError, match="measure: one of"):
-        measure_finite("product", POINT2, Release(Q, 0.0), T)
+        measure_finite("product", POINT2, D2, Release(Q, 0.0), T)
+    # a box's H_I under an oblique D is not computed (hours): NaN, and said so
+    box = Source2D.of("box", x=[-0.1, 0.1], y=[-0.1, 0.1])
+    assert not measure_finite("entropy", box, D2, Release(Q, 0.0), T)
+    assert measure_finite("entropy", box, np.diag([D_L, D_T]), Release(Q, 0.0), T)
+    assert math.isnan(ReleasedPlume2D(box, D2, V2, T, Release(Q, 0.0), T).h_i())

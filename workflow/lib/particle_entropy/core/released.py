@@ -29,9 +29,9 @@ quadrature in age, ~1e-11 relative), read as the instantaneous references are re
 
 While nothing is released (t <= t0) every score is NaN: there is no plume to normalise.
 
-Cost. The exact plume at one t costs ~10 ms in 1-D (its entropy's adaptive rule: ~600 ages by
-~800-3,000 nodes) and 0.1-2 s in 2-D (the tensor rule), against ~0.1 ms for an FD step on the line
-(benchmarks/release_scores.py). So a run is scored against it at its last row only, t_final, the time a
+Cost. The exact plume at one t costs 10-40 ms in 1-D (its entropy's adaptive rule: ~600 ages by
+~800-3,000 nodes) and 0.1-2 s in 2-D (the tensor rule), against ~0.07 ms for an FD step of 200 nodes
+on the line (benchmarks/release_scores.py). So a run is scored against it at its last row only, t_final, the time a
 scene judges (RunConfig.reference passes ``scored`` False before: those rows' exact columns are NaN,
 as the plane's are before its last row for every run), and models/simulate.warm_up builds that plume
 before the timed steps (its H_I, its density at the measurement points and at a 1-D FD run's nodes,
@@ -42,9 +42,13 @@ Infinite values. A 2-D point source still releasing at t (t <= t1) has an infini
 point (c ~ ln(1/r) near it: Wilson and Miller's W(u, beta) as r -> 0); ``density`` gives NaN there, so a
 measure that reads it (SSE_points, COMIC_points: a lattice point on the source, as at v = 0, where the
 lattice's centre is the source) is NaN, while H_I and E stay finite (p ln p ~ ln(1/r) ln ln(1/r) is
-integrable in the plane). ``measure_finite`` tells, for a measure, a source, a release, t and points,
-whether the value is finite. On the line the plume is finite everywhere: at a point source the age
+integrable in the plane). ``measure_finite`` tells, for a measure, a source, D, a release, t and
+points, whether the value is finite. On the line the plume is finite everywhere: at a point source the age
 integral of its s^-1/2 converges.
+
+Not computed. H_I (so H_C and E) of a 2-D box in an oblique flow (D with D_xy != 0) is NaN:
+ReleaseReference2D refuses it (its tensor rule would need ~1e8 rectangle probabilities, hours);
+``measure_finite`` says so too. Its density at points is computed (~1.6 s at the 225 lattice points).
 """
 
 from __future__ import annotations
@@ -83,13 +87,19 @@ def singular(source, release: Release, t: float) -> bool:
     return release.end is None or release.end >= t
 
 
-def measure_finite(measure: str, source, release: Release, t: float, points=None) -> bool:
+def uncomputed_entropy(source, D) -> bool:
+    """Whether the exact plume's H_I is left NaN: a 2-D box under an oblique D (D_xy != 0), whose tensor
+    rule ReleaseReference2D refuses (hours)."""
+    return plane.is_plane(source) and source.kind == "box" and np.asarray(D, dtype=np.float64)[0, 1] != 0.0
+
+
+def measure_finite(measure: str, source, D, release: Release, t: float, points=None) -> bool:
     """Whether ``measure`` (a run's column in POINTWISE or INTEGRALS, or a scene's rmse, entropy,
-    dilution) of the exact plume of ``release`` from ``source`` at time t is finite: the integrals always;
-    a pointwise measure unless the plume is ``singular`` and one of ``points`` (M, 2) lies on the source
-    (``points`` None: anywhere, so it may)."""
+    dilution) of the exact plume of ``release`` from ``source`` under dispersion D at time t is finite:
+    the integrals unless ``uncomputed_entropy``; a pointwise measure unless the plume is ``singular``
+    and one of ``points`` (M, 2) lies on the source (``points`` None: anywhere, so it may)."""
     if measure in INTEGRALS:
-        return True
+        return not uncomputed_entropy(source, D)
     if measure not in POINTWISE:
         raise ValueError(f"measure: one of {', '.join(POINTWISE + INTEGRALS)}, got {measure!r}")
     if not singular(source, release, t):
@@ -122,9 +132,11 @@ class ExactPlume:
 
     @functools.cached_property
     def h_i(self) -> float:
-        """H_I of the plume normalised to unit mass [nats, dV = 1]."""
+        """H_I of the plume normalised to unit mass [nats, dV = 1]; NaN where ``uncomputed_entropy``."""
         ref = self.reference
-        return ref.h_i() if isinstance(ref, ReleaseReference2D) else ref.entropy()
+        if not isinstance(ref, ReleaseReference2D):
+            return ref.entropy()
+        return math.nan if uncomputed_entropy(ref.source, ref.D) else ref.h_i()
 
 
 @functools.lru_cache(maxsize=8)
