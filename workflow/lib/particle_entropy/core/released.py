@@ -69,6 +69,7 @@ from .release import Release, ReleaseReference, ReleaseReference2D
 POINTWISE = ("SSE", "AIC", "COMIC", "SSE_points", "COMIC_points", "rmse")
 INTEGRALS = ("H_C_analytic", "E_analytic", "entropy", "dilution")
 _MEMO = 4  # densities an exact plume keeps, by their points: the measurement points, FD's nodes, ...
+_MEMO_POINTS = 100_000  # ... of sets up to this size (a particle cloud's, asked once, is not kept)
 
 
 def released_span(release: Release, t_final: float, t: float) -> tuple[float, float]:
@@ -112,7 +113,7 @@ def measure_finite(measure: str, source, D, release: Release, t: float, points=N
 
 class ExactPlume:
     """The exact plume of a release at one t (ReleaseReference or ReleaseReference2D, ``reference``) and
-    the densities asked of it, kept by their points (the last _MEMO sets)."""
+    the densities asked of it, kept by their points (the last _MEMO sets of up to _MEMO_POINTS)."""
 
     def __init__(self, reference):
         self.reference = reference
@@ -121,6 +122,8 @@ class ExactPlume:
     def density(self, points) -> np.ndarray:
         """c at ``points`` (the reference's density, computed once per set of points) [M/L^d]."""
         p = np.asarray(points, dtype=np.float64)
+        if len(p) > _MEMO_POINTS:
+            return self.reference.density(p)
         key = (p.shape, p.tobytes())
         if key not in self._densities:
             if len(self._densities) >= _MEMO:
