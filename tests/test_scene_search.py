@@ -817,3 +817,57 @@ def test_the_sweep_figure_draws_each_dimension_in_its_own_lines_and_shades_each_
     assert spans == [(50.0, 500.0), (500.0, 700.0)]
     labels = [p.get_label() for p in shaded]
     assert any(lab.startswith("1-D:") for lab in labels) and any(lab.startswith("2-D:") for lab in labels)
+
+
+def test_the_sweep_figure_s_ticks_are_decades_that_never_overlap_and_its_labels_part():
+    """Two sweeps' Peclet numbers a few percent apart (42 and 51) would overlap as ticks: the axis
+    ticks the decades the sweeps span (and "0" where a sweep is at rest), and the 2-D sweep's FD labels
+    sit above its line while the 1-D ones sit below theirs."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from particle_entropy.figures.scenes_peclet import scenes_peclet
+
+    tables = [
+        _answer("peclet-0", 0.0, 0.1, 0.4),
+        _answer("peclet-1", 51.0, 0.2, 0.4),
+        _answer("peclet-2", 5091.0, 1.0, 0.3),
+        _answer("peclet2d-0", 42.0, 0.1, 0.4),
+        _answer("peclet2d-1", 679.0, 13.0, 1.5),
+    ]
+    fig = scenes_peclet(S.peclet_table(tables))
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels == ["0", "10", "100", "1,000", "10,000"]
+    ticks = list(ax.get_xticks())
+    assert ticks[1:] == [10.0, 100.0, 1000.0, 10000.0] and ticks[0] < 10.0
+    notes = [a for a in ax.texts if a.get_text().startswith("upwind")]
+    below = {round(a.xy[0], 6) for a in notes if a.get_position()[1] < 0}
+    above = {round(a.xy[0], 6) for a in notes if a.get_position()[1] > 0}
+    assert above == {42.0, 679.0} and 51.0 in below and 5091.0 in below
+
+
+def test_a_round_reads_a_few_columns_and_still_names_a_bad_run_table(tmp_path):
+    """read_runs reads only the columns a round needs (a run table holds dozens), and a run table
+    that is missing or not a table still ends in a TableReadError naming it, not in a schema error."""
+    from particle_entropy.core.io import TableReadError, write_parquet
+    from particle_entropy.models.simulate import run
+
+    central = {"method": "fd", "kernel": "implicit", "advection": "central", "fd_dt": 1.0, "n_range": [64, 512]}
+    spec = {"D": 1e-4, "v": 0.03, "t_final": 20.0, "target": {"value": 0.05}, "candidates": [central]}
+    scene = Scene.from_config("s", spec)
+    table, _ = run(scene.run_config(scene.candidates[0], 64))
+    path = tmp_path / "runs.parquet"
+    write_parquet(table.assign(unread=np.nan), path)
+    plan = pd.DataFrame([{"candidate": 0, "label": "", "n": 64, "first": 0, "last": 0, "round": 0}])
+    row = S.read_runs(plan, [str(path)]).iloc[0]
+    last = table.iloc[-1]
+    assert row["SSE_points"] == last["SSE_points"] and row["steps"] == last["step"]
+    assert row["core_s"] == pytest.approx(table["wall_s"].sum(), rel=1e-12)
+    read = S._run_columns(str(path), ["SSE_points"])
+    assert read == ["seed", "step", "time", "dt", "mass_min", "wall_s", "SSE_points"]
+    for bad in (tmp_path / "missing.parquet", tmp_path / "garbled.parquet"):
+        if bad.name.startswith("garbled"):
+            bad.write_bytes(np.random.default_rng(3).bytes(2000))
+        with pytest.raises(TableReadError, match=bad.name):
+            S.read_runs(plan, [str(bad)])

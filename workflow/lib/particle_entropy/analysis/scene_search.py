@@ -34,7 +34,7 @@ from ..core.io import read_parquet
 from ..scenes import defined
 from ..scenes.scene import SCENE_RUN_PATTERN, Candidate, Scene, sweep_of
 from .resampling import CONFIDENCE
-from .search import AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
+from .search import WALL, AdaptiveSearch, check_plan_columns, measured_core_s, new_plan, next_round, seed_block
 
 CLIMB = 2  # rungs climbed a round while no rung passes
 # half_step: the row runs the candidate at half its time step (Scene.half_step), checking its answer
@@ -579,6 +579,20 @@ def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
 REACTIVE_ONLY = ("product_error", "SSE_points_C", "mass_lost_BC")  # a reactive run's columns (models/simulate.py)
 
 
+def _run_columns(path: str, keep: list[str]) -> list[str] | None:
+    """The columns of the run table at ``path`` that read_runs reads: a run table holds every step's
+    measures (dozens of columns), of which a round needs a few; a conservative run has no REACTIVE_ONLY.
+    None (every column) where its schema cannot be read, so that read_parquet names the table's fault."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        have = set(pq.read_schema(path).names)
+    except (OSError, pa.ArrowException):
+        return None
+    return ["seed", "step", "time", "dt", "mass_min", WALL, *keep, *(k for k in REACTIVE_ONLY if k in have)]
+
+
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """One row per run of a plan (``paths`` in its order): the last step's measures, the smallest
     mass over every step and its first negative step (negative_steps), the run's work and its
@@ -601,7 +615,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     if plan.empty:  # every candidate over the budget: nothing ran
         return pd.DataFrame(rows, columns=[*columns, "steps", "core_s"])
     for r, path in zip(plan.itertuples(), paths):
-        table = read_parquet(path)
+        table = read_parquet(path, columns=_run_columns(path, keep))
         core_s = measured_core_s(table, ["seed"]).set_index("seed")["core_s"]
         for seed, g in table.groupby("seed", sort=True):
             g = g.sort_values("step")

@@ -497,6 +497,32 @@ SCENE_MEASURES = ("rmse", "entropy", "dilution", "product", "product_rmse")
 # the authors' grid (whole growing steps while t < t_final) would judge them later (t = 51.6 for 50)
 SCENE_TIME_GRID_TEXT = "exact (a scene is judged at t_final; the authors' grid steps past it)"
 SOURCE_SHAPE = with_pairs(source_shape())  # the kinds of core/sources.py and core/sources2d.py
+# A scene's source may let its mass out over time instead of all at t = 0 (core/release.py's Release:
+# rate q from t0 until t1); the rules between these keys and t_final are core/typed.py's (Release, _Scene).
+RELEASE_SHAPE = {
+    "type": "object",
+    "x-model": "Release",  # core/typed.py's, with the rule: until after from, each number finite
+    "additionalProperties": False,
+    "required": ["rate"],
+    "properties": {
+        "rate": {
+            "type": "number",
+            "exclusiveMinimum": 0,
+            "description": "q, the mass released per unit time [M/T]; a number > 0 and finite",
+        },
+        "from": {
+            "type": "number",
+            "minimum": 0,
+            "description": "t0, when the release starts [T]; a number >= 0 and < t_final (default 0)",
+        },
+        "until": {
+            "oneOf": [{"type": "number", "minimum": 0}, {"type": "null"}],
+            "description": "t1, when it stops [T]; a number > from, or absent (null): it releases up to t_final",
+        },
+    },
+}
+# a scene's own source: a kind and, optionally, its release (B's plume in a reaction takes none)
+SCENE_SOURCE_SHAPE = {**SOURCE_SHAPE, "properties": {**SOURCE_SHAPE["properties"], "release": RELEASE_SHAPE}}
 # a 2-D scene's dispersion (core/sources2d.dispersion_tensor): along and across the flow, or along the axes
 DISPERSION_2D_SHAPE = {
     "type": "object",
@@ -594,10 +620,13 @@ SCENE = (
         "source",
         "scenes.<name>.source",
         {"kind": "point", "x0": 0.0},
-        f"the initial plume, unit mass: {source_forms()}; in 2-D the same with pairs: {source_forms_2d()}",
+        f"the initial plume, unit mass: {source_forms()}; in 2-D the same with pairs: {source_forms_2d()}; any "
+        "kind may add release: {rate: q, from: t0, until: t1}, its mass let out at q per unit time from t0 until "
+        "t1 (absent or null: up to t_final) instead of all at t = 0",
         kind="shape",
-        shape=SOURCE_SHAPE,
-        range_text=source_ranges(),
+        shape=SCENE_SOURCE_SHAPE,
+        range_text=f"{source_ranges()}; a release's rate > 0, 0 <= from < t_final, until > from (none in a reactive "
+        "scene)",
     ),
     Setting(
         "reaction",

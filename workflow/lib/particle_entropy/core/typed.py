@@ -51,6 +51,7 @@ from .settings import (
     CASE_SECTION,
     MAX_REALISATIONS,
     REALISATIONS_DOC,
+    RELEASE_SHAPE,
     SCENE,
     SCENES_PECLET,
     SCENES_PECLET2D,
@@ -122,6 +123,8 @@ def annotation(fragment: dict, defs: dict | None = None):
         return functools.reduce(operator.or_, (annotation(f, defs) for f in fragment["oneOf"]))
     if "enum" in fragment:
         return Literal[tuple(fragment["enum"])]
+    if kind == "null":  # a key that may be written null (a release's open until): the one value None
+        return type(None)
     if kind in ("number", "integer"):
         bounds = {arg: fragment[key] for key, arg in _BOUNDS.items() if key in fragment}
         return integer(**bounds) if kind == "integer" else number(**bounds)
@@ -552,6 +555,29 @@ class _Scene(Section):
         return self
 
     @model_validator(mode="after")
+    def _release_in_time(self):
+        """A source's release must put mass in before t_final, and only into a conservative scene: the
+        reactive runs count their source's unit mass at t = 0 (core/runconfig.py refuses a reactive run
+        with a release)."""
+        release = self.source.get("release") if isinstance(self.source, Mapping) else None
+        if release is None:
+            return self
+        if self.reaction is not None:
+            raise refuse(
+                "source.release",
+                "absent in a reactive scene: its runs and reference start from the source's unit mass at t = 0 "
+                "(a reaction with a release is not built); drop the release or the reaction",
+            )
+        start = release.get("from", 0.0)
+        if not start < self.t_final:
+            raise refuse(
+                "source.release.from",
+                f"a time in [0, t_final = {self.t_final:g}) [T]: a release that starts at or after the observation "
+                "has put no mass in by then",
+            )
+        return self
+
+    @model_validator(mode="after")
     def _blocks(self):
         r, most = self.realisations, self.max_realisations
         if most is not None and (most < r or most % r):
@@ -650,8 +676,42 @@ class _Dispersion(OneOf):
         return self.model_dump(exclude_unset=True)
 
 
+class _Release(OneOf):
+    """A source's release (core/release.py's Release): every number finite, until after from (the rule
+    between release.from and the scene's t_final is the scene's: _Scene)."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _finite(cls, data):  # before the bounds, so that nan and inf are refused with their range
+        if not isinstance(data, Mapping):
+            return data
+        for key in ("rate", "from", "until"):
+            value = data.get(key)
+            if isinstance(value, float) and not math.isfinite(value):
+                described = RELEASE_SHAPE["properties"][key]["description"]
+                raise refuse(key, f"{described} (a finite number: YAML .nan and .inf are not settings)")
+        return data
+
+    @model_validator(mode="after")
+    def _until_after_from(self):
+        start, end = getattr(self, "from") or 0.0, self.until
+        if end is not None and not end > start:
+            raise refuse(
+                "until",
+                f"a time > from = {start:g} [T]: the release stops after it starts; or absent "
+                "(null): it releases up to t_final",
+            )
+        return self
+
+
 # the models of structured values whose rules their owner states
-_OWNED = {"Candidate": _Candidate, "Reaction": _Reaction, "SpeciesB": _SpeciesB, "Dispersion": _Dispersion}
+_OWNED = {
+    "Candidate": _Candidate,
+    "Reaction": _Reaction,
+    "SpeciesB": _SpeciesB,
+    "Dispersion": _Dispersion,
+    "Release": _Release,
+}
 
 
 def keys_in(prefix: str, settings) -> tuple:

@@ -7,6 +7,8 @@ shaded over the sweep's spacing. Each FD answer is labelled with its scheme, gri
 
 from __future__ import annotations
 
+import math
+
 import pandas as pd
 
 from ..analysis.scene_search import FAMILIES, crossover
@@ -23,6 +25,24 @@ def _fd_numbers(row) -> str:
 
 
 LINES = {1: "-", 2: "--"}  # a sweep's dimension -> its lines
+NOTE_AT = {1: (4, -10), 2: (4, 5)}  # and its FD labels' offset in points: below the 1-D line, above the 2-D one
+
+
+def _pe_ticks(x_of: dict) -> tuple[list[float], list[str]]:
+    """The x ticks: the decades the sweeps span (two sweeps' Peclet numbers may lie a few percent apart,
+    whose own ticks would overlap) and, where a sweep has Pe = 0, "0" where it is drawn."""
+    drawn = [x for p, x in x_of.items() if p > 0]
+    ticks, labels = [], []
+    if len(drawn) != len(x_of):
+        zero = x_of[0] if 0 in x_of else min(x_of.values())
+        ticks, labels = [zero], ["0"]
+    if drawn:
+        lo, hi = math.floor(math.log10(min(drawn))), math.ceil(math.log10(max(drawn)))
+        ticks += [10.0**k for k in range(lo, hi + 1)]
+        labels += [f"{10.0**k:,.0f}" if k >= 0 else f"{10.0**k:g}" for k in range(lo, hi + 1)]
+    return ticks, labels
+
+
 SHADES = {1: {"color": "0.88"}, 2: {"facecolor": "none", "edgecolor": "0.55", "hatch": "///", "lw": 0}}
 
 
@@ -61,8 +81,8 @@ def scenes_peclet(table: pd.DataFrame):
         logy=True,
         legend=None,
     )
-    ticks = [x_of[p] for p in pe]
-    ax.set_xticks(ticks, [f"{p:,.3g}" for p in pe], rotation=30)
+    ticks, labels = _pe_ticks(x_of)
+    ax.set_xticks(ticks, labels)
     ax.minorticks_off()
     ax.legend(fontsize=6, loc="best")
     return fig
@@ -96,7 +116,7 @@ def _draw_sweep(ax, table: pd.DataFrame, dim: int, x_of: dict, top: float, named
                 ax.annotate(
                     _fd_numbers(row),
                     (px, row.cost_s),
-                    xytext=(4, -10),
+                    xytext=NOTE_AT[int(dim)],
                     textcoords="offset points",
                     fontsize=6,
                     color=colour,

@@ -21,11 +21,13 @@ import typing
 from pathlib import Path
 
 import annotated_types as at
+import yaml
 from pydantic import StrictBool, StrictInt
 from pydantic.fields import FieldInfo
 
 from ..core.case import NONE
 from ..core.settings import BY_KEY, SETTINGS, UNIQUE
+from ..core.typed import SAFE_LOADER
 from . import config as typed
 from .configcheck import SCHEMA_PATH
 
@@ -47,7 +49,9 @@ def _yaml(value) -> str:
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_yaml(v) for v in value) + "]"
     if isinstance(value, str) and not re.fullmatch(r"[A-Za-z_][\w-]*", value):
-        return json.dumps(value)  # quoted; a plain word stays plain
+        return json.dumps(value)  # quoted; a plain word stays plain ...
+    if isinstance(value, str) and yaml.load(value, Loader=SAFE_LOADER) != value:
+        return json.dumps(value)  # ... unless YAML reads it as another value (null, true, no)
     return str(value) if not isinstance(value, bool) else str(value).lower()
 
 
@@ -103,9 +107,10 @@ class Writer:
             return self.entry(args[0], [*args[1:], *metadata])
         if origin in (typing.Union, types.UnionType):
             kinds = [a for a in args if a is not type(None)]
-            if len(kinds) == 1:  # optional: the key may be left out
+            null = [{"type": "null"}] if len(kinds) < len(args) else []  # a key that may be written null
+            if len(kinds) == 1 and not null:
                 return self.entry(kinds[0], metadata)
-            return {"oneOf": [self.entry(a) for a in kinds]}
+            return {"oneOf": [self.entry(a) for a in kinds] + null}
         if origin is typing.Literal:
             return {"type": "string", "enum": list(args)}
         if origin is list:

@@ -13,6 +13,8 @@ import math
 import sys
 from collections.abc import Callable
 
+import numpy as np
+
 from ..core.case import SettingError
 from ..core.runconfig import check_plume_width
 from ..core.settings import SCENE_REACH
@@ -79,6 +81,55 @@ def check_reach(scene) -> None:
     key = source.POSITION  # the parameter that places the source
     raise SettingError(
         scene.key(f"source.{key}"), getattr(source, key), f"a number in [{-reach:.6g}, {reach:.6g}]: {why}"
+    )
+
+
+# How near a 2-D point source, in standard deviations of the released plume (the Mahalanobis distance by
+# its covariance), a measurement point counts as on it: the exact plume's quadrature (core/release.py)
+# holds the density to its closed form down to ~1e-10 of the plume's width from the source, and the
+# density is infinite on it.
+AT_SOURCE = 1e-10
+
+
+def check_release_points(scene) -> None:
+    """SettingError naming scenes.<name>.target.measure where an rmse target would need the concentration
+    at a 2-D point source that is still releasing at t_final: it is infinite there (c grows as ln(1/r)
+    toward the point). The RMSE is taken at the 15 x 15 lattice over the released plume (its centre x0 +
+    v a, a the puffs' mean age, along its principal axes); a lattice point within AT_SOURCE sd of the
+    source is on it: always at v = 0 (the lattice's centre is the source), in a flow where the source
+    falls on a tick. H_C and E integrate c ln c and c over the plume, finite (the singularity is
+    integrable), and a release that ends before t_final, or a source with an extent, has a finite
+    concentration everywhere: those are not refused."""
+    release = scene.release
+    if release is None or scene.dim != 2 or scene.source.kind != "point" or release.end is not None:
+        return
+    if scene.measure != "rmse":
+        return
+    plume = scene.reference
+    points = np.asarray(scene.points, dtype=np.float64)
+    offset = points - np.asarray(scene.source.centre, dtype=np.float64)
+    inverse = np.linalg.inv(np.asarray(plume.covariance, dtype=np.float64))
+    sds = np.sqrt(np.einsum("ij,jk,ik->i", offset, inverse, offset))
+    i = int(np.argmin(sds))
+    if sds[i] > AT_SOURCE:
+        return
+    n = round(math.sqrt(len(points)))
+    where = (
+        "its centre: at v = 0 the lattice is centred on the source"
+        if scene.speed == 0.0
+        else (
+            f"point ({i // n}, {i % n}), {sds[i]:.3g} sd from it: the flow has carried the lattice's centre a whole "
+            "number of its steps from the source"
+        )
+    )
+    raise SettingError(
+        scene.key("target.measure"),
+        scene.measure,
+        "entropy or dilution (integrals over the plume, finite), or rmse at points away from the source: a 2-D "
+        "point source still releasing at t_final (release without until, or until >= t_final) has an infinite "
+        f"concentration where it stands, and the {n} x {n} measurement lattice has a point on it, {where}; "
+        "rmse is allowed where no point is (another v), for a release that ends before t_final, or for a "
+        "source with an extent (a gaussian or a box)",
     )
 
 

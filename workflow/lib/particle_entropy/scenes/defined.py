@@ -69,8 +69,12 @@ def check(scene, ref: dict | None) -> None:
 
 def closed_form(scene) -> dict | None:
     """A scene's reference when it is a closed form known before any job, as ``undefined`` reads it: a
-    conservative plume's exact values at the scene's points (core/reference.py, no error of its own),
-    or a reaction without B (scenes/reference.compute); None for A + B -> C, solved by a job."""
+    conservative plume's exact values at the scene's points (core/reference.py, no error of its own; a
+    release's by its quadrature in age, core/release.py, to ~1e-10), or a reaction without B
+    (scenes/reference.compute); None for A + B -> C, solved by a job."""
+    if scene.reaction is None and scene.release is not None:
+        values = _released(scene).density(scene.points)
+        return {"a_points": values.tolist(), "a_error": np.zeros_like(values).tolist()}
     if scene.reaction is None:
         values = scene.reference.density(scene.points)
         return {"a_points": values.tolist(), "a_error": np.zeros_like(values).tolist()}
@@ -79,3 +83,14 @@ def closed_form(scene) -> dict | None:
     if scene.reaction.closed_form(scene.t_final) is not None:
         return reference.compute(reference.physics(scene))
     return None
+
+
+def _released(scene):
+    """The exact plume of the scene's release at t_final (core/release.py): c at any point, by quadrature
+    in the puffs' ages."""
+    from ..core.release import ReleaseReference, ReleaseReference2D
+
+    if scene.dim == 2:
+        D, v = np.asarray(scene.D, dtype=np.float64), np.asarray(scene.v, dtype=np.float64)
+        return ReleaseReference2D(scene.source, scene.release, D, v, scene.t_final)
+    return ReleaseReference(scene.source, scene.release, scene.D, scene.v, scene.t_final)

@@ -12,7 +12,7 @@ import functools
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -23,6 +23,8 @@ from ..core.reactions import Reaction, ReactionError
 from ..core.reference import Reference
 from ..core.reference2d import Reference2D
 from ..core.registry import DEFAULT_ADVECTION, MEASUREMENT_POINTS
+from ..core.release import Release, ReleaseError
+from ..core.released import ReleasedPlume, ReleasedPlume2D, released_span
 from ..core.runconfig import RunConfig
 from ..core.runcost import StepWork, Tally
 from ..core.settings import MAX_REALISATIONS, PAPER, PLANE_COST, REACTIVE_COST, SCENE, SCENE_REACH, defaults
@@ -244,6 +246,9 @@ class Scene:
     paper_pattern: str = ""  # the paper run's table pattern, for those
     max_realisations: int = 0  # the most realisations of a particle rung, in blocks of ``realisations`` (0: 4 x)
     reaction: Reaction | None = None  # A -> C or A + B -> C (core/reactions.py); None: conservative
+    # the source's mass let out at a rate over time (core/release.py; end None: up to t_final, also where the
+    # config's until is t_final or later); None: all of it at t = 0
+    release: Release | None = None
 
     @property
     def blocks(self) -> int:
@@ -293,7 +298,12 @@ class Scene:
 
     @property
     def reference(self):
-        """The exact solution at the observation time (2-D: core/reference2d.Reference2D)."""
+        """The exact solution at the observation time (2-D: core/reference2d.Reference2D); with a release,
+        what its runs are measured against (RunConfig.reference: core/released.py's plume, whose moments
+        place the measurement points)."""
+        if self.release is not None:
+            kind = ReleasedPlume2D if self.dim == 2 else ReleasedPlume
+            return kind(self.source, self.D, self.v, self.t_final, self.release, self.t_final)
         if self.dim == 2:
             return Reference2D(self.source, self.D, self.v, self.t_final)
         return Reference(self.source, self.D, self.v, self.t_final)
@@ -322,9 +332,12 @@ class Scene:
         """The width the measurement points span, whatever the FD window: 2 REACH sqrt(2 variance)
         of the exact plume at t_final (the paper's 12 at its t = 1000), or the source's extent
         widened by REACH sqrt(4 D t_final) each side where that is less (a wide box, whose variance
-        overstates its reach) [L]."""
-        by_variance = REACH * math.sqrt(2.0 * self.reference.variance)
-        by_extent = self.source.half_width + REACH * math.sqrt(4.0 * self.D * self.t_final)
+        overstates its reach); a release's streak of puffs, |v| A long after A of releasing, adds half its
+        length to the extent [L]."""
+        exact = self.reference
+        by_variance = REACH * math.sqrt(2.0 * exact.variance)
+        streak = 0.0 if self.release is None else 0.5 * abs(self.v) * exact.ages()[1]
+        by_extent = self.source.half_width + streak + REACH * math.sqrt(4.0 * self.D * self.t_final)
         return 2.0 * min(by_variance, by_extent)
 
     @property
@@ -341,9 +354,14 @@ class Scene:
         (tests/test_rest_frame.py).
         Scenes that differ only in v thus share their particle runs (the identity digests settings).
         Not FD, whose grid and advection scheme the flow sets; not a reactive scene, whose B need not
-        move with A; not a 2-D scene whose measurement lattice turns with v (an isotropic plume's
-        axes are along v: Reference2D.axes), whose points at rest would be others."""
+        move with A; not a scene with a release, whose source stays where it is while the flow carries
+        what it has let out (at rest every puff would start at the source's place, in the flow each
+        starts there too but its elders have moved on: no one shift maps the two); not a 2-D scene whose
+        measurement lattice turns with v (an isotropic plume's axes are along v: Reference2D.axes),
+        whose points at rest would be others."""
         if candidate.case.method == "fd" or self.reaction is not None or self.speed == 0.0:
+            return False
+        if self.release is not None:
             return False
         if self.dim == 1:
             return True
@@ -378,6 +396,8 @@ class Scene:
             out["window"] = self.points_span  # the measurement points span the plume, at rest too
         if self.reaction is not None:  # only then: a conservative scene's runs keep their identity
             out["reaction"] = self.reaction.record()
+        if self.release is not None:  # likewise: {rate, start, end}, as RunConfig reads it back
+            out["release"] = asdict(self.release)
         if candidate.case.method == "fd":
             if candidate.courant is None:
                 out["dt0"] = candidate.fd_dt
@@ -398,7 +418,7 @@ class Scene:
         """The checked run of a candidate at resolution n, as its jobs run it (settings); ``carried``:
         at the scene's own v, the run that one at rest stands for (runs_at_rest), as the checks judge it."""
         settings = self.settings(candidate)
-        settings["source"], settings["reaction"] = self.source, self.reaction
+        settings["source"], settings["reaction"], settings["release"] = self.source, self.reaction, self.release
         if carried:
             settings["v"] = self.v
         return RunConfig.for_case(replace(candidate.case, n=n), seed=seed, **settings).resolved()
@@ -422,14 +442,15 @@ class Scene:
         path of a bad value, also for the rules that need the built scene and its runs."""
         s = spec if isinstance(spec, SPEC) else validate(SPEC, spec, functools.partial(_where, name))
         key = functools.partial(key_path, name)
+        s, release = _release(key, s)  # the source's keys apart from its release's
         if _plane_keys(s):
-            return cls._in_plane(name, s, key, case_defaults)
+            return cls._in_plane(name, s, key, case_defaults, release)
         D, v, t_final, r = s.D, s.v, s.t_final, s.realisations
         source = _source(key, s.source)
         reaction = _reaction(key, s.reaction)
         extent = _extent(source, reaction)  # the domains hold a second species' plume too
         span = 2.0 * (extent + s.margin * math.sqrt(2.0 * D * t_final))
-        omega = span if s.omega is None else s.omega
+        omega = span + 2.0 * abs(v) * _released_for(release, t_final) if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         if s.fd_length is not None:  # from the margin it holds the plume by the margin's range
             scene_checks.check_window(key, fd_length, extent, D, t_final)
@@ -450,7 +471,7 @@ class Scene:
         budget = math.inf if s.budget is None else s.budget
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
-        scene = replace(scene, budget=budget, max_realisations=most, reaction=reaction)
+        scene = replace(scene, budget=budget, max_realisations=most, reaction=reaction, release=release)
         scene_checks.check_reach(scene)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             c.check_runs(scene, i, s.candidates[i].model_fields_set)
@@ -459,10 +480,11 @@ class Scene:
         return scene
 
     @classmethod
-    def _in_plane(cls, name: str, s, key, case_defaults: Mapping | None) -> Scene:
-        """A 2-D scene (issue 52): v [vx, vy], D {L, T} or {x, y}, a 2-D source; its domains the source's
-        extent plus ``margin`` sd of 2 D t_final along each axis (core/plane.source_reach), every candidate's
-        runs checked at both ends of its ladder (core/plane.check)."""
+    def _in_plane(cls, name: str, s, key, case_defaults: Mapping | None, release: Release | None = None) -> Scene:
+        """A 2-D scene (issue 52): v [vx, vy], D {L, T} or {x, y}, a 2-D source (and its ``release``); its
+        domains the source's extent plus ``margin`` sd of 2 D t_final along each axis (core/plane.source_reach;
+        the particles' also the path |v| t_e a release's first puffs travel while the source stays), every
+        candidate's runs checked at both ends of its ladder (core/plane.check)."""
         _check_plane_keys(s, key)
         if s.reaction is not None:
             raise SettingError(
@@ -481,7 +503,8 @@ class Scene:
         t_final, r = s.t_final, s.realisations
         sd = np.sqrt(np.diag(2.0 * np.asarray(D) * t_final))  # of 2 D t_final along each axis
         span = 2.0 * float(np.max(plane.source_reach(source) + s.margin * sd))
-        omega = span if s.omega is None else s.omega
+        path = np.abs(np.asarray(v)) * _released_for(release, t_final)  # 0 without a release
+        omega = 2.0 * float(np.max(plane.source_reach(source) + s.margin * sd + path)) if s.omega is None else s.omega
         fd_length = span if s.fd_length is None else s.fd_length
         cands = tuple(
             Candidate.from_spec(c, case_defaults or {}, lambda k, i=i: key(f"candidates[{i}].{k}"))
@@ -496,9 +519,10 @@ class Scene:
         budget = math.inf if s.budget is None else s.budget
         most = s.max_realisations or min(MAX_BLOCKS, MAX_REALISATIONS // r) * r
         scene = cls(name, D, v, t_final, source, omega, fd_length, s.target.measure, s.target.value, r, cands, cost)
-        scene = replace(scene, budget=budget, max_realisations=most)
+        scene = replace(scene, budget=budget, max_realisations=most, release=release)
         for i, c in enumerate(cands):  # every candidate's runs must fit their domains, at both ends
             c.check_runs(scene, i, s.candidates[i].model_fields_set)
+        scene_checks.check_release_points(scene)  # no measurement point where the exact plume is infinite
         defined.check(scene, defined.closed_form(scene))
         return scene
 
@@ -535,6 +559,32 @@ def _source2d(key, spec):
         return Source2D.of(**spec)
     except SourceError as e:
         raise SettingError(key(f"source.{e.param}"), e.value, e.allowed) from None
+
+
+def _release(key, s):
+    """(the parsed scene ``s`` with its source's keys only, the Release at scenes.<name>.source.release or
+    None); a release still on at t_final (until >= t_final) is the open one, whose runs it shares.
+    SettingError names the key path (the model, core/typed.py, has held every key to its range)."""
+    spec = s.source.get("release") if isinstance(s.source, Mapping) else None
+    if spec is None:
+        return s, None
+    try:
+        release = Release.from_spec(spec)
+    except ReleaseError as e:
+        raise SettingError(key(f"source.release.{e.param}"), e.value, e.allowed) from None
+    if release.end is not None and release.end >= s.t_final:
+        release = replace(release, end=None)
+    source = {k: value for k, value in s.source.items() if k != "release"}
+    return s.model_copy(update={"source": source}), release
+
+
+def _released_for(release: Release | None, t_final: float) -> float:
+    """t_e = min(until, t_final), when a release stops letting mass out by t_final (0 without one) [T]: the
+    particles' domain, carried by the flow from the source since t = 0, has left the source |v| t_e behind
+    by then (RunConfig's MTPT check of a release holds omega to it)."""
+    if release is None:
+        return 0.0
+    return released_span(release, t_final, t_final)[1]
 
 
 def _where(name: str, path: list) -> str:
@@ -682,7 +732,7 @@ def shares_paper_runs(scene: Scene, pattern: str, paper_run) -> Scene:
     particle candidate of a carried scene of the paper's physics shares them too: its runs are
     computed at rest (Scene.runs_at_rest), with the paper's RunConfig and points exactly."""
     shared = set()
-    if scene.reaction is not None or scene.dim == 2:  # a reactive or 2-D scene's runs: none is the paper's
+    if scene.reaction is not None or scene.dim == 2 or scene.release is not None:  # none of their runs is the paper's
         return replace(scene, paper_pattern=pattern)
     for ci, cand in enumerate(scene.candidates):
         mine = scene.run_config(cand, cand.n_lo)
