@@ -74,9 +74,12 @@ RECORD_COLUMN_DOCS = {  # records.COLUMNS
     "mass_min": "smallest particle or node mass (PT: 1/N; with a release m_p, NaN while none is released)",
     "mass_released": "with a continuous release only: the mass released by this time, q times the overlap of "
     "[0, t] with [t0, t1] (models/release_step.py); FD's `mass_total` + `mass_outflow` and MTPT's `mass_total` "
-    "equal it to round-off. A release run's entropies are NaN while it holds no mass, and its scores against "
-    "the exact plume (`SSE`, `COMIC`, `SSE_points`, `COMIC_points`, `H_C_analytic`, `E_analytic`) NaN: the "
-    "release's exact reference is not part of the runs (core/released.py)",
+    "equal it to round-off. A release run's entropies are NaN while it holds no mass. Its scores against "
+    "the exact plume (core/released.py: quadrature in age; `SSE`, `COMIC`, `SSE_points`, `COMIC_points`, "
+    "`H_C_analytic`, `E_analytic`) are on its last row only, at t_final, NaN before: `H_C_analytic` and "
+    "`E_analytic` of the plume normalised to unit mass, the SSEs of the concentration of the mass released "
+    "(PT's estimate times its particles' mass) [M²/L²]; NaN where the exact concentration is infinite (a 2-D "
+    "point source still releasing, at its point)",
     "mass_outflow": "with a continuous release only: the mass that has left the FD window through its end nodes "
     "(2-D: its boundary ring) by this time, the sum of each step's flux into them as its mass balance counts it "
     "(0 for particles)",

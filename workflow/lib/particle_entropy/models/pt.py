@@ -75,7 +75,9 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float, m_p: float | None = 
     """Entropies, dilution index and fitness of the reconstruction at time t; SSE_points and
     COMIC_points interpolate the same reconstruction (bin centres or the kernel's grid) to the
     measurement points (measures.sse_points). ``m_p``: a release's particle mass (models/release_step.py),
-    its particles those released so far (none yet: NaN measures); None: N particles of 1 / N."""
+    its particles those released so far (none yet: NaN measures), whose SSEs are of the estimate times
+    the mass they hold, as the exact plume's concentration carries the mass released (core/released.py);
+    None: N particles of 1 / N."""
     dV = cfg.dV
     n = cfg.n if m_p is None else x_sorted.size
     if n == 0:
@@ -94,8 +96,9 @@ def measure(cfg: RunConfig, x_sorted: np.ndarray, t: float, m_p: float | None = 
         h_i, err, n_pts, err_points = -math.inf, 0.0, 1, 0.0
     else:
         h_i = M.entropy_inconsistent(f, spacing)
-        err, n_pts = M.sse(f, ref.sampled(pts, spacing)), pts.size
-        err_points = ref.sse_points(points, pts, f, spacing)
+        c = f if m_p is None else f * (n * m_p)  # a release's: the estimate times the mass its particles hold
+        err, n_pts = M.sse(c, ref.sampled(pts, spacing)), pts.size
+        err_points = ref.sse_points(points, pts, c, spacing)
     h_c = M.entropy_consistent(h_i, dV)
     h_d = math.log(n)  # Eq. 13: equal masses 1/N
     return {

@@ -26,8 +26,9 @@ exact plume the step's release has become; PT as particles released at their own
 each walked from its release on.
 
 A conservative row holds the paper's measures (each model's ``measure``) and the exact solution's; a
-release's row also the mass released so far and, for FD, the mass that has left the window (its exact
-solution's scores are NaN here: core/released.py); a reactive row the masses of A, B and the product
+release's row also the mass released so far and, for FD, the mass that has left the window, and its
+exact solution's scores at the last row only (core/released.py: the exact plume is a quadrature in age,
+built by warm_up before the timed steps; NaN before); a reactive row the masses of A, B and the product
 made so far, A + C still held (mass_total) and the fraction of B + C lost (mass_lost_BC: FD's window
 ends let both totals out, particles none), and the last row also the errors against the scene's
 reference: the SSE of C_A and of C_C at the scene's points (SSE_points, SSE_points_C) and the product
@@ -98,7 +99,9 @@ def _model(method: str):
 def warm_up(cfg: RunConfig) -> None:
     """Load the compiled kernels this case calls (numba's on-disk cache, ~0.05-0.4 s once per
     process) and what its exact solution is computed with before the timed steps, so that step 0's
-    and step 1's wall times are the steps' own."""
+    and step 1's wall times are the steps' own; with a release, its exact plume at t_final (warm_release)."""
+    if cfg.release is not None:
+        warm_release(cfg)
     if cfg.dim == 2:  # the plane's steps compile their pair loops (numerics/pair_transfer) when first run
         return
     advection = cfg.advection if cfg.v != 0.0 else None  # FD in a flow: its scheme's solver
@@ -109,6 +112,18 @@ def warm_up(cfg: RunConfig) -> None:
     if ("reference", cfg.source.kind) not in _WARM:
         cfg.source.warm_up()
         _WARM.add(("reference", cfg.source.kind))
+
+
+def warm_release(cfg: RunConfig) -> None:
+    """Build the exact plume a release run's last row is scored against (core/released.py) before the
+    timed steps: its H_I and its density at the measurement points and, on the line, FD's nodes, which
+    released.exact_plume keeps for that row (0.01-2 s, the quadrature in age: not the model's cost)."""
+    t = cfg.t_final
+    ref = cfg.reference(t)
+    ref.entropy()
+    ref.density(cfg.points(t))
+    if cfg.dim == 1 and cfg.method == "fd":
+        ref.density(_model("fd").grid(cfg)[0])
 
 
 # ------------------------------------------------------------------------------------ the rows
