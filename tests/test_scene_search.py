@@ -377,6 +377,38 @@ def test_a_run_negative_mid_way_is_unscored_though_it_ends_positive(tmp_path):
     )
 
 
+def test_a_release_run_s_mass_is_judged_against_what_it_released(tmp_path):
+    """A release run holds the mass q t its source let out, not 1: read_runs gives its mass_total as the
+    fraction it holds of that (FD: what its window has not let out), so that it is scored as a spill is;
+    a run that lost more than MASS_LOSS_MAX of it is unscored."""
+    from particle_entropy.core.io import write_parquet
+    from particle_entropy.models.simulate import run
+
+    fd = {"method": "fd", "kernel": "implicit", "advection": "tvd", "courant": 0.75, "n_range": [32, 64]}
+    spec = {
+        "v": [0.5, 0.0],
+        "D": {"L": 1e-2, "T": 1e-3},
+        "t_final": 4.0,
+        "source": {"kind": "point", "x0": [0.0, 0.0], "release": {"rate": 250.0}},
+        "target": {"measure": "dilution", "value": 0.05},
+        "candidates": [fd],
+    }
+    scene = Scene.from_config("s", spec)
+    table, _ = run(scene.run_config(scene.candidates[0], 32))
+    last = table.iloc[-1]
+    assert last["mass_released"] == pytest.approx(1000.0) and last["mass_total"] > 999.0
+    path = tmp_path / "runs.parquet"
+    write_parquet(table, path)
+    plan = pd.DataFrame([{"candidate": 0, "label": "", "n": 32, "first": 0, "last": 0, "round": 0}])
+    row = S.read_runs(plan, [str(path)]).iloc[0]
+    held = (last["mass_released"] - last["mass_outflow"]) / last["mass_released"]
+    assert row["mass_total"] == pytest.approx(held, rel=1e-12) and S.unscored(scene, row) == ""
+    lost = row.copy()
+    lost["mass_total"] = 1.0 - 2.0 * S.MASS_LOSS_MAX
+    assert S.unscored(scene, lost).startswith("mass lost through the window's ends")
+    assert S.held(pd.Series({"mass_total": 0.5})) == 0.5  # a spill's run: its unit mass's fraction as it is
+
+
 def test_a_run_that_never_goes_negative_has_no_negative_step():
     table = pd.DataFrame(
         {"step": [0, 1, 2], "time": [0.0, 1.0, 2.0], "dt": [0.0, 1.0, 1.0], "mass_min": [0.0, -1e-13, 0.0]}

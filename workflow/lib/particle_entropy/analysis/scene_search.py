@@ -581,11 +581,13 @@ def negative_steps(table: pd.DataFrame) -> tuple[int, float, float, float]:
 
 
 REACTIVE_ONLY = ("product_error", "SSE_points_C", "mass_lost_BC")  # a reactive run's columns (models/simulate.py)
+RELEASED = "mass_released"  # a release run's column (models/simulate.py): the mass let out by then
 
 
 def _run_columns(path: str, keep: list[str]) -> list[str] | None:
     """The columns of the run table at ``path`` that read_runs reads: a run table holds every step's
-    measures (dozens of columns), of which a round needs a few; a conservative run has no REACTIVE_ONLY.
+    measures (dozens of columns), of which a round needs a few; a conservative run has no REACTIVE_ONLY, a
+    spill no RELEASED.
     None (every column) where its schema cannot be read, so that read_parquet names the table's fault."""
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -594,13 +596,24 @@ def _run_columns(path: str, keep: list[str]) -> list[str] | None:
         have = set(pq.read_schema(path).names)
     except (OSError, pa.ArrowException):
         return None
-    return ["seed", "step", "time", "dt", "mass_min", WALL, *keep, *(k for k in REACTIVE_ONLY if k in have)]
+    return [
+        "seed",
+        "step",
+        "time",
+        "dt",
+        "mass_min",
+        WALL,
+        *keep,
+        *(k for k in (*REACTIVE_ONLY, RELEASED) if k in have),
+    ]
 
 
 def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
     """One row per run of a plan (``paths`` in its order): the last step's measures, the smallest
     mass over every step and its first negative step (negative_steps), the run's work and its
-    measured core-seconds (the sum of its steps' wall time: search.measured_core_s)."""
+    measured core-seconds (the sum of its steps' wall time: search.measured_core_s). A release run's
+    ``mass_total`` is the fraction it holds of the mass released by t_final (``held``), 1 for a whole
+    plume, as a spill's is of its unit mass."""
     keep = ["SSE_points", "COMIC_points", "H_C", "H_C_analytic", "E", "E_analytic", "mass_total"]
     keep += ["dV", "work"]
     columns = [
@@ -632,6 +645,7 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                     "half_step": bool(getattr(r, "half_step", False)),
                     "seed": int(seed),
                     **{k: float(last[k]) for k in keep},
+                    "mass_total": held(last),
                     **{k: float(last[k]) if k in g else math.nan for k in REACTIVE_ONLY},
                     "mass_min": smallest,
                     "negative_step": step,
@@ -642,6 +656,13 @@ def read_runs(plan: pd.DataFrame, paths: list[str]) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+def held(last) -> float:
+    """The mass a run holds at its ``last`` row: a spill's of its unit mass, a release's the fraction of the
+    mass released by then (``mass_released``), so that what left an FD window counts alike."""
+    released = float(last[RELEASED]) if RELEASED in last else math.nan
+    return float(last["mass_total"]) / released if released > 0 else float(last["mass_total"])
 
 
 FAMILIES = {"fd": "grid (best FD)", "pt": "particles (best PT or MTPT)", "mtpt": "particles (best PT or MTPT)"}
