@@ -174,3 +174,18 @@ def test_the_plot_job_runs_the_recommended_rung_on_the_first_seed(plane):
     run = SM.model_run(plane, table, base_seed=3)
     assert run.recommended and run.seed == 3 and run.cfg.n == 16 and run.cfg.method == "fd"
     assert len(run.state) == 17 * 17 and {"x", "y", "c"} <= set(run.state)
+
+
+def test_a_point_still_releasing_is_mapped_in_decades():
+    """A 2-D point source still releasing is infinite at its point: the map's levels are 1 and 3 times the
+    powers of ten from three decades below its peak, where even bands would leave the plume's body blank."""
+    np.testing.assert_allclose(SM.decade_levels(54.0), [0.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0], rtol=1e-12)
+    source = {"kind": "point", "x0": [0.0, 0.0], "release": {"rate": 1.0}}
+    well = Scene.from_config("well", {**_SPEC, "source": source, "candidates": [FD]})
+    maps, (cx, _) = _maps(well, None)
+    top = float(np.nanmax(maps.exact))
+    assert maps.levels[0] == 0.0 and maps.levels[-2] < top <= maps.levels[-1]
+    assert top * 1e-3 <= maps.levels[1] < top * 3e-3
+    exact = maps.filled[0]
+    assert exact.norm(maps.levels[1:-1]).tolist() == list(range(1, len(maps.levels) - 1))  # a colour a band
+    assert "M/L" in cx.figure.axes[-1].get_ylabel()  # a release's mass, not a unit mass

@@ -17,7 +17,7 @@ from particle_entropy.scenes.scene import Scene
 exit_on_table_errors()  # a table that fails its page checksums: one line naming it, exit 1
 
 table, par = read_parquet(snakemake.input[0]), snakemake.params
-built, maps = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults), None
+built, maps, profile = Scene.from_config(snakemake.wildcards.name, par.spec, par.case_defaults), None, None
 if built.dim == 2:  # its maps: the model's final state, run here
     from particle_entropy.figures.scene_maps import model_run
 
@@ -25,5 +25,12 @@ if built.dim == 2:  # its maps: the model's final state, run here
     if run is not None:
         print(f"map of {run.row['label']} at n = {run.row['n']}: run in {run.wall_s:.2f} s", file=sys.stderr)
     maps = (built, run)
-figure = scene(table, maps)
+    if built.release is not None:  # and the plume's axis: the recommended and each FD scheme's best rung
+        from particle_entropy.figures.scene_profile import profile_runs
+
+        profile = profile_runs(built, table, par.base_seed, [run])
+figure = scene(table, maps, profile)
+if profile is not None:
+    for label in figure.profile.models:
+        print(f"along the axis, {label}: max |error| {figure.profile.max_error(label):.4g} beyond B", file=sys.stderr)
 save_figure(figure, snakemake.output.png, snakemake.output.pdf)

@@ -9,7 +9,9 @@ seeds). Unscored runs (negative concentrations) are drawn hollow and named below
 an error (NaN: not run, as when the reference cannot judge the target) or at error 0 has no place
 on the log axis: it is not drawn, and panel (a) says how many are missing. A 2-D scene's figure adds
 (c) the exact concentration at t_final and (d) the recommended model's, one grid and one set of levels
-(figures/scene_maps.py); a 1-D scene's is drawn as before.
+(figures/scene_maps.py); a 1-D scene's is drawn as before. A 2-D scene with a release draws in (b) instead
+the concentration along the plume's axis: the exact plume, the recommended model and each FD candidate's
+best rung (figures/scene_profile.py), as the MT3DMS manual compares its schemes.
 """
 
 from __future__ import annotations
@@ -28,21 +30,24 @@ MEASURE_LABEL = {
 }
 
 
-def scene(table: pd.DataFrame, maps=None):
+def scene(table: pd.DataFrame, maps=None, profile=None):
     """The figure of one scene's table; of a 2-D scene with ``maps``, (scene, its ModelRun or None),
-    panels a and b above the exact and the model's maps (figures/scene_maps.py)."""
+    panels a and b above the exact and the model's maps (figures/scene_maps.py); with ``profile``, the
+    ModelRuns of a 2-D release scene's axis (figures/scene_profile.profile_runs), panel b draws them
+    along the plume's axis (drawn: the figure's ``profile`` attribute, a scene_profile.Profile)."""
     if maps is None:
         fig, (ax, bx) = new_figure(2, width=5.4, height=5.6)
     else:
         fig, (ax, bx) = _with_maps(*maps)
     name, measure, target = table["scene"].iloc[0], table["measure"].iloc[0], table["target"].iloc[0]
     labels = list(dict.fromkeys(table["label"]))
+    colours = {label: AUTO_COLOURS[i % len(AUTO_COLOURS)] for i, label in enumerate(labels)}
     reactive = "product_series" in table
     drawable = _on_log_axes(table)
     for i, label in enumerate(labels):
         every = table[table["label"] == label].sort_values("n")
         rows = every[drawable[every.index]]  # a NaN or zero error has no place on the log axis
-        colour, marker = AUTO_COLOURS[i % len(AUTO_COLOURS)], AUTO_MARKERS[i % len(AUTO_MARKERS)]
+        colour, marker = colours[label], AUTO_MARKERS[i % len(AUTO_MARKERS)]
         scored = rows["unscored"] == ""
         err = np.vstack([rows["error_mean"] - rows["error_lo"], rows["error_hi"] - rows["error_mean"]])
         ax.errorbar(
@@ -79,6 +84,8 @@ def scene(table: pd.DataFrame, maps=None):
                     label=f"{label}, n = {r['n']:,}",
                 )
             continue
+        if profile is not None:
+            continue
         scored = every["unscored"] == ""
         bx.plot(
             every.loc[scored, "n"],
@@ -108,6 +115,10 @@ def scene(table: pd.DataFrame, maps=None):
     comic = table[table["comic_best"]]
     if reactive:
         _product_panel(bx, table, best)
+    elif profile is not None:
+        from .scene_profile import draw_profile
+
+        fig.profile = draw_profile(bx, maps[0], profile, colours)
     elif len(comic):
         r = comic.iloc[0]
         bx.plot(
@@ -126,7 +137,7 @@ def scene(table: pd.DataFrame, maps=None):
         label = label.replace("[1/L]", "[1/L²]")
     style_axes(ax, "a", f"scene {name}: error against cost", label, "counted cost of one run [s]", logx=True)
     ax.set_yscale("log")
-    if not reactive:
+    if not reactive and profile is None:
         style_axes(
             bx,
             "b",

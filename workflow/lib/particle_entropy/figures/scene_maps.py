@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import matplotlib
 import numpy as np
 import pandas as pd
-from matplotlib.colors import ListedColormap
+from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
@@ -30,6 +30,7 @@ from .style import BLACK, VERMILLION
 MAP_NODES = 200  # grid points a side
 MAP_REACH = 4.0  # the grid spans the exact plume's centre +- 4 sd along x and y
 LEVELS = 10  # filled-contour bands, at most (MaxNLocator's round numbers from 0 to the larger peak)
+DECADES = 3  # a plume infinite at its source: bands 1 and 3 times each power of ten, this many decades down
 CMAP = "YlGnBu"  # light where nothing is: the plume stands out on white
 
 
@@ -64,28 +65,38 @@ class Maps:
     rmse: float
 
 
+def best_rungs(table: pd.DataFrame) -> pd.DataFrame:
+    """Every candidate's best rung: its scored run of least mean error (the cheaper on a tie), one row a
+    candidate that has one, in the table's candidate order."""
+    err = table["error_mean"].astype(float)
+    ran = table[np.isfinite(err) & (table["unscored"] == "")]
+    best = ran.sort_values(["error_mean", "cost_s"]).groupby("candidate", sort=False).head(1)
+    return best.sort_values("candidate")
+
+
 def map_row(table: pd.DataFrame) -> tuple[pd.Series | None, bool]:
     """The rung the model panel draws, and whether it is the recommended one: the recommended row;
-    else, of every candidate's best rung (its least mean error, a scored run), the cheapest (least
-    counted cost); (None, False) if no rung has an error."""
+    else, of every candidate's best rung (``best_rungs``), the cheapest (least counted cost); (None,
+    False) if no rung has an error."""
     best = table[table["recommended"]]
     if len(best):
         return best.iloc[0], True
-    err = table["error_mean"].astype(float)
-    ran = table[np.isfinite(err) & (table["unscored"] == "")]
-    if not len(ran):
+    per_candidate = best_rungs(table)
+    if not len(per_candidate):
         return None, False
-    per_candidate = ran.sort_values(["error_mean", "cost_s"]).groupby("candidate", sort=False).head(1)
     return per_candidate.sort_values(["cost_s", "error_mean"]).iloc[0], False
 
 
 def model_run(scene, table: pd.DataFrame, base_seed: int) -> ModelRun | None:
     """The final state of the rung ``map_row`` picks, run once on the scene's first seed; None if none."""
+    row, recommended = map_row(table)
+    return None if row is None else run_row(scene, row, recommended, base_seed)
+
+
+def run_row(scene, row: pd.Series, recommended: bool, base_seed: int) -> ModelRun:
+    """The final state of the table ``row``'s rung (its candidate and n), run once on the scene's first seed."""
     from ..models.simulate import run
 
-    row, recommended = map_row(table)
-    if row is None:
-        return None
     candidate = scene.candidates[int(row["candidate"])]
     cfg = scene.run_config(candidate, int(row["n"]), seed=int(base_seed))
     start = time.perf_counter()
@@ -129,13 +140,11 @@ def draw_maps(axes, cax, scene, run: ModelRun | None, nodes: int = MAP_NODES) ->
         model = concentration(run.cfg, run.state, points).reshape(len(x), len(y))
         at = scene.points
         rmse = float(np.sqrt(np.mean((concentration(run.cfg, run.state, at) - exact_ref.density(at)) ** 2)))
-    top = max(float(exact.max()), float(model.max()) if model is not None else 0.0)
-    levels = MaxNLocator(nbins=LEVELS).tick_values(0.0, top)
-    levels = levels[levels >= 0.0]
-    if levels[-1] < top:
-        levels = np.append(levels, levels[-1] + (levels[1] - levels[0]))
-    below = model is not None and float(model.min()) < 0.0  # a model's negative values: the under colour
-    style = {"levels": levels, **_colours(len(levels) - 1), "extend": "min" if below else "neither"}
+    top = max(float(np.nanmax(exact)), float(np.nanmax(model)) if model is not None else 0.0)
+    singular = bool(getattr(exact_ref, "singular", False))  # a 2-D point still releasing: c ~ ln(1/r) at it
+    levels = decade_levels(top) if singular else even_levels(top)
+    below = model is not None and float(np.nanmin(model)) < 0.0  # a model's negative values: the under colour
+    style = {"levels": levels, **_colours(levels), "extend": "min" if below else "neither"}
     lines_at = levels[1:-1]
     filled, lines = [], []
     for ax, c in zip(axes, (exact, model)):
@@ -154,15 +163,44 @@ def draw_maps(axes, cax, scene, run: ModelRun | None, nodes: int = MAP_NODES) ->
         key = [Line2D([], [], color=BLACK, lw=0.7), Patch(facecolor=style["cmap"](0.75), edgecolor="none")]
         axes[1].legend(key, ["exact", "model"], loc="upper right", fontsize=8, framealpha=0.9)
     cbar = axes[0].figure.colorbar(filled[0], cax=cax)
-    cbar.set_label(r"concentration $c$ [1/L$^2$]")
+    cbar.set_label(concentration_label(scene))
     return Maps(x, y, exact, model, levels, tuple(filled), tuple(lines), math.nan if rmse is None else rmse)
 
 
-def _colours(bands: int) -> dict:
-    """contourf's colours for ``bands`` bands: white below the first level above 0, then CMAP's from
-    light to dark; a value below 0 (a model's undershoot) in VERMILLION."""
+def even_levels(top: float) -> np.ndarray:
+    """At most LEVELS bands of round, even width from 0 to at least ``top`` (MaxNLocator)."""
+    levels = MaxNLocator(nbins=LEVELS).tick_values(0.0, top)
+    levels = levels[levels >= 0.0]
+    if levels[-1] < top:
+        levels = np.append(levels, levels[-1] + (levels[1] - levels[0]))
+    return levels
+
+
+def decade_levels(top: float) -> np.ndarray:
+    """0, then 1 and 3 times each power of ten from DECADES decades below ``top`` up to the first at or above
+    it: a plume whose concentration is infinite at its source (a 2-D point still releasing) has its body
+    DECADES decades below its peak on any grid near the source, where even bands would leave it blank (the
+    MT3DMS manual contours its wells' plumes so, at 0.1, 1, 10, 50 mg/L)."""
+    low = math.floor(math.log10(top)) - DECADES
+    steps = [m * 10.0**k for k in range(low, low + DECADES + 2) for m in (1.0, 3.0)]
+    steps = [x for x in steps if x >= top * 10.0**-DECADES]
+    cut = next(i for i, x in enumerate(steps) if x >= top)
+    return np.array([0.0, *steps[: cut + 1]])
+
+
+def concentration_label(scene) -> str:
+    """The axis label of a 2-D scene's concentration: of its unit mass [1/L^2], or of a release's mass [M/L^2]."""
+    return r"concentration $c$ [M/L$^2$]" if scene.release is not None else r"concentration $c$ [1/L$^2$]"
+
+
+def _colours(levels: np.ndarray) -> dict:
+    """contourf's colours and norm for the bands between ``levels``: white below the first level above 0,
+    then CMAP's from light to dark, one a band whatever its width; a value below 0 (a model's undershoot)
+    in VERMILLION."""
+    bands = len(levels) - 1
     shades = matplotlib.colormaps[CMAP](np.linspace(0.12, 1.0, max(bands - 1, 1)))
-    return {"cmap": ListedColormap(np.vstack([[1.0, 1.0, 1.0, 1.0], shades])[:bands]).with_extremes(under=VERMILLION)}
+    cmap = ListedColormap(np.vstack([[1.0, 1.0, 1.0, 1.0], shades])[:bands]).with_extremes(under=VERMILLION)
+    return {"cmap": cmap, "norm": BoundaryNorm(levels, bands)}
 
 
 def _model_title(run: ModelRun | None, rmse: float | None) -> str:
