@@ -843,7 +843,8 @@ def test_the_sweep_figure_draws_each_dimension_in_its_own_lines_and_shades_each_
     fig = scenes_peclet(S.peclet_table(tables))
     ax = fig.axes[0]
     styles = {c.get_label(): c.lines[0].get_linestyle() for c in ax.containers}  # errorbar: (line, caps, bars)
-    assert styles[f"1-D: {S.FAMILIES['fd']}"] == "-" and styles[f"2-D: {S.FAMILIES['fd']}"] == "--"
+    fd = f"{S.FAMILIES['fd']}: upwind, Cr 0.5"  # every FD answer's scheme and Courant number, said once
+    assert styles[f"1-D: {fd}"] == "-" and styles[f"2-D: {fd}"] == "--"
     shaded = [p for p in ax.patches if "overtake" in p.get_label()]  # axvspan: a rectangle over the span
     spans = sorted((round(p.get_x(), 6), round(p.get_x() + p.get_width(), 6)) for p in shaded)
     assert spans == [(50.0, 500.0), (500.0, 700.0)]
@@ -873,7 +874,13 @@ def test_the_sweep_figure_s_ticks_are_decades_that_never_overlap_and_its_labels_
     assert labels == ["0", "10", "100", "1,000", "10,000"]
     ticks = list(ax.get_xticks())
     assert ticks[1:] == [10.0, 100.0, 1000.0, 10000.0] and ticks[0] < 10.0
-    notes = [a for a in ax.texts if a.get_text().startswith("upwind")]
+    assert 5091.0 < ax.get_xlim()[1] < 10000.0  # a decade's tick past the data does not widen the view
+    spans = sorted(p.get_label() for p in ax.patches if "overtake" in p.get_label())
+    assert spans == [
+        "1-D: particles overtake the grid: Pe in (51, 5,091]",
+        "2-D: particles overtake the grid: Pe in (42, 679]",
+    ]
+    notes = [a for a in ax.texts if a.get_text().startswith("Pe_dx")]  # the scheme and Courant: in the legend
     below = {round(a.xy[0], 6) for a in notes if a.get_position()[1] < 0}
     above = {round(a.xy[0], 6) for a in notes if a.get_position()[1] > 0}
     assert above == {42.0, 679.0} and 51.0 in below and 5091.0 in below

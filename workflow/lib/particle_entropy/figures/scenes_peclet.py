@@ -15,13 +15,35 @@ from ..analysis.scene_search import FAMILIES, crossover
 from .style import AUTO_COLOURS, AUTO_MARKERS, new_figure, style_axes
 
 
-def _fd_numbers(row) -> str:
-    """An FD answer's scheme (its label's third word; at rest none), grid Peclet and Courant numbers."""
+def _pe(p: float) -> str:
+    """A Peclet number as the README writes it: whole with thousands' commas from 100 on (5,091)."""
+    return f"{p:,.0f}" if p >= 100 else f"{p:.3g}"
+
+
+def _scheme(row) -> str:
+    """An FD answer's scheme: its label's third word; at rest none."""
     words = str(row.label).split()
-    scheme = words[2] if len(words) > 3 else "at rest"
+    return words[2] if len(words) > 3 else "at rest"
+
+
+def _fd_numbers(row, shared: str = "") -> str:
+    """An FD answer's scheme, grid Peclet and Courant numbers; with ``shared`` (the scheme and Courant
+    number every answer of its sweep in a flow has, said once in the legend) its grid Peclet number alone."""
     if not row.grid_peclet > 0:
-        return scheme
-    return f"{scheme}\nPe_dx {row.grid_peclet:.3g}, Cr {row.courant:.3g}"
+        return _scheme(row)
+    if shared:
+        return f"Pe_dx {row.grid_peclet:.3g}"
+    return f"{_scheme(row)}\nPe_dx {row.grid_peclet:.3g}, Cr {row.courant:.3g}"
+
+
+def _shared(rows: pd.DataFrame) -> str:
+    """The scheme and Courant number of every FD answer of a sweep in a flow, where they are one, else ''."""
+    moving = rows[rows["grid_peclet"] > 0]
+    kinds = {(_scheme(r), f"{r.courant:.3g}") for r in moving.itertuples()}
+    if len(kinds) != 1:
+        return ""
+    scheme, courant = kinds.pop()
+    return f"{scheme}, Cr {courant}"
 
 
 LINES = {1: "-", 2: "--"}  # a sweep's dimension -> its lines
@@ -68,7 +90,7 @@ def scenes_peclet(table: pd.DataFrame):
                 x_of[cross[0]],
                 x_of[cross[1]],
                 zorder=0,
-                label=f"{where}particles overtake the grid: Pe in ({cross[0]:,.3g}, {cross[1]:,.3g}]",
+                label=f"{where}particles overtake the grid: Pe in ({_pe(cross[0])}, {_pe(cross[1])}]",
                 **SHADES[int(dim)],
             )
     style_axes(
@@ -82,7 +104,9 @@ def scenes_peclet(table: pd.DataFrame):
         legend=None,
     )
     ticks, labels = _pe_ticks(x_of)
+    view = ax.get_xlim()  # the decades' ticks do not widen the view
     ax.set_xticks(ticks, labels)
+    ax.set_xlim(view)
     ax.minorticks_off()
     ax.legend(fontsize=6, loc="best")
     return fig
@@ -97,6 +121,7 @@ def _draw_sweep(ax, table: pd.DataFrame, dim: int, x_of: dict, top: float, named
         rows = rows.sort_values("peclet")
         x = rows["peclet"].map(x_of)
         met = rows["cost_s"].notna()
+        shared = _shared(rows[met]) if family == FAMILIES["fd"] else ""
         lo = (rows["cost_s"] - rows["cost_lo"]).where(rows["cost_lo"].notna(), 0.0)
         ax.errorbar(
             x[met],
@@ -109,12 +134,12 @@ def _draw_sweep(ax, table: pd.DataFrame, dim: int, x_of: dict, top: float, named
             lw=1.4,
             ls=LINES[int(dim)],
             capsize=2,
-            label=name,
+            label=f"{name}: {shared}" if shared else name,
         )
         if family == FAMILIES["fd"]:
             for px, row in zip(x[met], rows[met].itertuples()):
                 ax.annotate(
-                    _fd_numbers(row),
+                    _fd_numbers(row, shared),
                     (px, row.cost_s),
                     xytext=NOTE_AT[int(dim)],
                     textcoords="offset points",
