@@ -826,22 +826,26 @@ def test_a_2d_scene_s_whole_ladder_replayed_gives_brute_forces_answer(tmp_path):
     assert len(checked) >= 5  # the targets reach several answers
 
 
-def test_the_sweep_figure_draws_each_dimension_in_its_own_lines_and_shades_each_crossover():
-    """figures/scenes_peclet.png: the 1-D sweep in full lines, the 2-D one dashed, and two shaded
-    crossovers whose spans are each sweep's own (50, 500] and (500, 700]."""
+def _sweep_axes(tables: list[pd.DataFrame]):
+    """The axes of figures/scenes_peclet.png drawn from scene tables (_answer's)."""
     import matplotlib
 
     matplotlib.use("Agg")
     from particle_entropy.figures.scenes_peclet import scenes_peclet
 
+    return scenes_peclet(S.peclet_table(tables)).axes[0]
+
+
+def test_the_sweep_figure_draws_each_dimension_in_its_own_lines_and_shades_each_crossover():
+    """figures/scenes_peclet.png: the 1-D sweep in full lines, the 2-D one dashed, and two shaded
+    crossovers whose spans are each sweep's own (50, 500] and (500, 700]."""
     tables = [
         _answer("peclet-0", 50.0, 0.1, 0.4),
         _answer("peclet-1", 500.0, 1.0, 0.3),
         _answer("peclet2d-0", 500.0, 0.1, 0.4),
         _answer("peclet2d-1", 700.0, 13.0, 1.5),
     ]
-    fig = scenes_peclet(S.peclet_table(tables))
-    ax = fig.axes[0]
+    ax = _sweep_axes(tables)
     styles = {c.get_label(): c.lines[0].get_linestyle() for c in ax.containers}  # errorbar: (line, caps, bars)
     fd = f"{S.FAMILIES['fd']}: upwind, Cr 0.5"  # every FD answer's scheme and Courant number, said once
     assert styles[f"1-D: {fd}"] == "-" and styles[f"2-D: {fd}"] == "--"
@@ -856,11 +860,6 @@ def test_the_sweep_figure_s_ticks_are_decades_that_never_overlap_and_its_labels_
     """Two sweeps' Peclet numbers a few percent apart (42 and 51) would overlap as ticks: the axis
     ticks the decades the sweeps span (and "0" where a sweep is at rest), and the 2-D sweep's FD labels
     sit above its line while the 1-D ones sit below theirs."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from particle_entropy.figures.scenes_peclet import scenes_peclet
-
     tables = [
         _answer("peclet-0", 0.0, 0.1, 0.4),
         _answer("peclet-1", 51.0, 0.2, 0.4),
@@ -868,8 +867,7 @@ def test_the_sweep_figure_s_ticks_are_decades_that_never_overlap_and_its_labels_
         _answer("peclet2d-0", 42.0, 0.1, 0.4),
         _answer("peclet2d-1", 679.0, 13.0, 1.5),
     ]
-    fig = scenes_peclet(S.peclet_table(tables))
-    ax = fig.axes[0]
+    ax = _sweep_axes(tables)
     labels = [t.get_text() for t in ax.get_xticklabels()]
     assert labels == ["0", "10", "100", "1,000", "10,000"]
     ticks = list(ax.get_xticks())
