@@ -166,7 +166,19 @@ def test_check_config_refuses_a_bad_scene_and_accepts_the_shipped_ones():
 
     config = dict(load_yaml(ROOT / "config.yaml"))
     check_config(config)  # the shipped scenes are valid
-    shipped = {"paper", "carried", "spill", "narrow", "front", "well_mixed", "carried_reaction", "plume2d", "oblique", "mt3dms_p03", "mt3dms_p04"}
+    shipped = {
+        "paper",
+        "carried",
+        "spill",
+        "narrow",
+        "front",
+        "well_mixed",
+        "carried_reaction",
+        "plume2d",
+        "oblique",
+        "mt3dms_p03",
+        "mt3dms_p04",
+    }
     assert set(config["scenes"]) == shipped
     config["scenes"] = {**config["scenes"], "carried": {**config["scenes"]["carried"], "margin": 0.5}}
     with pytest.raises(SettingError) as err:
