@@ -6,7 +6,7 @@ import sys
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)
 
-from particle_entropy.analysis.scene_search import SceneSearch, read_runs
+from particle_entropy.analysis.scene_search import SceneSearch
 from particle_entropy.core.io import exit_on_table_errors, read_parquet, write_parquet
 from particle_entropy.scenes.scene import Scene
 
@@ -23,7 +23,7 @@ if "reference" in inp.keys():  # a reactive scene's: a target it cannot judge st
 search = SceneSearch(scene, reference)
 if plan is None:
     plan = search.first_plan(int(par.base_seed))
-    runs = read_runs(plan.iloc[:0], [])  # none yet
+    runs = search.read_runs(plan.iloc[:0], [])  # none yet
 else:
     earlier = read_parquet(inp.read) if "read" in inp.keys() else None
     runs = search.runs_since(plan, list(inp.runs), earlier)

@@ -150,17 +150,13 @@ class AdaptiveSearch(ABC):
         read (of every row but those ``plan``'s last round added, which come last: ``extended``), so
         that only the new rows' run tables are read. ``earlier`` None: every row's. A kind whose
         read_runs gives a table with a row per run, in the plan's order (KEEPS_READS)."""
-        if earlier is None or plan.empty:
+        new = (plan[ROUND] == plan[ROUND].max()).to_numpy()  # an empty plan: none, and all() holds
+        if earlier is None or new.all():
             return self.read_runs(plan, list(paths))
-        new = (plan[ROUND] == plan[ROUND].max()).to_numpy()
-        if new.all():
-            return self.read_runs(plan, list(paths))
-        old = plan[~new].reset_index(drop=True)
-        if not new[len(old) :].all():
+        first = int(new.argmax())
+        if not new[first:].all():
             raise ValueError(f"{self.title}: a plan's last round must add its rows after the earlier ones")
-        added = self.read_runs(plan[new].reset_index(drop=True), [p for p, n in zip(paths, new) if n])
-        if added.empty:
-            return earlier
+        added = self.read_runs(plan.iloc[first:].reset_index(drop=True), list(paths)[first:])
         return added if earlier.empty else pd.concat([earlier, added], ignore_index=True)
 
     def round_inputs(self, k: int, plan_at: Callable[[int], str], plan_paths: PlanPaths) -> dict:

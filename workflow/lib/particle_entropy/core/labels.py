@@ -70,3 +70,13 @@ def case_label(case: Case, n: bool = True) -> str:
     if n and case.n is not None:
         parts.append(f"N={case.n:,}")
     return ", ".join(parts)
+
+
+def integer(x: float) -> str:
+    """An integer with thousands separators: 16970.56 -> '16,971'."""
+    return f"{round(float(x)):,}"
+
+
+def interval(lo: float, hi: float) -> str:
+    """A half-open interval of resolutions or Peclet numbers: (668, 1,243]."""
+    return f"({integer(lo)}, {integer(hi)}]"

@@ -3,7 +3,8 @@ sweeps' table (analysis/scene_search.peclet_table): the counted cost of one run 
 of the cheapest particle candidate that meet the target, against v L / D; bars from the cost of the
 failing resolution below each answer, hollow markers where a family never meets it, the crossover
 shaded over the sweep's spacing. Each FD answer is labelled with its scheme, grid Peclet number
-|v| dx / D and Courant number |v| dt / dx."""
+|v| dx / D and Courant number |v| dt / dx; a scheme and Courant number every answer of a sweep shares
+is said once, in its legend entry."""
 
 from __future__ import annotations
 
@@ -12,12 +13,8 @@ import math
 import pandas as pd
 
 from ..analysis.scene_search import FAMILIES, crossover
+from ..core.labels import interval
 from .style import AUTO_COLOURS, AUTO_MARKERS, new_figure, style_axes
-
-
-def _pe(p: float) -> str:
-    """A Peclet number as the README writes it: whole with thousands' commas from 100 on (5,091)."""
-    return f"{p:,.0f}" if p >= 100 else f"{p:.3g}"
 
 
 def _scheme(row) -> str:
@@ -55,9 +52,8 @@ def _pe_ticks(x_of: dict) -> tuple[list[float], list[str]]:
     whose own ticks would overlap) and, where a sweep has Pe = 0, "0" where it is drawn."""
     drawn = [x for p, x in x_of.items() if p > 0]
     ticks, labels = [], []
-    if len(drawn) != len(x_of):
-        zero = x_of[0] if 0 in x_of else min(x_of.values())
-        ticks, labels = [zero], ["0"]
+    if len(drawn) != len(x_of):  # Pe = 0 (a Peclet number is never negative)
+        ticks, labels = [x_of[0.0]], ["0"]
     if drawn:
         lo, hi = math.floor(math.log10(min(drawn))), math.ceil(math.log10(max(drawn)))
         ticks += [10.0**k for k in range(lo, hi + 1)]
@@ -90,7 +86,7 @@ def scenes_peclet(table: pd.DataFrame):
                 x_of[cross[0]],
                 x_of[cross[1]],
                 zorder=0,
-                label=f"{where}particles overtake the grid: Pe in ({_pe(cross[0])}, {_pe(cross[1])}]",
+                label=f"{where}particles overtake the grid: Pe in {interval(*cross)}",
                 **SHADES[int(dim)],
             )
     style_axes(

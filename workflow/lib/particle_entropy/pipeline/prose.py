@@ -32,6 +32,7 @@ import pandas as pd
 
 from ..analysis import resampling, scene_search
 from ..analysis.optimum import SEARCH_DEFAULTS
+from ..core.labels import integer, interval
 from ..core.registry import FGT_TOLERANCE, MEASUREMENT_POINTS
 from ..core.runconfig import GRID_SPACING, MAX_GRID_POINTS
 from ..core.settings import REACTIVE_COST, SCENE, SCENE_MIN_MARGIN, defaults
@@ -54,11 +55,6 @@ SEARCH_KEYS = ("width", "realisations", "max_realisations", "initial_points", "s
 
 
 # ------------------------------------------------------------------------------ formatting
-def integer(x: float) -> str:
-    """An integer with thousands separators: 16970.56 -> '16,971'."""
-    return f"{round(float(x)):,}"
-
-
 def seconds(x: float) -> str:
     """A counted cost to SIGNIFICANT digits, without an exponent below 1e4: 0.000356 -> '0.00036'."""
     return f"{float(x):.{SIGNIFICANT}g}"
@@ -79,11 +75,6 @@ def exponent(n: int) -> str:
 def percent(x: float) -> str:
     """A fraction as a percentage: 0.95 -> '95 %'."""
     return f"{100 * float(x):g} %"
-
-
-def interval(lo: float, hi: float) -> str:
-    """A half-open interval of resolutions or Peclet numbers: (668, 1,243]."""
-    return f"({integer(lo)}, {integer(hi)}]"
 
 
 def model(label: str) -> str:
