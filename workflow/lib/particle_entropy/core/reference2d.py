@@ -34,6 +34,8 @@ _H_STEP = 2.0  # ... on panels at most 2 marginal sd wide within 8 sd of an edge
 _H_MIN_STEP = 6.0  # ... and at most 6 sd of S's minor axis (an oblique S's corners vary on that scale) ...
 _H_NODES = 12  # ... each with 12 Gauss-Legendre nodes
 
+LATTICE_N, LATTICE_SDS = 15, 3.0  # the measurement lattice: n x n points, +- sds standard deviations along each axis
+
 
 def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights on [-1, 1]."""
@@ -210,7 +212,7 @@ class Reference2D:
         (principal_axes)."""
         return principal_axes(self.covariance, self.v)
 
-    def points(self, n: int = 15, sds: float = 3.0) -> np.ndarray:
+    def points(self, n: int = LATTICE_N, sds: float = LATTICE_SDS) -> np.ndarray:
         """The measurement points (n * n, 2) over the plume (lattice), carried with it [L]."""
         return lattice(self.centre, self.covariance, self.v, n, sds)
 
@@ -234,7 +236,7 @@ def principal_axes(covariance, v) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(np.clip(values, 0.0, None)), axes
 
 
-def lattice(centre, covariance, v, n: int = 15, sds: float = 3.0) -> np.ndarray:
+def lattice(centre, covariance, v, n: int = LATTICE_N, sds: float = LATTICE_SDS) -> np.ndarray:
     """The measurement points (n * n, 2): an n x n lattice along the principal axes of the plume's
     ``covariance`` (principal_axes), +- ``sds`` standard deviations along each, centred on the plume's
     ``centre`` (carried with it), the first axis's index the slower; independent of any model's window [L]."""

@@ -61,7 +61,7 @@ import numpy as np
 
 from . import measures as M
 from . import plane
-from .reference2d import lattice
+from .reference2d import LATTICE_N, LATTICE_SDS, lattice
 from .release import Release, ReleaseReference, ReleaseReference2D
 
 # the measures a run reads off the exact plume's value at points (its own or the measurement points; a
@@ -292,6 +292,6 @@ class ReleasedPlume2D(_Released):
         p = np.atleast_2d(np.asarray(points, dtype=np.float64))
         return self._density(p, len(p))
 
-    def points(self, n: int = 15, sds: float = 3.0) -> np.ndarray:
+    def points(self, n: int = LATTICE_N, sds: float = LATTICE_SDS) -> np.ndarray:
         """The n x n lattice over the released plume (reference2d.lattice) [L]."""
         return lattice(self.centre, self.covariance, np.asarray(self.v, dtype=np.float64), n, sds)

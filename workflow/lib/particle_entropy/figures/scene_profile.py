@@ -19,11 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from ..core.reference2d import LATTICE_SDS  # the axis spans the lattice's extent along it
 from .scene_maps import ModelRun, best_rungs, concentration, concentration_label, run_row
 from .style import BLACK, style_axes
 
 AXIS_NODES = 401  # points along the axis
-LATTICE_SDS = 3.0  # the axis spans the released plume's centre +- this many sd along it, as the lattice does
 
 
 @dataclass(frozen=True)
