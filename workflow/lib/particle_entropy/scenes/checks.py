@@ -16,6 +16,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.case import SettingError
+from ..core.released import singular
 from ..core.runconfig import check_plume_width
 from ..core.settings import SCENE_REACH
 
@@ -100,10 +101,7 @@ def check_release_points(scene) -> None:
     falls on a tick. H_C and E integrate c ln c and c over the plume, finite (the singularity is
     integrable), and a release that ends before t_final, or a source with an extent, has a finite
     concentration everywhere: those are not refused."""
-    release = scene.release
-    if release is None or scene.dim != 2 or scene.source.kind != "point" or release.end is not None:
-        return
-    if scene.measure != "rmse":
+    if scene.release is None or scene.measure != "rmse" or not singular(scene.source, scene.release, scene.t_final):
         return
     plume = scene.reference
     points = np.asarray(scene.points, dtype=np.float64)
